@@ -1,0 +1,423 @@
+//! The world as plain data: floor regions, the RoboCup Small-Size field, walls, cubes and
+//! pillars. Scenario files embed these types directly; [`Layout::solids`] turns them into the
+//! one list of solid shapes that both the physics world and the renderer use.
+
+use crate::shapes::{Solid, SolidShape};
+use nalgebra::{Point2, Vector2};
+use serde::{Deserialize, Serialize};
+
+/// An 8-bit RGB colour, written `[r, g, b]` in scenario files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Rgb(pub [u8; 3]);
+
+impl Rgb {
+    /// Components scaled to 0..1.
+    pub fn to_unit(self) -> [f32; 3] {
+        [
+            self.0[0] as f32 / 255.0,
+            self.0[1] as f32 / 255.0,
+            self.0[2] as f32 / 255.0,
+        ]
+    }
+}
+
+/// The playing floor of the RoboCup Small-Size field (Fig. 6 of the corner paper, with the
+/// project's choices for goals, walls and lines). The field centre is the world origin, its long
+/// axis the world x axis; the yellow goal is at +x, the blue goal at -x.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FieldSpec {
+    /// A1: half-length of the playing floor, to the goal lines.
+    pub half_length_mm: f64,
+    /// B: half-width of the playing floor.
+    pub half_width_mm: f64,
+    /// A2 - A1: how far the floor runs on into each goal.
+    pub goal_depth_mm: f64,
+    /// Width of the goal mouth.
+    pub goal_width_mm: f64,
+    /// Height of the goal walls.
+    pub goal_wall_height_mm: f64,
+    /// Height of the field walls around the floor region.
+    pub wall_height_mm: f64,
+    /// Thickness of field and goal walls (they stand outside the floor region).
+    pub wall_thickness_mm: f64,
+    /// Width of the white lines.
+    pub line_width_mm: f64,
+    /// Radius of the centre circle.
+    pub centre_circle_radius_mm: f64,
+    /// Colour of the field walls.
+    pub wall_rgb: Rgb,
+    /// Colour of the goal at +x.
+    pub goal_pos_x_rgb: Rgb,
+    /// Colour of the goal at -x.
+    pub goal_neg_x_rgb: Rgb,
+}
+
+impl Default for FieldSpec {
+    fn default() -> Self {
+        Self {
+            half_length_mm: 1370.0,
+            half_width_mm: 762.5,
+            goal_depth_mm: 180.0,
+            goal_width_mm: 500.0,
+            goal_wall_height_mm: 160.0,
+            wall_height_mm: 100.0,
+            wall_thickness_mm: 50.0,
+            line_width_mm: 10.0,
+            centre_circle_radius_mm: 250.0,
+            wall_rgb: Rgb([235, 235, 235]),
+            goal_pos_x_rgb: Rgb([235, 200, 20]),
+            goal_neg_x_rgb: Rgb([25, 60, 220]),
+        }
+    }
+}
+
+impl FieldSpec {
+    /// A2: half-length of the floor region to the goal backs.
+    pub fn floor_half_length_mm(&self) -> f64 {
+        self.half_length_mm + self.goal_depth_mm
+    }
+
+    /// The floor region: the playing rectangle and the two goal pockets.
+    pub fn floor_rects(&self) -> [FloorRect; 3] {
+        let a1 = self.half_length_mm;
+        let gd = self.goal_depth_mm;
+        [
+            FloorRect {
+                center_mm: [0.0, 0.0],
+                size_mm: [2.0 * a1, 2.0 * self.half_width_mm],
+                angle_deg: 0.0,
+            },
+            FloorRect {
+                center_mm: [a1 + gd / 2.0, 0.0],
+                size_mm: [gd, self.goal_width_mm],
+                angle_deg: 0.0,
+            },
+            FloorRect {
+                center_mm: [-(a1 + gd / 2.0), 0.0],
+                size_mm: [gd, self.goal_width_mm],
+                angle_deg: 0.0,
+            },
+        ]
+    }
+
+    /// Field walls and goal walls as wall segments whose inner faces lie on the floor boundary.
+    pub fn walls(&self) -> Vec<Wall> {
+        let a1 = self.half_length_mm;
+        let a2 = self.floor_half_length_mm();
+        let b = self.half_width_mm;
+        let g = self.goal_width_mm / 2.0;
+        let t = self.wall_thickness_mm;
+        let h = t / 2.0;
+        let field = |from: [f64; 2], to: [f64; 2]| Wall {
+            from_mm: from,
+            to_mm: to,
+            thickness_mm: t,
+            height_mm: self.wall_height_mm,
+            rgb: self.wall_rgb,
+        };
+        let goal = |from: [f64; 2], to: [f64; 2], rgb: Rgb| Wall {
+            from_mm: from,
+            to_mm: to,
+            thickness_mm: t,
+            height_mm: self.goal_wall_height_mm,
+            rgb,
+        };
+        let mut walls = vec![
+            // Long sides, running over the corners so that no gap is left.
+            field([-a1 - t, b + h], [a1 + t, b + h]),
+            field([-a1 - t, -b - h], [a1 + t, -b - h]),
+        ];
+        for s in [1.0, -1.0] {
+            // End walls beside each goal mouth.
+            walls.push(field([s * (a1 + h), g], [s * (a1 + h), b]));
+            walls.push(field([s * (a1 + h), -g], [s * (a1 + h), -b]));
+            let rgb = if s > 0.0 {
+                self.goal_pos_x_rgb
+            } else {
+                self.goal_neg_x_rgb
+            };
+            // Goal back and sides.
+            walls.push(goal([s * (a2 + h), -g - t], [s * (a2 + h), g + t], rgb));
+            walls.push(goal([s * a1, g + h], [s * (a2 + t), g + h], rgb));
+            walls.push(goal([s * a1, -g - h], [s * (a2 + t), -g - h], rgb));
+        }
+        walls
+    }
+
+    /// Is `p` on one of the white lines (boundary, centre line, centre circle)?
+    pub fn on_line(&self, p: Point2<f64>) -> bool {
+        let w = self.line_width_mm;
+        let a1 = self.half_length_mm;
+        let b = self.half_width_mm;
+        let (ax, ay) = (p.x.abs(), p.y.abs());
+        if ax > a1 || ay > b {
+            return false;
+        }
+        let boundary = ax >= a1 - w || ay >= b - w;
+        let centre_line = ax <= w / 2.0;
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        let circle = (r - self.centre_circle_radius_mm).abs() <= w / 2.0;
+        boundary || centre_line || circle
+    }
+}
+
+/// A rectangle of floor colour (for floors other than the field, e.g. corridors).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FloorRect {
+    /// Centre of the rectangle.
+    pub center_mm: [f64; 2],
+    /// Full side lengths along its own x and y axes.
+    pub size_mm: [f64; 2],
+    /// Rotation of its x axis from the world x axis.
+    #[serde(default)]
+    pub angle_deg: f64,
+}
+
+impl FloorRect {
+    /// Does the rectangle contain `p` (boundary included)?
+    pub fn contains(&self, p: Point2<f64>) -> bool {
+        let (s, c) = self.angle_deg.to_radians().sin_cos();
+        let d = p - Point2::from(self.center_mm);
+        let lx = c * d.x + s * d.y;
+        let ly = -s * d.x + c * d.y;
+        lx.abs() <= self.size_mm[0] / 2.0 && ly.abs() <= self.size_mm[1] / 2.0
+    }
+}
+
+/// A free-standing wall: a segment with thickness, height and colour.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Wall {
+    /// One end of the wall's centre line.
+    pub from_mm: [f64; 2],
+    /// The other end of the wall's centre line.
+    pub to_mm: [f64; 2],
+    /// Thickness across the centre line.
+    #[serde(default = "default_wall_thickness")]
+    pub thickness_mm: f64,
+    /// Height above the floor.
+    #[serde(default = "default_wall_height")]
+    pub height_mm: f64,
+    /// Colour.
+    #[serde(default = "default_wall_rgb")]
+    pub rgb: Rgb,
+}
+
+fn default_wall_thickness() -> f64 {
+    100.0
+}
+fn default_wall_height() -> f64 {
+    150.0
+}
+fn default_wall_rgb() -> Rgb {
+    Rgb([235, 235, 235])
+}
+
+/// A cube standing on the floor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cube {
+    /// Centre of its footprint.
+    pub center_mm: [f64; 2],
+    /// Side length.
+    #[serde(default = "default_cube_size")]
+    pub size_mm: f64,
+    /// Rotation about the vertical axis.
+    #[serde(default)]
+    pub angle_deg: f64,
+    /// Colour.
+    #[serde(default = "default_cube_rgb")]
+    pub rgb: Rgb,
+}
+
+fn default_cube_size() -> f64 {
+    130.0
+}
+fn default_cube_rgb() -> Rgb {
+    Rgb([40, 40, 40])
+}
+
+/// An upright cylinder standing on the floor (a pillar, a post).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pillar {
+    /// Centre of its footprint.
+    pub center_mm: [f64; 2],
+    /// Radius.
+    pub radius_mm: f64,
+    /// Height above the floor.
+    pub height_mm: f64,
+    /// Colour.
+    pub rgb: Rgb,
+}
+
+/// The static world: floor, field, walls and obstacles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Layout {
+    /// The RoboCup Small-Size field, when present (`[world.field]`).
+    pub field: Option<FieldSpec>,
+    /// Extra rectangles of floor colour. With neither a field nor rectangles the whole plane is
+    /// floor.
+    pub floor_rects: Vec<FloorRect>,
+    /// Colour of the floor region (field green).
+    pub floor_rgb: Rgb,
+    /// Colour of the floor outside the floor region.
+    pub outside_rgb: Rgb,
+    /// Colour of the field's white lines.
+    pub line_rgb: Rgb,
+    /// Free-standing walls.
+    pub walls: Vec<Wall>,
+    /// Cubes.
+    pub cubes: Vec<Cube>,
+    /// Pillars.
+    pub pillars: Vec<Pillar>,
+}
+
+impl Default for Layout {
+    fn default() -> Self {
+        Self {
+            field: None,
+            floor_rects: Vec::new(),
+            floor_rgb: Rgb([30, 130, 55]),
+            outside_rgb: Rgb([120, 100, 80]),
+            line_rgb: Rgb([240, 240, 240]),
+            walls: Vec::new(),
+            cubes: Vec::new(),
+            pillars: Vec::new(),
+        }
+    }
+}
+
+impl Layout {
+    /// Every floor-coloured rectangle: the field's and the extra ones.
+    pub fn all_floor_rects(&self) -> Vec<FloorRect> {
+        let mut rects: Vec<FloorRect> = self.field.iter().flat_map(|f| f.floor_rects()).collect();
+        rects.extend(self.floor_rects.iter().cloned());
+        rects
+    }
+
+    /// Is the floor at `p` floor-coloured (inside the floor region)?
+    pub fn is_floor(&self, p: Point2<f64>) -> bool {
+        if self.field.is_none() && self.floor_rects.is_empty() {
+            return true;
+        }
+        self.all_floor_rects().iter().any(|r| r.contains(p))
+    }
+
+    /// Every wall, the field's included.
+    pub fn all_walls(&self) -> Vec<Wall> {
+        let mut walls: Vec<Wall> = self.field.iter().flat_map(|f| f.walls()).collect();
+        walls.extend(self.walls.iter().cloned());
+        walls
+    }
+
+    /// All solid obstacles as boxes and cylinders, in world coordinates.
+    pub fn solids(&self) -> Vec<Solid> {
+        let mut out = Vec::new();
+        for w in self.all_walls() {
+            let a = Vector2::from(w.from_mm);
+            let b = Vector2::from(w.to_mm);
+            let d = b - a;
+            let len = d.norm();
+            out.push(Solid {
+                shape: SolidShape::Box {
+                    center_mm: Point2::from((a + b) / 2.0),
+                    half_extents_mm: Vector2::new(len / 2.0, w.thickness_mm / 2.0),
+                    angle_rad: d.y.atan2(d.x),
+                },
+                height_mm: w.height_mm,
+                rgb: w.rgb,
+            });
+        }
+        for c in &self.cubes {
+            out.push(Solid {
+                shape: SolidShape::Box {
+                    center_mm: Point2::from(c.center_mm),
+                    half_extents_mm: Vector2::new(c.size_mm / 2.0, c.size_mm / 2.0),
+                    angle_rad: c.angle_deg.to_radians(),
+                },
+                height_mm: c.size_mm,
+                rgb: c.rgb,
+            });
+        }
+        for p in &self.pillars {
+            out.push(Solid {
+                shape: SolidShape::Cylinder {
+                    center_mm: Point2::from(p.center_mm),
+                    radius_mm: p.radius_mm,
+                },
+                height_mm: p.height_mm,
+                rgb: p.rgb,
+            });
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn field_floor_region_includes_goal_pockets_only_within_the_mouth() {
+        let layout = Layout {
+            field: Some(FieldSpec::default()),
+            ..Layout::default()
+        };
+        assert!(layout.is_floor(Point2::new(0.0, 0.0)));
+        assert!(layout.is_floor(Point2::new(1500.0, 200.0)));
+        assert!(!layout.is_floor(Point2::new(1500.0, 300.0)));
+        assert!(!layout.is_floor(Point2::new(1600.0, 0.0)));
+        assert!(!layout.is_floor(Point2::new(0.0, 770.0)));
+    }
+
+    #[test]
+    fn field_walls_enclose_the_floor_region() {
+        let f = FieldSpec::default();
+        let layout = Layout {
+            field: Some(f.clone()),
+            ..Layout::default()
+        };
+        let solids = layout.solids();
+        // Points just outside the floor boundary are inside some wall; just inside are not.
+        let outside = [
+            Point2::new(0.0, 762.5 + 1.0),
+            Point2::new(1370.0 + 1.0, 600.0),
+            Point2::new(1550.0 + 1.0, 0.0),
+            Point2::new(1450.0, 250.0 + 1.0),
+            Point2::new(-1550.0 - 1.0, 100.0),
+        ];
+        for p in outside {
+            assert!(
+                solids.iter().any(|s| s.shape.distance_mm(p) <= 0.0),
+                "{p} not in a wall"
+            );
+        }
+        let inside = [
+            Point2::new(0.0, 762.5 - 1.0),
+            Point2::new(1549.0, 0.0),
+            Point2::new(1369.0, 700.0),
+        ];
+        for p in inside {
+            assert!(
+                solids.iter().all(|s| s.shape.distance_mm(p) > 0.0),
+                "{p} in a wall"
+            );
+        }
+    }
+
+    #[test]
+    fn lines_are_ten_mm_wide() {
+        let f = FieldSpec::default();
+        assert!(f.on_line(Point2::new(0.0, 100.0)));
+        assert!(f.on_line(Point2::new(4.9, 100.0)));
+        assert!(!f.on_line(Point2::new(5.1, 100.0)));
+        assert!(f.on_line(Point2::new(250.0, 0.0)));
+        assert!(f.on_line(Point2::new(600.0, 755.0)));
+        assert!(!f.on_line(Point2::new(600.0, 700.0)));
+        assert!(!f.on_line(Point2::new(1400.0, 0.0)));
+    }
+}

@@ -1,0 +1,19 @@
+//! omniloop-sim: the simulated side of omniloop. A rapier2d world holds the RoboCup
+//! Small-Size field (or any floor of walls, cubes and pillars) and acceleration-limited
+//! omnidirectional robots.
+
+pub mod layout;
+pub mod shapes;
+pub mod world;
+
+pub use layout::{Cube, FieldSpec, FloorRect, Layout, Pillar, Rgb, Wall};
+pub use shapes::{Solid, SolidShape};
+pub use world::{RobotBodySpec, RobotState, RobotStats, World};
+
+/// Errors of the simulator.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// A world or sensor description that cannot be built.
+    #[error("invalid world: {0}")]
+    Invalid(String),
+}

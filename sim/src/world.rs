@@ -1,0 +1,480 @@
+//! The physics world: rapier2d bodies for the field, walls, cubes, pillars and the robots.
+//!
+//! Robots are dynamic discs whose velocity is set every physics step by the drive model of
+//! eq. (8) ([`AccelLimitedDrive`]), starting from the velocity the body actually has, so that a
+//! robot pushed back by a wall accelerates again at the limit. Obstacles are fixed colliders, so
+//! a robot never passes through them, whatever it is commanded. Contacts are counted from the
+//! engine's collision events, confirmed by the contact manifold's distance (rapier also reports
+//! speculative contacts a few millimetres before touching).
+
+use crate::SimError;
+use crate::layout::{Layout, Rgb};
+use crate::shapes::{Solid, SolidShape};
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_control::{AccelLimitedDrive, VelocityCommand};
+use rapier2d::prelude::*;
+use std::sync::mpsc::{Receiver, channel};
+
+/// Two colliders closer than this (mm) are touching.
+pub const TOUCH_TOLERANCE_MM: f64 = 0.5;
+
+/// A robot body: an omnidirectional disc.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotBodySpec {
+    /// Pose at the start: x, y in mm, rotation in rad.
+    pub start: Isometry2<f64>,
+    /// Disc radius.
+    pub radius_mm: f64,
+    /// Body height (for rendering).
+    pub height_mm: f64,
+    /// Translational acceleration limit alpha of eq. (8).
+    pub accel_limit_mm_s2: f64,
+    /// Rotational acceleration limit.
+    pub angular_accel_limit_rad_s2: f64,
+    /// Body colour (for rendering).
+    pub rgb: Rgb,
+}
+
+/// The state of a robot as the physics engine has it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RobotState {
+    /// Position (mm) and heading (rad).
+    pub pose: Isometry2<f64>,
+    /// Velocity in the world frame.
+    pub velocity_mm_s: Vector2<f64>,
+    /// Rotation rate.
+    pub omega_rad_s: f64,
+}
+
+/// What happened to a robot so far, measured at every physics step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RobotStats {
+    /// How many times it started touching a wall, cube, pillar or robot.
+    pub contacts: u32,
+    /// Largest |dv| / dt between two physics steps.
+    pub peak_accel_mm_s2: f64,
+    /// Largest speed.
+    pub peak_speed_mm_s: f64,
+    /// Smallest distance from its edge to a solid or another robot.
+    pub min_clearance_mm: f64,
+    /// Length of the path its centre travelled.
+    pub path_length_mm: f64,
+}
+
+impl RobotStats {
+    fn new() -> Self {
+        Self {
+            contacts: 0,
+            peak_accel_mm_s2: 0.0,
+            peak_speed_mm_s: 0.0,
+            min_clearance_mm: f64::INFINITY,
+            path_length_mm: 0.0,
+        }
+    }
+}
+
+struct Robot {
+    spec: RobotBodySpec,
+    body: RigidBodyHandle,
+    collider: ColliderHandle,
+    drive: AccelLimitedDrive,
+    command: VelocityCommand,
+    stats: RobotStats,
+    /// Colliders rapier says this robot is in contact with, and whether they actually touch.
+    pairs: Vec<(ColliderHandle, bool)>,
+}
+
+/// What a collider belongs to.
+#[derive(Debug, Clone, Copy)]
+enum Owner {
+    Solid(usize),
+    Robot(usize),
+}
+
+/// The simulated world.
+pub struct World {
+    physics: PhysicsWorld,
+    layout: Layout,
+    solids: Vec<Solid>,
+    robots: Vec<Robot>,
+    events: ChannelEventCollector,
+    collisions: Receiver<CollisionEvent>,
+    _forces: Receiver<ContactForceEvent>,
+    _tears: Receiver<SoftBodyTearEvent>,
+    owners: Vec<(ColliderHandle, Owner)>,
+    physics_step_s: f64,
+    steps: u64,
+}
+
+fn vec(v: Vector2<f64>) -> Vector {
+    Vector::new(v.x as Real, v.y as Real)
+}
+
+impl World {
+    /// Builds the world from its layout and robots, stepping physics every `physics_step_s`.
+    pub fn new(
+        layout: &Layout,
+        robots: &[RobotBodySpec],
+        physics_step_s: f64,
+    ) -> Result<Self, SimError> {
+        if !(physics_step_s.is_finite() && physics_step_s > 0.0) {
+            return Err(SimError::Invalid(format!(
+                "physics_step_s = {physics_step_s} must be > 0"
+            )));
+        }
+        let mut physics = PhysicsWorld::new();
+        physics.gravity = Vector::ZERO;
+        physics.integration_parameters.dt = physics_step_s as Real;
+        physics.integration_parameters.length_unit = 1000.0;
+
+        let solids = layout.solids();
+        let mut owners = Vec::with_capacity(solids.len() + robots.len());
+        for s in &solids {
+            let collider = match s.shape {
+                SolidShape::Box {
+                    center_mm,
+                    half_extents_mm,
+                    angle_rad,
+                } => ColliderBuilder::cuboid(half_extents_mm.x as Real, half_extents_mm.y as Real)
+                    .translation(vec(center_mm.coords))
+                    .rotation(angle_rad as Real),
+                SolidShape::Cylinder {
+                    center_mm,
+                    radius_mm,
+                } => ColliderBuilder::ball(radius_mm as Real).translation(vec(center_mm.coords)),
+            };
+            let h = physics.insert_collider(collider.friction(0.0).restitution(0.0), None);
+            owners.push((h, Owner::Solid(owners.len())));
+        }
+
+        let mut out = Vec::with_capacity(robots.len());
+        for spec in robots {
+            let drive =
+                AccelLimitedDrive::new(spec.accel_limit_mm_s2, spec.angular_accel_limit_rad_s2)
+                    .map_err(|e| SimError::Invalid(e.to_string()))?;
+            let body = RigidBodyBuilder::dynamic()
+                .translation(vec(spec.start.translation.vector))
+                .rotation(spec.start.rotation.angle() as Real)
+                .ccd_enabled(true)
+                .can_sleep(false);
+            let collider = ColliderBuilder::ball(spec.radius_mm as Real)
+                .friction(0.0)
+                .restitution(0.0)
+                .active_events(ActiveEvents::COLLISION_EVENTS);
+            let (body, collider) = physics.insert(body, collider);
+            owners.push((collider, Owner::Robot(out.len())));
+            out.push(Robot {
+                spec: spec.clone(),
+                body,
+                collider,
+                drive,
+                command: VelocityCommand::STOP,
+                stats: RobotStats::new(),
+                pairs: Vec::new(),
+            });
+        }
+        let (ctx, crx) = channel();
+        let (ftx, frx) = channel();
+        let (ttx, trx) = channel();
+        Ok(Self {
+            physics,
+            layout: layout.clone(),
+            solids,
+            robots: out,
+            events: ChannelEventCollector::new(ctx, ftx, ttx),
+            collisions: crx,
+            _forces: frx,
+            _tears: trx,
+            owners,
+            physics_step_s,
+            steps: 0,
+        })
+    }
+
+    /// The static layout.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// The static solids (walls, cubes, pillars) in world coordinates.
+    pub fn solids(&self) -> &[Solid] {
+        &self.solids
+    }
+
+    /// Number of robots.
+    pub fn robot_count(&self) -> usize {
+        self.robots.len()
+    }
+
+    /// The body description of robot `i`.
+    pub fn robot_spec(&self, i: usize) -> &RobotBodySpec {
+        &self.robots[i].spec
+    }
+
+    /// Simulated time since the start.
+    pub fn time_s(&self) -> f64 {
+        self.steps as f64 * self.physics_step_s
+    }
+
+    /// Sets the velocity command robot `i` follows (through its drive) from now on.
+    pub fn set_command(&mut self, i: usize, command: VelocityCommand) {
+        self.robots[i].command = command;
+    }
+
+    /// The command robot `i` follows.
+    pub fn command(&self, i: usize) -> VelocityCommand {
+        self.robots[i].command
+    }
+
+    /// Position, heading and velocity of robot `i`.
+    pub fn robot_state(&self, i: usize) -> RobotState {
+        let body = &self.physics.bodies[self.robots[i].body];
+        let t = body.translation();
+        let v = body.linvel();
+        RobotState {
+            pose: Isometry2::new(
+                Vector2::new(t.x as f64, t.y as f64),
+                body.rotation().angle() as f64,
+            ),
+            velocity_mm_s: Vector2::new(v.x as f64, v.y as f64),
+            omega_rad_s: body.angvel() as f64,
+        }
+    }
+
+    /// Contacts, peak speed and acceleration, clearance and path length of robot `i`.
+    pub fn stats(&self, i: usize) -> RobotStats {
+        self.robots[i].stats
+    }
+
+    /// Distance from robot `i`'s edge to the nearest solid or other robot.
+    pub fn clearance_mm(&self, i: usize) -> f64 {
+        let me = self.robot_state(i);
+        let p = Point2::from(me.pose.translation.vector);
+        let r = self.robots[i].spec.radius_mm;
+        let mut best = f64::INFINITY;
+        for s in &self.solids {
+            best = best.min(s.shape.distance_mm(p) - r);
+        }
+        for (j, other) in self.robots.iter().enumerate() {
+            if j != i {
+                let q = self.robot_state(j).pose.translation.vector;
+                best = best.min((q - p.coords).norm() - other.spec.radius_mm - r);
+            }
+        }
+        best
+    }
+
+    /// Gap between robot `i`'s disc and the collider `other`.
+    fn gap_mm(&self, i: usize, other: ColliderHandle) -> f64 {
+        let p = Point2::from(self.robot_state(i).pose.translation.vector);
+        let r = self.robots[i].spec.radius_mm;
+        match self.owners.iter().find(|(h, _)| *h == other) {
+            Some((_, Owner::Solid(k))) => self.solids[*k].shape.distance_mm(p) - r,
+            Some((_, Owner::Robot(j))) => {
+                let q = self.robot_state(*j).pose.translation.vector;
+                (q - p.coords).norm() - r - self.robots[*j].spec.radius_mm
+            }
+            None => f64::INFINITY,
+        }
+    }
+
+    /// The solid footprints of every robot except `except`, for ray casts and rendering.
+    pub fn robot_solids(&self, except: Option<usize>) -> Vec<Solid> {
+        (0..self.robots.len())
+            .filter(|&j| Some(j) != except)
+            .map(|j| {
+                let spec = &self.robots[j].spec;
+                Solid {
+                    shape: SolidShape::Cylinder {
+                        center_mm: Point2::from(self.robot_state(j).pose.translation.vector),
+                        radius_mm: spec.radius_mm,
+                    },
+                    height_mm: spec.height_mm,
+                    rgb: spec.rgb,
+                }
+            })
+            .collect()
+    }
+
+    /// Distance from `origin` along unit `dir` to the first solid or robot other than `except`
+    /// (the ground truth for free space), or `None` beyond `max_mm`.
+    pub fn ray_cast_mm(
+        &self,
+        origin: Point2<f64>,
+        dir: Vector2<f64>,
+        max_mm: f64,
+        except: Option<usize>,
+    ) -> Option<f64> {
+        self.solids
+            .iter()
+            .chain(self.robot_solids(except).iter())
+            .filter_map(|s| s.shape.ray_cast_mm(origin, dir, max_mm))
+            .min_by(f64::total_cmp)
+    }
+
+    /// Advances the world by `duration_s` in physics steps (rounded to a whole number of
+    /// steps), applying each robot's command through its drive at every step.
+    pub fn advance(&mut self, duration_s: f64) {
+        let n = (duration_s / self.physics_step_s).round().max(1.0) as u64;
+        for _ in 0..n {
+            self.step();
+        }
+    }
+
+    fn step(&mut self) {
+        let dt = self.physics_step_s;
+        let mut before = Vec::with_capacity(self.robots.len());
+        for r in &self.robots {
+            let body = &mut self.physics.bodies[r.body];
+            let v = body.linvel();
+            let v = Vector2::new(v.x as f64, v.y as f64);
+            let v_new = r.drive.step(v, r.command.v_mm_s, dt);
+            let w_new = r
+                .drive
+                .step_angular(body.angvel() as f64, r.command.omega_rad_s, dt);
+            body.set_linvel(vec(v_new), true);
+            body.set_angvel(w_new as Real, true);
+            let t = body.translation();
+            before.push((v, Vector2::new(t.x as f64, t.y as f64)));
+        }
+        self.physics.step_with_events(&(), &self.events);
+        self.steps += 1;
+
+        for (i, (v0, p0)) in before.into_iter().enumerate() {
+            let s = self.robot_state(i);
+            let clearance = self.clearance_mm(i);
+            let st = &mut self.robots[i].stats;
+            let a = (s.velocity_mm_s - v0).norm() / dt;
+            st.peak_accel_mm_s2 = st.peak_accel_mm_s2.max(a);
+            st.peak_speed_mm_s = st.peak_speed_mm_s.max(s.velocity_mm_s.norm());
+            st.path_length_mm += (s.pose.translation.vector - p0).norm();
+            st.min_clearance_mm = st.min_clearance_mm.min(clearance);
+        }
+        while let Ok(event) = self.collisions.try_recv() {
+            let (c1, c2, started) = match event {
+                CollisionEvent::Started(a, b, _) => (a, b, true),
+                CollisionEvent::Stopped(a, b, _) => (a, b, false),
+            };
+            for r in self.robots.iter_mut() {
+                let other = if r.collider == c1 {
+                    c2
+                } else if r.collider == c2 {
+                    c1
+                } else {
+                    continue;
+                };
+                if started {
+                    if !r.pairs.iter().any(|(h, _)| *h == other) {
+                        r.pairs.push((other, false));
+                    }
+                } else {
+                    r.pairs.retain(|(h, _)| *h != other);
+                }
+            }
+        }
+        // rapier keeps speculative contacts and recycles manifolds, so whether two colliders
+        // touch is decided from their exact distance.
+        for i in 0..self.robots.len() {
+            let pairs = std::mem::take(&mut self.robots[i].pairs);
+            let mut checked = Vec::with_capacity(pairs.len());
+            for (other, touching) in pairs {
+                let now = self.gap_mm(i, other) <= TOUCH_TOLERANCE_MM;
+                if now && !touching {
+                    self.robots[i].stats.contacts += 1;
+                }
+                checked.push((other, now));
+            }
+            self.robots[i].pairs = checked;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layout::Wall;
+
+    fn robot_at(x: f64, y: f64) -> RobotBodySpec {
+        RobotBodySpec {
+            start: Isometry2::new(Vector2::new(x, y), 0.0),
+            radius_mm: 90.0,
+            height_mm: 140.0,
+            accel_limit_mm_s2: 300.0,
+            angular_accel_limit_rad_s2: 10.0,
+            rgb: Rgb([20, 20, 20]),
+        }
+    }
+
+    fn wall_layout() -> Layout {
+        Layout {
+            walls: vec![Wall {
+                from_mm: [500.0, -1000.0],
+                to_mm: [500.0, 1000.0],
+                thickness_mm: 100.0,
+                height_mm: 150.0,
+                rgb: Rgb([235, 235, 235]),
+            }],
+            ..Layout::default()
+        }
+    }
+
+    #[test]
+    fn free_motion_follows_the_drive_model_exactly() {
+        let mut w = World::new(&Layout::default(), &[robot_at(0.0, 0.0)], 0.002).unwrap();
+        w.set_command(0, VelocityCommand::translate(Vector2::new(0.0, 400.0)));
+        w.advance(1.0);
+        let s = w.robot_state(0);
+        // 300 mm/s^2 for 1 s from rest: 300 mm/s.
+        assert!((s.velocity_mm_s.y - 300.0).abs() < 1e-2, "{s:?}");
+        // Displacement alpha t^2 / 2 = 150 mm, up to the step's discretisation.
+        assert!((s.pose.translation.y - 150.0).abs() < 0.5, "{s:?}");
+        assert!(w.stats(0).peak_accel_mm_s2 <= 300.0 * 1.01);
+        assert_eq!(w.stats(0).contacts, 0);
+    }
+
+    #[test]
+    fn a_robot_driven_into_a_wall_at_2000_mm_s_stays_outside_and_the_contact_is_counted() {
+        let mut spec = robot_at(0.0, 0.0);
+        spec.accel_limit_mm_s2 = 20_000.0;
+        let mut w = World::new(&wall_layout(), &[spec], 0.002).unwrap();
+        w.set_command(0, VelocityCommand::translate(Vector2::new(2000.0, 0.0)));
+        let mut max_x: f64 = 0.0;
+        for _ in 0..100 {
+            w.advance(0.02);
+            max_x = max_x.max(w.robot_state(0).pose.translation.x);
+        }
+        // The wall's face is at x = 450; the robot's centre must stay at or before 360.
+        assert!(max_x <= 450.0 - 90.0 + 1.0, "max x {max_x}");
+        assert!(w.clearance_mm(0) > -1.0);
+        assert_eq!(w.stats(0).contacts, 1);
+        assert!(w.stats(0).min_clearance_mm > -1.0);
+    }
+
+    #[test]
+    fn passing_close_to_a_wall_is_not_a_contact() {
+        let mut w = World::new(&wall_layout(), &[robot_at(350.0, -800.0)], 0.002).unwrap();
+        // Centre at x = 350: the robot's edge passes 10 mm from the wall face.
+        w.set_command(0, VelocityCommand::translate(Vector2::new(0.0, 400.0)));
+        w.advance(3.0);
+        assert_eq!(w.stats(0).contacts, 0);
+        assert!((w.stats(0).min_clearance_mm - 10.0).abs() < 0.5);
+    }
+
+    #[test]
+    fn ray_cast_sees_walls_and_other_robots() {
+        let w = World::new(
+            &wall_layout(),
+            &[robot_at(0.0, 0.0), robot_at(0.0, 300.0)],
+            0.002,
+        )
+        .unwrap();
+        let d = w
+            .ray_cast_mm(Point2::origin(), Vector2::new(1.0, 0.0), 5000.0, Some(0))
+            .unwrap();
+        assert!((d - 450.0).abs() < 1e-9);
+        let d = w
+            .ray_cast_mm(Point2::origin(), Vector2::new(0.0, 1.0), 5000.0, Some(0))
+            .unwrap();
+        assert!((d - 210.0).abs() < 1e-3);
+    }
+}

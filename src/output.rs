@@ -1,0 +1,90 @@
+//! Writing a run's results: `summary.json`, `trajectory.csv` and `topview.png`.
+
+use crate::record::write_trajectory_csv;
+use crate::runner::RunOutput;
+use crate::scenario::Scenario;
+use crate::topview::{Marker, PathLayer, draw_topview};
+use anyhow::Context;
+use nalgebra::Point2;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// The default output folder of a scenario: `runs/<name>`.
+pub fn default_out_dir(scenario: &Scenario) -> PathBuf {
+    Path::new("runs").join(&scenario.name)
+}
+
+/// Writes `summary.json`, `trajectory.csv` and `topview.png` into `dir` (created if needed).
+pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let summary_path = dir.join("summary.json");
+    let text = serde_json::to_string_pretty(&out.summary)?;
+    std::fs::write(&summary_path, text + "\n")
+        .with_context(|| format!("writing {}", summary_path.display()))?;
+    let traj_path = dir.join("trajectory.csv");
+    let f = File::create(&traj_path).with_context(|| format!("writing {}", traj_path.display()))?;
+    write_trajectory_csv(&out.trajectory, BufWriter::new(f))
+        .with_context(|| format!("writing {}", traj_path.display()))?;
+    draw_run_topview(&dir.join("topview.png"), scenario, out)?;
+    Ok(())
+}
+
+/// The top view of one run: world, true path, estimated path, other robots, start and goal.
+pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
+    let truth: Vec<Point2<f64>> = out
+        .trajectory
+        .iter()
+        .map(|r| Point2::new(r.x_mm, r.y_mm))
+        .collect();
+    let estimate: Vec<Point2<f64>> = out
+        .trajectory
+        .iter()
+        .filter_map(|r| Some(Point2::new(r.est_x_mm?, r.est_y_mm?)))
+        .collect();
+    let mut layers = vec![PathLayer {
+        label: "true path".into(),
+        rgb: [220, 30, 30],
+        points: &truth,
+        dots: false,
+    }];
+    if !estimate.is_empty() {
+        layers.push(PathLayer {
+            label: "estimated".into(),
+            rgb: [30, 80, 230],
+            points: &estimate,
+            dots: true,
+        });
+    }
+    for (k, p) in out.other_paths.iter().enumerate() {
+        layers.push(PathLayer {
+            label: format!("robot {}", k + 1),
+            rgb: [200, 40, 160],
+            points: p,
+            dots: false,
+        });
+    }
+    let mut markers = vec![Marker {
+        at: scenario.robot.start.point(),
+        radius_mm: scenario.robot.radius_mm,
+        rgb: [20, 20, 20],
+        label: "start".into(),
+    }];
+    if let Some(g) = &scenario.goal {
+        markers.push(Marker {
+            at: g.point(),
+            radius_mm: g.tolerance_mm,
+            rgb: [250, 130, 0],
+            label: "goal".into(),
+        });
+    }
+    draw_topview(
+        file,
+        &scenario.name,
+        &scenario.world,
+        &layers,
+        &markers,
+        1000,
+    )?;
+    Ok(())
+}

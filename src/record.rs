@@ -1,0 +1,92 @@
+//! What a run leaves behind: the trajectory (one row a control cycle) and the summary.
+
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+
+/// One control cycle: truth, estimate (when an estimator ran) and command.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrajectoryRow {
+    /// Simulated time at the start of the cycle.
+    pub t_s: f64,
+    /// True x.
+    pub x_mm: f64,
+    /// True y.
+    pub y_mm: f64,
+    /// True heading.
+    pub theta_rad: f64,
+    /// True velocity, x.
+    pub vx_mm_s: f64,
+    /// True velocity, y.
+    pub vy_mm_s: f64,
+    /// Commanded velocity, x (world frame).
+    pub cmd_vx_mm_s: f64,
+    /// Commanded velocity, y (world frame).
+    pub cmd_vy_mm_s: f64,
+    /// Estimated x, when an estimator ran this cycle.
+    pub est_x_mm: Option<f64>,
+    /// Estimated y.
+    pub est_y_mm: Option<f64>,
+    /// Estimated heading.
+    pub est_theta_rad: Option<f64>,
+}
+
+/// Column names of `trajectory.csv`, in order.
+pub const TRAJECTORY_HEADER: &str = "t_s,x_mm,y_mm,theta_rad,vx_mm_s,vy_mm_s,cmd_vx_mm_s,cmd_vy_mm_s,est_x_mm,est_y_mm,est_theta_rad";
+
+/// Writes the trajectory as CSV; empty cells where no estimate exists. Numbers are written in
+/// their shortest exact form, so equal runs give byte-identical files.
+pub fn write_trajectory_csv(rows: &[TrajectoryRow], mut w: impl Write) -> std::io::Result<()> {
+    writeln!(w, "{TRAJECTORY_HEADER}")?;
+    let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+    for r in rows {
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            r.t_s,
+            r.x_mm,
+            r.y_mm,
+            r.theta_rad,
+            r.vx_mm_s,
+            r.vy_mm_s,
+            r.cmd_vx_mm_s,
+            r.cmd_vy_mm_s,
+            opt(r.est_x_mm),
+            opt(r.est_y_mm),
+            opt(r.est_theta_rad)
+        )?;
+    }
+    Ok(())
+}
+
+/// The metrics of a run, written to `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Scenario name.
+    pub scenario: String,
+    /// Seed used.
+    pub seed: u64,
+    /// Controller that drove the robot.
+    pub controller: String,
+    /// Control cycles run.
+    pub cycles: u64,
+    /// Simulated time.
+    pub sim_time_s: f64,
+    /// Wall-clock time the run took.
+    pub wall_time_s: f64,
+    /// Control cycles per wall-clock second.
+    pub cycles_per_s: f64,
+    /// How many times the robot started touching a wall, cube, pillar or robot (physics engine).
+    pub wall_contacts: u32,
+    /// Largest speed of the robot.
+    pub peak_speed_mm_s: f64,
+    /// Largest acceleration between two physics steps.
+    pub peak_accel_mm_s2: f64,
+    /// Whether the robot centre came within the goal tolerance.
+    pub reached_goal: bool,
+    /// When it did.
+    pub time_to_goal_s: Option<f64>,
+    /// Smallest distance from the robot's edge to a wall, cube, pillar or robot.
+    pub min_clearance_mm: f64,
+    /// Length of the path the robot centre travelled.
+    pub path_length_mm: f64,
+}

@@ -1,0 +1,221 @@
+//! The closed loop: sense, decide, act, record, once a control period.
+
+use crate::record::{Summary, TrajectoryRow};
+use crate::scenario::{ControllerKind, Scenario, controller_name};
+use nalgebra::Point2;
+use omniloop_control::{AccelLimitedDrive, GoToGoal, VelocityCommand};
+use omniloop_sim::{SimError, World};
+use std::time::Instant;
+
+/// Why a run could not be carried out.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The world could not be built.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// A controller could not be built.
+    #[error("control: {0}")]
+    Control(#[from] omniloop_control::ControlError),
+}
+
+/// Drives another robot through its waypoints on its true pose.
+struct Mover {
+    waypoints: Vec<Point2<f64>>,
+    next: usize,
+    cycle: bool,
+    controller: GoToGoal,
+}
+
+/// Everything a run produced.
+#[derive(Debug, Clone)]
+pub struct RunOutput {
+    /// Metrics.
+    pub summary: Summary,
+    /// One row a control cycle.
+    pub trajectory: Vec<TrajectoryRow>,
+    /// The paths of the other robots, one point a control cycle.
+    pub other_paths: Vec<Vec<Point2<f64>>>,
+}
+
+/// A scenario being run, one control cycle at a time.
+pub struct Simulation {
+    scenario: Scenario,
+    world: World,
+    goal_controller: Option<GoToGoal>,
+    movers: Vec<Mover>,
+    cycle: u64,
+    time_to_goal_s: Option<f64>,
+    trajectory: Vec<TrajectoryRow>,
+    other_paths: Vec<Vec<Point2<f64>>>,
+}
+
+impl Simulation {
+    /// Builds the world and controllers of a validated scenario.
+    pub fn new(scenario: &Scenario) -> Result<Self, RunError> {
+        let world = World::new(
+            &scenario.world,
+            &scenario.robot_bodies(),
+            scenario.run.physics_step_s,
+        )?;
+        let r = &scenario.robot;
+        let drive = AccelLimitedDrive::new(r.accel_limit_mm_s2, r.angular_accel_limit_rad_s2)?;
+        let goal_controller = match scenario.control.kind {
+            ControllerKind::GoToGoalTruth => Some(GoToGoal::new(r.max_speed_mm_s, drive)?),
+            ControllerKind::Idle => None,
+        };
+        let mut movers = Vec::new();
+        for o in &scenario.other_robots {
+            let drive = AccelLimitedDrive::new(o.accel_limit_mm_s2, 10.0)?;
+            movers.push(Mover {
+                waypoints: o
+                    .waypoints_mm
+                    .iter()
+                    .map(|w| Point2::new(w[0], w[1]))
+                    .collect(),
+                next: 0,
+                cycle: o.cycle,
+                controller: GoToGoal::new(o.max_speed_mm_s, drive)?,
+            });
+        }
+        Ok(Self {
+            scenario: scenario.clone(),
+            world,
+            goal_controller,
+            other_paths: vec![Vec::new(); movers.len()],
+            movers,
+            cycle: 0,
+            time_to_goal_s: None,
+            trajectory: Vec::new(),
+        })
+    }
+
+    /// The world being simulated.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// Control cycles run so far.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    /// Whether the run is over: time is up, or the goal is reached and the run stops there.
+    pub fn finished(&self) -> bool {
+        self.cycle >= self.scenario.max_cycles()
+            || (self.scenario.run.stop_at_goal && self.time_to_goal_s.is_some())
+    }
+
+    /// One control cycle: observe, choose commands, record, advance the world one period.
+    pub fn step(&mut self) {
+        let t = self.world.time_s();
+        let state = self.world.robot_state(0);
+        let position = Point2::from(state.pose.translation.vector);
+        let command = match (&self.goal_controller, &self.scenario.goal) {
+            (Some(c), Some(g)) => c.command(position.coords, g.point().coords),
+            _ => VelocityCommand::STOP,
+        };
+        self.world.set_command(0, command);
+        for (k, m) in self.movers.iter_mut().enumerate() {
+            let p = Point2::from(self.world.robot_state(k + 1).pose.translation.vector);
+            self.other_paths[k].push(p);
+            if m.next < m.waypoints.len() && (m.waypoints[m.next] - p).norm() < 20.0 {
+                m.next += 1;
+                if m.cycle && m.next == m.waypoints.len() {
+                    m.next = 0;
+                }
+            }
+            let cmd = match m.waypoints.get(m.next) {
+                Some(w) => m.controller.command(p.coords, w.coords),
+                None => VelocityCommand::STOP,
+            };
+            self.world.set_command(k + 1, cmd);
+        }
+        self.trajectory.push(TrajectoryRow {
+            t_s: t,
+            x_mm: state.pose.translation.x,
+            y_mm: state.pose.translation.y,
+            theta_rad: state.pose.rotation.angle(),
+            vx_mm_s: state.velocity_mm_s.x,
+            vy_mm_s: state.velocity_mm_s.y,
+            cmd_vx_mm_s: command.v_mm_s.x,
+            cmd_vy_mm_s: command.v_mm_s.y,
+            est_x_mm: None,
+            est_y_mm: None,
+            est_theta_rad: None,
+        });
+        self.world.advance(self.scenario.run.control_period_s);
+        self.cycle += 1;
+        if let (None, Some(g)) = (self.time_to_goal_s, &self.scenario.goal) {
+            let p = self.world.robot_state(0).pose.translation.vector;
+            if (p - g.point().coords).norm() <= g.tolerance_mm {
+                self.time_to_goal_s = Some(self.world.time_s());
+            }
+        }
+    }
+
+    /// Ends the run: the summary and everything recorded.
+    pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
+        // The final state closes the trajectory.
+        let s = self.world.robot_state(0);
+        let last_cmd = self.world.command(0);
+        self.trajectory.push(TrajectoryRow {
+            t_s: self.world.time_s(),
+            x_mm: s.pose.translation.x,
+            y_mm: s.pose.translation.y,
+            theta_rad: s.pose.rotation.angle(),
+            vx_mm_s: s.velocity_mm_s.x,
+            vy_mm_s: s.velocity_mm_s.y,
+            cmd_vx_mm_s: last_cmd.v_mm_s.x,
+            cmd_vy_mm_s: last_cmd.v_mm_s.y,
+            est_x_mm: None,
+            est_y_mm: None,
+            est_theta_rad: None,
+        });
+        for (k, path) in self.other_paths.iter_mut().enumerate() {
+            path.push(Point2::from(
+                self.world.robot_state(k + 1).pose.translation.vector,
+            ));
+        }
+        let stats = self.world.stats(0);
+        let summary = Summary {
+            scenario: self.scenario.name.clone(),
+            seed: self.scenario.seed,
+            controller: controller_name(self.scenario.control.kind),
+            cycles: self.cycle,
+            sim_time_s: self.world.time_s(),
+            wall_time_s,
+            cycles_per_s: if wall_time_s > 0.0 {
+                self.cycle as f64 / wall_time_s
+            } else {
+                0.0
+            },
+            wall_contacts: stats.contacts,
+            peak_speed_mm_s: stats.peak_speed_mm_s,
+            peak_accel_mm_s2: stats.peak_accel_mm_s2,
+            reached_goal: self.time_to_goal_s.is_some(),
+            time_to_goal_s: self.time_to_goal_s,
+            min_clearance_mm: stats.min_clearance_mm,
+            path_length_mm: stats.path_length_mm,
+        };
+        RunOutput {
+            summary,
+            trajectory: self.trajectory,
+            other_paths: self.other_paths,
+        }
+    }
+}
+
+/// Runs a validated scenario to its end, calling `progress(cycle, max_cycles)` after each cycle.
+pub fn run_scenario(
+    scenario: &Scenario,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<RunOutput, RunError> {
+    let start = Instant::now();
+    let mut sim = Simulation::new(scenario)?;
+    let max = scenario.max_cycles();
+    while !sim.finished() {
+        sim.step();
+        progress(sim.cycle(), max);
+    }
+    Ok(sim.finish(start.elapsed().as_secs_f64()))
+}

@@ -1,0 +1,264 @@
+//! Scenario files: the schema of the TOML a user writes, with defaults, and its validation.
+//!
+//! Every table rejects unknown keys. Parsing and validation errors name the file, the line
+//! and column, and the dotted path of the field ([`crate::scenario_error`]).
+
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_sim::{Layout, Rgb};
+use serde::{Deserialize, Serialize};
+
+/// A complete scenario: the world, the robot, what it should do and for how long.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Name of the scenario (default: the file name without extension).
+    #[serde(default)]
+    pub name: String,
+    /// One line saying what the scenario shows.
+    #[serde(default)]
+    pub description: String,
+    /// Seed of every random draw in the run (sensor noise, odometry noise).
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Timing of the run.
+    #[serde(default)]
+    pub run: RunSpec,
+    /// Floor, field, walls, cubes and pillars.
+    #[serde(default)]
+    pub world: Layout,
+    /// The robot under test.
+    pub robot: RobotSpec,
+    /// Further robots, moving obstacles driven between waypoints.
+    #[serde(default)]
+    pub other_robots: Vec<OtherRobotSpec>,
+    /// Where the robot should go, if anywhere.
+    #[serde(default)]
+    pub goal: Option<GoalSpec>,
+    /// How the robot chooses its velocity.
+    #[serde(default)]
+    pub control: ControlSpec,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+/// Timing of the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunSpec {
+    /// Longest simulated time; the run ends earlier when the goal is reached.
+    pub duration_s: f64,
+    /// Period of the control cycle (render, vision, control).
+    pub control_period_s: f64,
+    /// Physics step; a whole number of them makes one control period.
+    pub physics_step_s: f64,
+    /// End the run as soon as the goal is reached.
+    pub stop_at_goal: bool,
+}
+
+impl Default for RunSpec {
+    fn default() -> Self {
+        Self {
+            duration_s: 30.0,
+            control_period_s: 0.04,
+            physics_step_s: 0.002,
+            stop_at_goal: true,
+        }
+    }
+}
+
+/// A planar pose as written in scenario files.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSpec {
+    /// x position.
+    pub x_mm: f64,
+    /// y position.
+    pub y_mm: f64,
+    /// Heading, counter-clockwise from the world x axis.
+    #[serde(default)]
+    pub heading_deg: f64,
+}
+
+impl PoseSpec {
+    /// As an isometry (mm, rad).
+    pub fn isometry(&self) -> Isometry2<f64> {
+        Isometry2::new(
+            Vector2::new(self.x_mm, self.y_mm),
+            self.heading_deg.to_radians(),
+        )
+    }
+
+    /// The position.
+    pub fn point(&self) -> Point2<f64> {
+        Point2::new(self.x_mm, self.y_mm)
+    }
+}
+
+/// The robot under test.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobotSpec {
+    /// Where it starts, at rest.
+    pub start: PoseSpec,
+    /// Disc radius.
+    #[serde(default = "default_radius")]
+    pub radius_mm: f64,
+    /// Body height.
+    #[serde(default = "default_height")]
+    pub height_mm: f64,
+    /// Top speed the controllers command.
+    #[serde(default = "default_max_speed")]
+    pub max_speed_mm_s: f64,
+    /// Translational acceleration limit alpha of eq. (8).
+    #[serde(default = "default_accel")]
+    pub accel_limit_mm_s2: f64,
+    /// Rotational acceleration limit.
+    #[serde(default = "default_angular_accel")]
+    pub angular_accel_limit_rad_s2: f64,
+    /// Body colour.
+    #[serde(default = "default_robot_rgb")]
+    pub rgb: Rgb,
+}
+
+fn default_radius() -> f64 {
+    90.0
+}
+fn default_height() -> f64 {
+    140.0
+}
+fn default_max_speed() -> f64 {
+    400.0
+}
+fn default_accel() -> f64 {
+    300.0
+}
+fn default_angular_accel() -> f64 {
+    10.0
+}
+fn default_robot_rgb() -> Rgb {
+    Rgb([25, 25, 30])
+}
+
+/// Another robot: a moving obstacle that drives through its waypoints (on ground truth).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OtherRobotSpec {
+    /// Where it starts, at rest.
+    pub start: PoseSpec,
+    /// Points it drives to in turn; empty to stand still.
+    #[serde(default)]
+    pub waypoints_mm: Vec<[f64; 2]>,
+    /// Start again at the first waypoint after the last.
+    #[serde(default)]
+    pub cycle: bool,
+    /// Its top speed.
+    #[serde(default = "default_other_speed")]
+    pub max_speed_mm_s: f64,
+    /// Its acceleration limit.
+    #[serde(default = "default_accel")]
+    pub accel_limit_mm_s2: f64,
+    /// Disc radius.
+    #[serde(default = "default_radius")]
+    pub radius_mm: f64,
+    /// Body height.
+    #[serde(default = "default_height")]
+    pub height_mm: f64,
+    /// Body colour.
+    #[serde(default = "default_other_rgb")]
+    pub rgb: Rgb,
+}
+
+fn default_other_speed() -> f64 {
+    300.0
+}
+fn default_other_rgb() -> Rgb {
+    Rgb([200, 40, 160])
+}
+
+/// The goal point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GoalSpec {
+    /// x of the goal point (world frame).
+    pub x_mm: f64,
+    /// y of the goal point (world frame).
+    pub y_mm: f64,
+    /// The goal is reached when the robot centre is this close.
+    #[serde(default = "default_goal_tolerance")]
+    pub tolerance_mm: f64,
+}
+
+fn default_goal_tolerance() -> f64 {
+    100.0
+}
+
+impl GoalSpec {
+    /// The goal point.
+    pub fn point(&self) -> Point2<f64> {
+        Point2::new(self.x_mm, self.y_mm)
+    }
+}
+
+/// Which controller drives the robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ControllerKind {
+    /// Stand still.
+    Idle,
+    /// Straight to the goal on the true pose (a reference that needs no vision).
+    #[default]
+    GoToGoalTruth,
+}
+
+/// How the robot chooses its velocity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlSpec {
+    /// The controller.
+    pub kind: ControllerKind,
+}
+
+impl Scenario {
+    /// Parses a scenario from TOML text (no validation; see [`crate::load_scenario`]).
+    pub fn from_toml(text: &str) -> Result<Self, toml::de::Error> {
+        toml::from_str(text)
+    }
+
+    /// The robot bodies of the world: the robot under test first, then the others.
+    pub fn robot_bodies(&self) -> Vec<omniloop_sim::RobotBodySpec> {
+        let mut out = vec![omniloop_sim::RobotBodySpec {
+            start: self.robot.start.isometry(),
+            radius_mm: self.robot.radius_mm,
+            height_mm: self.robot.height_mm,
+            accel_limit_mm_s2: self.robot.accel_limit_mm_s2,
+            angular_accel_limit_rad_s2: self.robot.angular_accel_limit_rad_s2,
+            rgb: self.robot.rgb,
+        }];
+        for o in &self.other_robots {
+            out.push(omniloop_sim::RobotBodySpec {
+                start: o.start.isometry(),
+                radius_mm: o.radius_mm,
+                height_mm: o.height_mm,
+                accel_limit_mm_s2: o.accel_limit_mm_s2,
+                angular_accel_limit_rad_s2: default_angular_accel(),
+                rgb: o.rgb,
+            });
+        }
+        out
+    }
+
+    /// Number of control cycles the run lasts at most.
+    pub fn max_cycles(&self) -> u64 {
+        (self.run.duration_s / self.run.control_period_s).round() as u64
+    }
+}
+
+/// The name of a controller as written in scenario files.
+pub fn controller_name(kind: ControllerKind) -> String {
+    match toml::Value::try_from(kind) {
+        Ok(toml::Value::String(s)) => s,
+        _ => format!("{kind:?}"),
+    }
+}

@@ -1,0 +1,317 @@
+//! Top-view figures: the world (floor, walls, cubes, pillars) with paths and markers, drawn
+//! with plotters into a PNG.
+
+use nalgebra::Point2;
+use omniloop_sim::{Layout, Rgb, SolidShape};
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+use std::path::Path;
+use std::sync::Once;
+
+/// Why a figure could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+pub enum FigureError {
+    /// Drawing failed.
+    #[error("drawing {file}: {message}")]
+    Draw {
+        /// Target file.
+        file: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// Encoding or writing the PNG failed.
+    #[error("writing {file}: {source}")]
+    Write {
+        /// Target file.
+        file: String,
+        /// The cause.
+        source: image::ImageError,
+    },
+}
+
+static FONT: Once = Once::new();
+const FONT_BYTES: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+
+fn register_font() {
+    FONT.call_once(|| {
+        // The font ships with the binary, so registering it cannot fail at run time.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_BYTES);
+    });
+}
+
+/// A path to draw.
+#[derive(Debug, Clone)]
+pub struct PathLayer<'a> {
+    /// Legend text.
+    pub label: String,
+    /// Colour.
+    pub rgb: [u8; 3],
+    /// Points in world mm.
+    pub points: &'a [Point2<f64>],
+    /// Draw as dots instead of a line.
+    pub dots: bool,
+}
+
+/// A marker: a circle of given radius (mm) with a label.
+#[derive(Debug, Clone)]
+pub struct Marker {
+    /// Centre.
+    pub at: Point2<f64>,
+    /// Radius in mm (drawn to scale).
+    pub radius_mm: f64,
+    /// Colour.
+    pub rgb: [u8; 3],
+    /// Text beside it (may be empty).
+    pub label: String,
+}
+
+fn color(c: [u8; 3]) -> RGBColor {
+    RGBColor(c[0], c[1], c[2])
+}
+
+fn rgb(c: Rgb) -> RGBColor {
+    RGBColor(c.0[0], c.0[1], c.0[2])
+}
+
+fn rect_corners(center: Point2<f64>, half: [f64; 2], angle: f64) -> Vec<(f64, f64)> {
+    let (s, c) = angle.sin_cos();
+    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .iter()
+        .map(|(a, b)| {
+            let x = a * half[0];
+            let y = b * half[1];
+            (center.x + c * x - s * y, center.y + s * x + c * y)
+        })
+        .collect()
+}
+
+/// The bounding box of everything drawn, with a margin.
+fn bounds(layout: &Layout, paths: &[PathLayer<'_>], markers: &[Marker]) -> (f64, f64, f64, f64) {
+    let mut pts: Vec<(f64, f64)> = Vec::new();
+    for r in layout.all_floor_rects() {
+        pts.extend(rect_corners(
+            Point2::from(r.center_mm),
+            [r.size_mm[0] / 2.0, r.size_mm[1] / 2.0],
+            r.angle_deg.to_radians(),
+        ));
+    }
+    for s in layout.solids() {
+        match s.shape {
+            SolidShape::Box {
+                center_mm,
+                half_extents_mm,
+                angle_rad,
+            } => pts.extend(rect_corners(
+                center_mm,
+                [half_extents_mm.x, half_extents_mm.y],
+                angle_rad,
+            )),
+            SolidShape::Cylinder {
+                center_mm,
+                radius_mm,
+            } => {
+                pts.push((center_mm.x - radius_mm, center_mm.y - radius_mm));
+                pts.push((center_mm.x + radius_mm, center_mm.y + radius_mm));
+            }
+        }
+    }
+    for p in paths {
+        pts.extend(p.points.iter().map(|q| (q.x, q.y)));
+    }
+    for m in markers {
+        pts.push((m.at.x - m.radius_mm, m.at.y - m.radius_mm));
+        pts.push((m.at.x + m.radius_mm, m.at.y + m.radius_mm));
+    }
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in pts {
+        if x.is_finite() && y.is_finite() {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if x0 > x1 {
+        return (-1000.0, 1000.0, -1000.0, 1000.0);
+    }
+    let m = 0.04 * (x1 - x0).max(y1 - y0) + 50.0;
+    (x0 - m, x1 + m, y0 - m, y1 + m)
+}
+
+/// Draws the world with paths and markers into a PNG `width` pixels wide (height follows the
+/// world's aspect ratio, so millimetres are square).
+pub fn draw_topview(
+    file: &Path,
+    title: &str,
+    layout: &Layout,
+    paths: &[PathLayer<'_>],
+    markers: &[Marker],
+    width: u32,
+) -> Result<(), FigureError> {
+    register_font();
+    let (x0, x1, y0, y1) = bounds(layout, paths, markers);
+    let (left, bottom, top, right) = (85u32, 50u32, 40u32, 20u32);
+    let plot_w = width - left - right;
+    let plot_h = ((plot_w as f64) * (y1 - y0) / (x1 - x0)).round().max(100.0) as u32;
+    let height = plot_h + top + bottom;
+    let mut buf = vec![255u8; (width * height * 3) as usize];
+    let name = file.display().to_string();
+    let err = |e: &dyn std::fmt::Display| FigureError::Draw {
+        file: name.clone(),
+        message: e.to_string(),
+    };
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(&e))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin_right(right)
+            .x_label_area_size(bottom)
+            .y_label_area_size(left)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .x_desc("x [mm]")
+            .y_desc("y [mm]")
+            .label_style(("sans-serif", 12))
+            .draw()
+            .map_err(|e| err(&e))?;
+        let area = chart.plotting_area();
+        area.draw(&Rectangle::new(
+            [(x0, y0), (x1, y1)],
+            rgb(layout.outside_rgb).filled(),
+        ))
+        .map_err(|e| err(&e))?;
+        let rects = layout.all_floor_rects();
+        if rects.is_empty() {
+            area.draw(&Rectangle::new(
+                [(x0, y0), (x1, y1)],
+                rgb(layout.floor_rgb).filled(),
+            ))
+            .map_err(|e| err(&e))?;
+        }
+        for r in rects {
+            let pts = rect_corners(
+                Point2::from(r.center_mm),
+                [r.size_mm[0] / 2.0, r.size_mm[1] / 2.0],
+                r.angle_deg.to_radians(),
+            );
+            area.draw(&Polygon::new(pts, rgb(layout.floor_rgb).filled()))
+                .map_err(|e| err(&e))?;
+        }
+        if let Some(f) = &layout.field {
+            let line = rgb(layout.line_rgb).stroke_width(1);
+            let (a, b) = (f.half_length_mm, f.half_width_mm);
+            area.draw(&PathElement::new(
+                vec![(-a, -b), (a, -b), (a, b), (-a, b), (-a, -b)],
+                line,
+            ))
+            .map_err(|e| err(&e))?;
+            area.draw(&PathElement::new(vec![(0.0, -b), (0.0, b)], line))
+                .map_err(|e| err(&e))?;
+            let circle: Vec<(f64, f64)> = (0..=72)
+                .map(|k| {
+                    let t = k as f64 * std::f64::consts::TAU / 72.0;
+                    (
+                        f.centre_circle_radius_mm * t.cos(),
+                        f.centre_circle_radius_mm * t.sin(),
+                    )
+                })
+                .collect();
+            area.draw(&PathElement::new(circle, line))
+                .map_err(|e| err(&e))?;
+        }
+        for s in layout.solids() {
+            let fill = rgb(s.rgb).filled();
+            let edge = RGBColor(60, 60, 60).stroke_width(1);
+            match s.shape {
+                SolidShape::Box {
+                    center_mm,
+                    half_extents_mm,
+                    angle_rad,
+                } => {
+                    let pts =
+                        rect_corners(center_mm, [half_extents_mm.x, half_extents_mm.y], angle_rad);
+                    area.draw(&Polygon::new(pts.clone(), fill))
+                        .map_err(|e| err(&e))?;
+                    let mut closed = pts;
+                    closed.push(closed[0]);
+                    area.draw(&PathElement::new(closed, edge))
+                        .map_err(|e| err(&e))?;
+                }
+                SolidShape::Cylinder {
+                    center_mm,
+                    radius_mm,
+                } => {
+                    let pts: Vec<(f64, f64)> = (0..36)
+                        .map(|k| {
+                            let t = k as f64 * std::f64::consts::TAU / 36.0;
+                            (
+                                center_mm.x + radius_mm * t.cos(),
+                                center_mm.y + radius_mm * t.sin(),
+                            )
+                        })
+                        .collect();
+                    area.draw(&Polygon::new(pts, fill)).map_err(|e| err(&e))?;
+                }
+            }
+        }
+        for m in markers {
+            let pts: Vec<(f64, f64)> = (0..=48)
+                .map(|k| {
+                    let t = k as f64 * std::f64::consts::TAU / 48.0;
+                    (
+                        m.at.x + m.radius_mm * t.cos(),
+                        m.at.y + m.radius_mm * t.sin(),
+                    )
+                })
+                .collect();
+            area.draw(&PathElement::new(pts, color(m.rgb).stroke_width(2)))
+                .map_err(|e| err(&e))?;
+            if !m.label.is_empty() {
+                area.draw(&Text::new(
+                    m.label.clone(),
+                    (m.at.x + m.radius_mm, m.at.y + m.radius_mm),
+                    ("sans-serif", 13).into_font().color(&BLACK),
+                ))
+                .map_err(|e| err(&e))?;
+            }
+        }
+        for p in paths {
+            let c = color(p.rgb);
+            let pts: Vec<(f64, f64)> = p.points.iter().map(|q| (q.x, q.y)).collect();
+            let series = if p.dots {
+                chart
+                    .draw_series(pts.iter().map(|&q| Circle::new(q, 2, c.filled())))
+                    .map_err(|e| err(&e))?
+            } else {
+                chart
+                    .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                    .map_err(|e| err(&e))?
+            };
+            series.label(p.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
+            });
+        }
+        if !paths.is_empty() {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 13))
+                .position(SeriesLabelPosition::UpperLeft)
+                .draw()
+                .map_err(|e| err(&e))?;
+        }
+        root.present().map_err(|e| err(&e))?;
+    }
+    image::RgbImage::from_raw(width, height, buf)
+        .expect("buffer size matches the image")
+        .save(file)
+        .map_err(|source| FigureError::Write {
+            file: file.display().to_string(),
+            source,
+        })
+}

@@ -1,0 +1,203 @@
+//! End-to-end checks of the foundation: scenario files, the loop, determinism, the drive limit
+//! and contacts.
+
+use omniloop::record::write_trajectory_csv;
+use omniloop::{LoadError, load_scenario, parse_scenario, run_scenario};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn scenarios_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_omniloop"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn every_scenario_file_passes_check() {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(scenarios_dir())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty());
+    for f in &files {
+        if let Err(e) = load_scenario(f) {
+            panic!("{} does not load:\n{e}", f.display());
+        }
+    }
+    let out = bin().arg("check").args(&files).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn the_printed_default_scenario_is_valid_and_complete() {
+    let out = bin().args(["run", "--print-default"]).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let s = parse_scenario(&text, Path::new("default.toml"), "default").unwrap();
+    // Every key the schema serialises appears in the printed example.
+    let full = toml::Value::try_from(&s).unwrap();
+    let printed: toml::Value = toml::from_str(&text).unwrap();
+    fn check(full: &toml::Value, printed: &toml::Value, path: &str) {
+        if let (Some(f), Some(p)) = (full.as_table(), printed.as_table()) {
+            for (k, v) in f {
+                let here = format!("{path}.{k}");
+                let Some(pv) = p.get(k) else {
+                    panic!("the printed default lacks `{here}`");
+                };
+                check(v, pv, &here);
+            }
+        }
+        if let (Some(f), Some(p)) = (full.as_array(), printed.as_array()) {
+            for (a, b) in f.iter().zip(p) {
+                check(a, b, path);
+            }
+        }
+    }
+    check(&full, &printed, "");
+}
+
+fn broken(name: &str, text: &str) -> (i32, String) {
+    let dir = tmp(&format!("broken_{name}"));
+    let f = dir.join(format!("{name}.toml"));
+    std::fs::write(&f, text).unwrap();
+    let out = bin().arg("check").arg(&f).output().unwrap();
+    (
+        out.status.code().unwrap(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+const BASE: &str = "[world.field]\n\n[robot]\nstart = { x_mm = 0.0, y_mm = 0.0 }\n\n[goal]\nx_mm = 500.0\ny_mm = 0.0\n";
+
+#[test]
+fn broken_scenarios_exit_2_with_file_line_column_and_field() {
+    let cases = [
+        (
+            "unknown_key",
+            BASE.replace("[goal]\n", "[goal]\nspeed_mm_s = 3.0\n"),
+            ":7:1: field `goal.speed_mm_s`: unknown field",
+        ),
+        (
+            "wrong_type",
+            BASE.replace("x_mm = 500.0", "x_mm = \"far\""),
+            ":7:8: field `goal.x_mm`: invalid type",
+        ),
+        (
+            "negative_radius",
+            BASE.replace("[goal]", "radius_mm = -90.0\n\n[goal]"),
+            ":6:1: field `robot.radius_mm`: must be a finite number > 0",
+        ),
+        (
+            "start_outside_floor",
+            BASE.replace("x_mm = 0.0, y_mm = 0.0", "x_mm = 0.0, y_mm = 2000.0"),
+            ":4:11: field `robot.start.x_mm`: start (0, 2000) mm is outside the floor region",
+        ),
+    ];
+    for (name, text, expected) in cases {
+        let (code, err) = broken(name, &text);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(
+            err.contains(&format!("{name}.toml{expected}")),
+            "{name}: {err}"
+        );
+    }
+}
+
+#[test]
+fn smoke_reaches_its_goal_without_contact_and_within_the_acceleration_limit() {
+    let s = load_scenario(&scenarios_dir().join("smoke.toml")).unwrap();
+    let out = run_scenario(&s, |_, _| {}).unwrap();
+    let m = &out.summary;
+    assert!(m.reached_goal, "{m:?}");
+    assert_eq!(m.wall_contacts, 0);
+    assert!(
+        m.peak_accel_mm_s2 <= s.robot.accel_limit_mm_s2 * 1.01,
+        "{m:?}"
+    );
+    assert!(m.peak_speed_mm_s <= s.robot.max_speed_mm_s * 1.01, "{m:?}");
+    assert!(m.min_clearance_mm > 0.0);
+    // Accelerations between control cycles, from the recorded velocities, obey the limit too.
+    for w in out.trajectory.windows(2) {
+        let dt = w[1].t_s - w[0].t_s;
+        let a = ((w[1].vx_mm_s - w[0].vx_mm_s).powi(2) + (w[1].vy_mm_s - w[0].vy_mm_s).powi(2))
+            .sqrt()
+            / dt;
+        assert!(
+            a <= s.robot.accel_limit_mm_s2 * 1.01,
+            "{a} at t = {}",
+            w[0].t_s
+        );
+    }
+}
+
+#[test]
+fn same_scenario_and_seed_give_byte_identical_trajectories() {
+    let f = scenarios_dir().join("smoke.toml");
+    let mut files = Vec::new();
+    for k in 0..2 {
+        let dir = tmp(&format!("determinism_{k}"));
+        let out = bin()
+            .args(["run", "--quiet", "--seed", "11", "--out"])
+            .arg(&dir)
+            .arg(&f)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        files.push(std::fs::read(dir.join("trajectory.csv")).unwrap());
+        let summary: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+        assert_eq!(summary["seed"], 11);
+        assert!(dir.join("topview.png").exists());
+    }
+    assert!(files[0].len() > 1000);
+    assert_eq!(files[0], files[1]);
+}
+
+#[test]
+fn a_robot_commanded_into_a_wall_at_2000_mm_s_stays_outside_and_the_contact_is_counted() {
+    let text = "[run]\nduration_s = 3.0\n\n[world]\n[[world.walls]]\nfrom_mm = [600.0, -500.0]\nto_mm = [600.0, 500.0]\n\n[robot]\nstart = { x_mm = 0.0, y_mm = 0.0 }\nmax_speed_mm_s = 2000.0\naccel_limit_mm_s2 = 20000.0\n\n[goal]\nx_mm = 900.0\ny_mm = 0.0\n";
+    let s = match parse_scenario(text, Path::new("wall.toml"), "wall") {
+        Ok(s) => s,
+        Err(LoadError::Invalid { problems }) => panic!("{problems:?}"),
+        Err(e) => panic!("{e}"),
+    };
+    let out = run_scenario(&s, |_, _| {}).unwrap();
+    let m = &out.summary;
+    assert!(!m.reached_goal);
+    assert!(m.peak_speed_mm_s >= 1999.0, "{m:?}");
+    assert_eq!(m.wall_contacts, 1, "{m:?}");
+    // Wall face at x = 550: the centre never gets past 550 - 90 = 460 (1 mm tolerance).
+    let max_x = out
+        .trajectory
+        .iter()
+        .map(|r| r.x_mm)
+        .fold(f64::MIN, f64::max);
+    assert!(max_x <= 461.0, "max x {max_x}");
+    assert!(m.min_clearance_mm >= -1.0, "{m:?}");
+    let mut csv = Vec::new();
+    write_trajectory_csv(&out.trajectory, &mut csv).unwrap();
+    assert!(
+        String::from_utf8(csv)
+            .unwrap()
+            .starts_with("t_s,x_mm,y_mm,theta_rad")
+    );
+}
