@@ -6,6 +6,7 @@
 //! ([`topview`]). The world lives in `omniloop-sim`, image processing in `omniloop-vision`,
 //! controllers in `omniloop-control`.
 
+pub mod calibrate;
 pub mod load;
 pub mod output;
 pub mod record;

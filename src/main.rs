@@ -1,10 +1,14 @@
 //! The `omniloop` command line.
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use nalgebra::{Isometry2, Vector2};
+use omniloop::calibrate::calibrate_sensor;
 use omniloop::output::{default_out_dir, write_run};
-use omniloop::{DEFAULT_SCENARIO, LoadError, load_scenario, run_scenario};
+use omniloop::runner::{RunOptions, render_snapshot};
+use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
+use omniloop_sim::{Renderer, RendererChoice};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -39,12 +43,49 @@ enum Command {
         /// Seed overriding the scenario's.
         #[arg(long)]
         seed: Option<u64>,
+        /// Renderer for the sensors' images: auto, gpu or cpu.
+        #[arg(long, default_value = "auto")]
+        renderer: RendererChoice,
+        /// Save every sensor's image every K cycles to OUT/frames/.
+        #[arg(long, value_name = "K")]
+        save_frames: Option<u64>,
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
         /// Print a complete, commented example scenario and exit.
         #[arg(long)]
         print_default: bool,
+    },
+    /// Render one frame of a sensor to a PNG.
+    Render {
+        /// Scenario file.
+        scenario: PathBuf,
+        /// Robot pose `x_mm,y_mm,theta_deg` (default: the scenario's start).
+        #[arg(long, allow_hyphen_values = true)]
+        pose: Option<String>,
+        /// Output PNG.
+        #[arg(long)]
+        out: PathBuf,
+        /// Sensor name (default: the robot's first sensor).
+        #[arg(long)]
+        sensor: Option<String>,
+        /// Renderer: auto, gpu or cpu.
+        #[arg(long, default_value = "auto")]
+        renderer: RendererChoice,
+        /// Leave out the sensor noise.
+        #[arg(long)]
+        no_noise: bool,
+    },
+    /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate.
+    Calibrate {
+        /// Scenario file.
+        scenario: PathBuf,
+        /// Sensor name (default: the robot's first sensor).
+        #[arg(long)]
+        sensor: Option<String>,
+        /// Output file (default: runs/<scenario name>/calibration_<sensor>.json).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
 }
 
@@ -59,7 +100,7 @@ impl std::fmt::Display for Exit {
 }
 impl std::error::Error for Exit {}
 
-fn load(path: &Path) -> anyhow::Result<omniloop::Scenario> {
+fn load(path: &Path) -> anyhow::Result<Scenario> {
     match load_scenario(path) {
         Ok(s) => Ok(s),
         Err(e @ LoadError::Invalid { .. }) => {
@@ -83,6 +124,17 @@ fn progress_bar(total: u64, quiet: bool) -> ProgressBar {
     bar
 }
 
+fn parse_pose(text: &str) -> anyhow::Result<Isometry2<f64>> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let nums: Result<Vec<f64>, _> = parts.iter().map(|p| p.parse::<f64>()).collect();
+    match nums {
+        Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => {
+            Ok(Isometry2::new(Vector2::new(v[0], v[1]), v[2].to_radians()))
+        }
+        _ => bail!("--pose {text:?}: expected x_mm,y_mm,theta_deg, e.g. --pose -900,0,45"),
+    }
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Check { files } => {
@@ -90,10 +142,6 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             for f in &files {
                 match load_scenario(f) {
                     Ok(s) => println!("{}: ok ({})", f.display(), s.name),
-                    Err(e @ LoadError::Invalid { .. }) => {
-                        eprintln!("{e}");
-                        bad = true;
-                    }
                     Err(e) => {
                         eprintln!("{e}");
                         bad = true;
@@ -109,6 +157,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             scenario,
             out,
             seed,
+            renderer,
+            save_frames,
             quiet,
             print_default,
         } => {
@@ -122,16 +172,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 s.seed = seed;
             }
             let dir = out.unwrap_or_else(|| default_out_dir(&s));
+            let options = RunOptions {
+                renderer,
+                save_frames_every: save_frames,
+                frames_dir: save_frames.map(|_| dir.join("frames")),
+            };
             let bar = progress_bar(s.max_cycles(), quiet);
             bar.set_prefix(s.name.clone());
-            let output = run_scenario(&s, |k, _| bar.set_position(k))
-                .with_context(|| format!("running {}", path.display()))?;
+            let output = run_scenario(
+                &s,
+                &options,
+                |msg| eprintln!("{msg}"),
+                |k, _| bar.set_position(k),
+            )
+            .with_context(|| format!("running {}", path.display()))?;
             bar.finish_and_clear();
             write_run(&dir, &s, &output)?;
             let m = &output.summary;
             println!(
-                "{}: {} cycles, {:.2} s simulated in {:.2} s ({:.0} cycles/s); goal {}; contacts {}; \
-                 min clearance {:.1} mm; results in {}",
+                "{}: {} cycles, {:.2} s simulated in {:.2} s ({:.0} cycles/s); goal {}; \
+                 contacts {}; min clearance {:.1} mm; results in {}",
                 m.scenario,
                 m.cycles,
                 m.sim_time_s,
@@ -145,6 +205,75 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 m.min_clearance_mm,
                 dir.display()
             );
+            Ok(())
+        }
+        Command::Render {
+            scenario,
+            pose,
+            out,
+            sensor,
+            renderer,
+            no_noise,
+        } => {
+            let s = load(&scenario)?;
+            let pose = pose.as_deref().map(parse_pose).transpose()?;
+            let mut r = Renderer::new(renderer, |msg| eprintln!("{msg}"))?;
+            let img = render_snapshot(&s, &mut r, sensor.as_deref(), pose, !no_noise)?;
+            if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+                std::fs::create_dir_all(parent)
+                    .with_context(|| format!("creating {}", parent.display()))?;
+            }
+            img.save(&out)
+                .with_context(|| format!("writing {}", out.display()))?;
+            println!(
+                "{}: {}x{} rendered by {} -> {}",
+                s.name,
+                img.width(),
+                img.height(),
+                r.name(),
+                out.display()
+            );
+            Ok(())
+        }
+        Command::Calibrate {
+            scenario,
+            sensor,
+            out,
+        } => {
+            let s = load(&scenario)?;
+            let Some(spec) = s.sensor(sensor.as_deref()) else {
+                bail!(
+                    "scenario {:?} has no sensor {}",
+                    s.name,
+                    sensor.map_or("at all".to_string(), |n| format!("{n:?}"))
+                );
+            };
+            let cal = calibrate_sensor(spec)?;
+            let out = out.unwrap_or_else(|| {
+                default_out_dir(&s).join(format!("calibration_{}.json", spec.name))
+            });
+            if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+                std::fs::create_dir_all(parent)
+                    .with_context(|| format!("creating {}", parent.display()))?;
+            }
+            cal.save(&out)?;
+            println!(
+                "sensor {}: {} samples every 0.25 px, floor horizon at R = {:.2} px",
+                spec.name,
+                cal.samples.len(),
+                cal.horizon_px
+            );
+            if let Some(f) = &cal.fit {
+                println!(
+                    "f(R) = R / (A - B sqrt(C + R^2)), fitted for R <= {:.1} px:",
+                    0.95 * cal.horizon_px
+                );
+                println!("A= {:.4}", f.a);
+                println!("B= {:.4e}", f.b);
+                println!("C= {:.4e}", f.c);
+                println!("rms residual {:.2e} mm", f.rms_mm);
+            }
+            println!("written to {}", out.display());
             Ok(())
         }
     }

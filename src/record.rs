@@ -89,4 +89,6 @@ pub struct Summary {
     pub min_clearance_mm: f64,
     /// Length of the path the robot centre travelled.
     pub path_length_mm: f64,
+    /// The renderer that traced the sensors' images (adapter name or `cpu (...)`), if any.
+    pub renderer: Option<String>,
 }

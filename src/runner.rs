@@ -4,7 +4,10 @@ use crate::record::{Summary, TrajectoryRow};
 use crate::scenario::{ControllerKind, Scenario, controller_name};
 use nalgebra::Point2;
 use omniloop_control::{AccelLimitedDrive, GoToGoal, VelocityCommand};
-use omniloop_sim::{SimError, World};
+use omniloop_sim::{
+    RenderError, Renderer, RendererChoice, Scene, Sensor, SensorNoise, SimError, World,
+};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Why a run could not be carried out.
@@ -16,6 +19,39 @@ pub enum RunError {
     /// A controller could not be built.
     #[error("control: {0}")]
     Control(#[from] omniloop_control::ControlError),
+    /// The renderer could not open or render.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// A frame could not be written.
+    #[error("writing frame {path}: {source}")]
+    Frame {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: image::ImageError,
+    },
+}
+
+/// How to run a scenario (what the command line adds to the scenario file).
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Which renderer traces the sensors' images.
+    pub renderer: RendererChoice,
+    /// Save every sensor's image every this many cycles (with `frames_dir`).
+    pub save_frames_every: Option<u64>,
+    /// Where saved frames go.
+    pub frames_dir: Option<PathBuf>,
+}
+
+/// The seed of sensor `index`'s noise, derived from the run's seed.
+pub fn sensor_noise_seed(seed: u64, index: usize) -> u64 {
+    seed ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
+
+/// The sensors of the robot under test, their noise and the renderer, when images are needed.
+struct Eyes {
+    renderer: Renderer,
+    sensors: Vec<(Sensor, SensorNoise)>,
 }
 
 /// Drives another robot through its waypoints on its true pose.
@@ -47,11 +83,18 @@ pub struct Simulation {
     time_to_goal_s: Option<f64>,
     trajectory: Vec<TrajectoryRow>,
     other_paths: Vec<Vec<Point2<f64>>>,
+    eyes: Option<Eyes>,
+    options: RunOptions,
 }
 
 impl Simulation {
-    /// Builds the world and controllers of a validated scenario.
-    pub fn new(scenario: &Scenario) -> Result<Self, RunError> {
+    /// Builds the world and controllers of a validated scenario. `notice` receives one-line
+    /// messages for the user (e.g. the renderer falling back to the CPU).
+    pub fn new(
+        scenario: &Scenario,
+        options: &RunOptions,
+        notice: impl FnOnce(&str),
+    ) -> Result<Self, RunError> {
         let world = World::new(
             &scenario.world,
             &scenario.robot_bodies(),
@@ -77,8 +120,25 @@ impl Simulation {
                 controller: GoToGoal::new(o.max_speed_mm_s, drive)?,
             });
         }
+        let needs_images =
+            !scenario.robot.sensors.is_empty() && options.save_frames_every.is_some();
+        let eyes = if needs_images {
+            let renderer = Renderer::new(options.renderer, notice)?;
+            let mut sensors = Vec::new();
+            for (i, spec) in scenario.robot.sensors.iter().enumerate() {
+                sensors.push((
+                    spec.build()?,
+                    SensorNoise::new(sensor_noise_seed(scenario.seed, i)),
+                ));
+            }
+            Some(Eyes { renderer, sensors })
+        } else {
+            None
+        };
         Ok(Self {
             scenario: scenario.clone(),
+            eyes,
+            options: options.clone(),
             world,
             goal_controller,
             other_paths: vec![Vec::new(); movers.len()],
@@ -105,8 +165,48 @@ impl Simulation {
             || (self.scenario.run.stop_at_goal && self.time_to_goal_s.is_some())
     }
 
+    /// Name of the renderer in use, if the run renders.
+    pub fn renderer_name(&self) -> Option<&str> {
+        self.eyes.as_ref().map(|e| e.renderer.name())
+    }
+
+    /// Renders every sensor of the robot under test at its current pose (with noise).
+    fn sense(&mut self) -> Result<Vec<image::RgbaImage>, RunError> {
+        let Some(eyes) = &mut self.eyes else {
+            return Ok(Vec::new());
+        };
+        let pose = self.world.robot_state(0).pose;
+        let scene = Scene::new(self.world.layout(), &self.world.robot_solids(None));
+        let mut frames = Vec::with_capacity(eyes.sensors.len());
+        for (sensor, noise) in eyes.sensors.iter_mut() {
+            frames.push(eyes.renderer.render(&scene, sensor, &pose, Some(noise))?);
+        }
+        Ok(frames)
+    }
+
+    fn save_frames(&self, frames: &[image::RgbaImage]) -> Result<(), RunError> {
+        let (Some(every), Some(dir), Some(eyes)) = (
+            self.options.save_frames_every,
+            &self.options.frames_dir,
+            &self.eyes,
+        ) else {
+            return Ok(());
+        };
+        if every == 0 || !self.cycle.is_multiple_of(every) {
+            return Ok(());
+        }
+        for (img, (sensor, _)) in frames.iter().zip(&eyes.sensors) {
+            let path = dir.join(format!("{}_{:06}.png", sensor.name, self.cycle));
+            img.save(&path)
+                .map_err(|source| RunError::Frame { path, source })?;
+        }
+        Ok(())
+    }
+
     /// One control cycle: observe, choose commands, record, advance the world one period.
-    pub fn step(&mut self) {
+    pub fn step(&mut self) -> Result<(), RunError> {
+        let frames = self.sense()?;
+        self.save_frames(&frames)?;
         let t = self.world.time_s();
         let state = self.world.robot_state(0);
         let position = Point2::from(state.pose.translation.vector);
@@ -151,6 +251,7 @@ impl Simulation {
                 self.time_to_goal_s = Some(self.world.time_s());
             }
         }
+        Ok(())
     }
 
     /// Ends the run: the summary and everything recorded.
@@ -196,6 +297,7 @@ impl Simulation {
             time_to_goal_s: self.time_to_goal_s,
             min_clearance_mm: stats.min_clearance_mm,
             path_length_mm: stats.path_length_mm,
+            renderer: self.eyes.as_ref().map(|e| e.renderer.name().to_string()),
         };
         RunOutput {
             summary,
@@ -208,14 +310,69 @@ impl Simulation {
 /// Runs a validated scenario to its end, calling `progress(cycle, max_cycles)` after each cycle.
 pub fn run_scenario(
     scenario: &Scenario,
+    options: &RunOptions,
+    notice: impl FnOnce(&str),
     mut progress: impl FnMut(u64, u64),
 ) -> Result<RunOutput, RunError> {
     let start = Instant::now();
-    let mut sim = Simulation::new(scenario)?;
+    if let Some(dir) = &options.frames_dir {
+        std::fs::create_dir_all(dir).map_err(|e| RunError::Frame {
+            path: dir.clone(),
+            source: image::ImageError::IoError(e),
+        })?;
+    }
+    let mut sim = Simulation::new(scenario, options, notice)?;
     let max = scenario.max_cycles();
     while !sim.finished() {
-        sim.step();
+        sim.step()?;
         progress(sim.cycle(), max);
     }
     Ok(sim.finish(start.elapsed().as_secs_f64()))
+}
+
+/// Renders what sensor `sensor` of the robot under test sees when the robot stands at `pose`
+/// (the scenario's start when `None`) and every other robot at its start, with the sensor's
+/// noise drawn as the first frame of a run would be, or clean when `noise` is false.
+pub fn render_snapshot(
+    scenario: &Scenario,
+    renderer: &mut Renderer,
+    sensor: Option<&str>,
+    pose: Option<nalgebra::Isometry2<f64>>,
+    noise: bool,
+) -> Result<image::RgbaImage, RunError> {
+    let index = match sensor {
+        Some(n) => scenario.robot.sensors.iter().position(|s| s.name == n),
+        None => (!scenario.robot.sensors.is_empty()).then_some(0),
+    }
+    .ok_or_else(|| {
+        SimError::Invalid(match sensor {
+            Some(n) => format!(
+                "scenario {:?} has no sensor {n:?} (it has: {})",
+                scenario.name,
+                scenario
+                    .robot
+                    .sensors
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            None => format!("scenario {:?} has no [[robot.sensors]]", scenario.name),
+        })
+    })?;
+    let mut bodies = scenario.robot_bodies();
+    if let Some(p) = pose {
+        bodies[0].start = p;
+    }
+    let world = World::new(&scenario.world, &bodies, scenario.run.physics_step_s)?;
+    let spec = &scenario.robot.sensors[index];
+    let sensor = spec.build()?;
+    let scene = Scene::new(world.layout(), &world.robot_solids(None));
+    let mut noise_source = noise.then(|| SensorNoise::new(sensor_noise_seed(scenario.seed, index)));
+    Ok(renderer.render(
+        &scene,
+        &sensor,
+        &world.robot_state(0).pose,
+        noise_source.as_mut(),
+    )?)
 }

@@ -4,7 +4,7 @@
 //! and column, and the dotted path of the field ([`crate::scenario_error`]).
 
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop_sim::{Layout, Rgb};
+use omniloop_sim::{Layout, Rgb, SensorSpec};
 use serde::{Deserialize, Serialize};
 
 /// A complete scenario: the world, the robot, what it should do and for how long.
@@ -120,13 +120,16 @@ pub struct RobotSpec {
     /// Body colour.
     #[serde(default = "default_robot_rgb")]
     pub rgb: Rgb,
+    /// Cameras on the robot (`[[robot.sensors]]`).
+    #[serde(default)]
+    pub sensors: Vec<SensorSpec>,
 }
 
 fn default_radius() -> f64 {
     90.0
 }
 fn default_height() -> f64 {
-    140.0
+    110.0
 }
 fn default_max_speed() -> f64 {
     400.0
@@ -247,6 +250,14 @@ impl Scenario {
             });
         }
         out
+    }
+
+    /// The sensor called `name`, or the first one when `name` is `None`.
+    pub fn sensor(&self, name: Option<&str>) -> Option<&SensorSpec> {
+        match name {
+            Some(n) => self.robot.sensors.iter().find(|s| s.name == n),
+            None => self.robot.sensors.first(),
+        }
     }
 
     /// Number of control cycles the run lasts at most.

@@ -3,7 +3,7 @@
 
 use crate::scenario::{ControllerKind, PoseSpec, Scenario};
 use nalgebra::Point2;
-use omniloop_sim::Layout;
+use omniloop_sim::{Layout, SensorSpec};
 use std::fmt;
 
 /// One step of a path into the scenario document.
@@ -201,6 +201,15 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         rb.angular_accel_limit_rad_s2,
     );
     c.pose_in_world("robot.start", &rb.start, rb.radius_mm, w);
+    for (i, sensor) in rb.sensors.iter().enumerate() {
+        check_sensor(&mut c, &format!("robot.sensors[{i}]"), sensor);
+        if rb.sensors[..i].iter().any(|o| o.name == sensor.name) {
+            c.fail(
+                format!("robot.sensors[{i}].name"),
+                format!("sensor name {:?} is used twice", sensor.name),
+            );
+        }
+    }
 
     for (i, o) in s.other_robots.iter().enumerate() {
         let p = format!("other_robots[{i}]");
@@ -243,6 +252,118 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         );
     }
     c.out
+}
+
+fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
+    if s.name.trim().is_empty() {
+        c.fail(format!("{p}.name"), "must not be empty");
+    }
+    for (key, v) in [("width_px", s.width_px), ("height_px", s.height_px)] {
+        if !(8..=4096).contains(&v) {
+            c.fail(format!("{p}.{key}"), format!("must be 8..=4096 (got {v})"));
+        }
+    }
+    let inside = |x: f64, y: f64| {
+        (0.0..=s.width_px as f64).contains(&x) && (0.0..=s.height_px as f64).contains(&y)
+    };
+    if let Some([x, y]) = s.principal_point_px.filter(|&[x, y]| !inside(x, y)) {
+        c.fail(
+            format!("{p}.principal_point_px"),
+            format!(
+                "({x}, {y}) lies outside the {}x{} image",
+                s.width_px, s.height_px
+            ),
+        );
+    }
+    if !(s.noise_sigma.is_finite() && s.noise_sigma >= 0.0) {
+        c.fail(
+            format!("{p}.noise_sigma"),
+            format!("must be >= 0 (got {})", s.noise_sigma),
+        );
+    }
+    let present = s.optics_present();
+    if present.len() != 1 {
+        c.fail(
+            p,
+            format!(
+                "a sensor needs exactly one of the tables hyperbolic, conical, spherical, \
+                 pinhole (found {})",
+                if present.is_empty() {
+                    "none".to_string()
+                } else {
+                    present.join(", ")
+                }
+            ),
+        );
+    }
+    if let Some(m) = &s.hyperbolic {
+        let q = format!("{p}.hyperbolic");
+        for (k, v) in [
+            ("a_mm", m.a_mm),
+            ("b_mm", m.b_mm),
+            ("c_mm", m.c_mm),
+            ("focal_px", m.focal_px),
+            ("focus_height_mm", m.focus_height_mm),
+            ("rim_radius_mm", m.rim_radius_mm),
+        ] {
+            c.positive(format!("{q}.{k}"), v);
+        }
+        let exact = m.a_mm.hypot(m.b_mm);
+        if (m.c_mm - exact).abs() > 1e-3 * exact {
+            c.fail(
+                format!("{q}.c_mm"),
+                format!(
+                    "must equal sqrt(a^2 + b^2) = {exact:.4} mm to within 0.1% (got {})",
+                    m.c_mm
+                ),
+            );
+        }
+        if m.focus_height_mm <= 2.0 * exact {
+            c.fail(
+                format!("{q}.focus_height_mm"),
+                "puts the camera (2 c below the focus) under the floor",
+            );
+        }
+    }
+    if let Some(m) = &s.conical {
+        let q = format!("{p}.conical");
+        if !(m.apex_angle_deg > 0.0 && m.apex_angle_deg < 180.0) {
+            c.fail(
+                format!("{q}.apex_angle_deg"),
+                format!("must lie in (0, 180) (got {})", m.apex_angle_deg),
+            );
+        }
+        c.positive(format!("{q}.radius_mm"), m.radius_mm);
+        c.positive(format!("{q}.tip_distance_mm"), m.tip_distance_mm);
+        c.positive(format!("{q}.focal_px"), m.focal_px);
+        c.positive(format!("{q}.lens_height_mm"), m.lens_height_mm);
+    }
+    if let Some(m) = &s.spherical {
+        let q = format!("{p}.spherical");
+        c.positive(format!("{q}.radius_mm"), m.radius_mm);
+        c.positive(format!("{q}.focal_px"), m.focal_px);
+        c.positive(format!("{q}.lens_height_mm"), m.lens_height_mm);
+        if m.camera_distance_mm.is_nan() || m.camera_distance_mm <= m.radius_mm {
+            c.fail(
+                format!("{q}.camera_distance_mm"),
+                format!(
+                    "must exceed radius_mm = {} (got {})",
+                    m.radius_mm, m.camera_distance_mm
+                ),
+            );
+        }
+    }
+    if let Some(m) = &s.pinhole {
+        let q = format!("{p}.pinhole");
+        c.positive(format!("{q}.focal_px"), m.focal_px);
+        c.positive(format!("{q}.height_mm"), m.height_mm);
+        if m.tilt_deg.is_nan() || m.tilt_deg.abs() > 90.0 {
+            c.fail(
+                format!("{q}.tilt_deg"),
+                format!("must lie in [-90, 90] (got {})", m.tilt_deg),
+            );
+        }
+    }
 }
 
 #[cfg(test)]

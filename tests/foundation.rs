@@ -121,7 +121,7 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
 #[test]
 fn smoke_reaches_its_goal_without_contact_and_within_the_acceleration_limit() {
     let s = load_scenario(&scenarios_dir().join("smoke.toml")).unwrap();
-    let out = run_scenario(&s, |_, _| {}).unwrap();
+    let out = run_scenario(&s, &Default::default(), |_| {}, |_, _| {}).unwrap();
     let m = &out.summary;
     assert!(m.reached_goal, "{m:?}");
     assert_eq!(m.wall_contacts, 0);
@@ -180,7 +180,7 @@ fn a_robot_commanded_into_a_wall_at_2000_mm_s_stays_outside_and_the_contact_is_c
         Err(LoadError::Invalid { problems }) => panic!("{problems:?}"),
         Err(e) => panic!("{e}"),
     };
-    let out = run_scenario(&s, |_, _| {}).unwrap();
+    let out = run_scenario(&s, &Default::default(), |_| {}, |_, _| {}).unwrap();
     let m = &out.summary;
     assert!(!m.reached_goal);
     assert!(m.peak_speed_mm_s >= 1999.0, "{m:?}");

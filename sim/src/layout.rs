@@ -253,6 +253,58 @@ pub struct Pillar {
     pub rgb: Rgb,
 }
 
+/// A flat upright board carrying vertical stripes (a landmark), e.g. the marks of the
+/// three-mark resection paper: black and white stripes with given width ratios.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Board {
+    /// One end of the board.
+    pub from_mm: [f64; 2],
+    /// The other end.
+    pub to_mm: [f64; 2],
+    /// Height of its lower edge above the floor.
+    #[serde(default)]
+    pub bottom_mm: f64,
+    /// Height of its upper edge above the floor.
+    pub top_mm: f64,
+    /// Thickness.
+    #[serde(default = "default_board_thickness")]
+    pub thickness_mm: f64,
+    /// Relative widths of the stripes from `from_mm` to `to_mm`, alternating `rgb_a`, `rgb_b`.
+    pub stripes: Vec<f64>,
+    /// Colour of the first, third, ... stripe.
+    #[serde(default = "default_board_a")]
+    pub rgb_a: Rgb,
+    /// Colour of the second, fourth, ... stripe.
+    #[serde(default = "default_board_b")]
+    pub rgb_b: Rgb,
+}
+
+fn default_board_thickness() -> f64 {
+    10.0
+}
+fn default_board_a() -> Rgb {
+    Rgb([15, 15, 15])
+}
+fn default_board_b() -> Rgb {
+    Rgb([245, 245, 245])
+}
+
+impl Board {
+    /// Cumulative stripe boundaries as fractions of the board's length, ending at 1.
+    pub fn stripe_edges(&self) -> Vec<f64> {
+        let total: f64 = self.stripes.iter().sum();
+        let mut acc = 0.0;
+        self.stripes
+            .iter()
+            .map(|w| {
+                acc += w;
+                acc / total
+            })
+            .collect()
+    }
+}
+
 /// The static world: floor, field, walls and obstacles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -274,6 +326,8 @@ pub struct Layout {
     pub cubes: Vec<Cube>,
     /// Pillars.
     pub pillars: Vec<Pillar>,
+    /// Striped boards (landmarks).
+    pub boards: Vec<Board>,
 }
 
 impl Default for Layout {
@@ -287,6 +341,7 @@ impl Default for Layout {
             walls: Vec::new(),
             cubes: Vec::new(),
             pillars: Vec::new(),
+            boards: Vec::new(),
         }
     }
 }
@@ -322,35 +377,51 @@ impl Layout {
             let b = Vector2::from(w.to_mm);
             let d = b - a;
             let len = d.norm();
-            out.push(Solid {
-                shape: SolidShape::Box {
+            out.push(Solid::standing(
+                SolidShape::Box {
                     center_mm: Point2::from((a + b) / 2.0),
                     half_extents_mm: Vector2::new(len / 2.0, w.thickness_mm / 2.0),
                     angle_rad: d.y.atan2(d.x),
                 },
-                height_mm: w.height_mm,
-                rgb: w.rgb,
-            });
+                w.height_mm,
+                w.rgb,
+            ));
         }
         for c in &self.cubes {
-            out.push(Solid {
-                shape: SolidShape::Box {
+            out.push(Solid::standing(
+                SolidShape::Box {
                     center_mm: Point2::from(c.center_mm),
                     half_extents_mm: Vector2::new(c.size_mm / 2.0, c.size_mm / 2.0),
                     angle_rad: c.angle_deg.to_radians(),
                 },
-                height_mm: c.size_mm,
-                rgb: c.rgb,
-            });
+                c.size_mm,
+                c.rgb,
+            ));
         }
         for p in &self.pillars {
-            out.push(Solid {
-                shape: SolidShape::Cylinder {
+            out.push(Solid::standing(
+                SolidShape::Cylinder {
                     center_mm: Point2::from(p.center_mm),
                     radius_mm: p.radius_mm,
                 },
-                height_mm: p.height_mm,
-                rgb: p.rgb,
+                p.height_mm,
+                p.rgb,
+            ));
+        }
+        for (i, b) in self.boards.iter().enumerate() {
+            let a = Vector2::from(b.from_mm);
+            let e = Vector2::from(b.to_mm);
+            let d = e - a;
+            out.push(Solid {
+                shape: SolidShape::Box {
+                    center_mm: Point2::from((a + e) / 2.0),
+                    half_extents_mm: Vector2::new(d.norm() / 2.0, b.thickness_mm / 2.0),
+                    angle_rad: d.y.atan2(d.x),
+                },
+                base_mm: b.bottom_mm,
+                height_mm: b.top_mm,
+                rgb: b.rgb_a,
+                board: Some(i),
             });
         }
         out

@@ -2,11 +2,17 @@
 //! Small-Size field (or any floor of walls, cubes and pillars) and acceleration-limited
 //! omnidirectional robots.
 
+pub mod calibration;
 pub mod layout;
+pub mod optics;
+pub mod render;
+pub mod sensor;
 pub mod shapes;
 pub mod world;
 
-pub use layout::{Cube, FieldSpec, FloorRect, Layout, Pillar, Rgb, Wall};
+pub use layout::{Board, Cube, FieldSpec, FloorRect, Layout, Pillar, Rgb, Wall};
+pub use render::{RenderError, Renderer, RendererChoice, Scene, SensorNoise};
+pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};
 pub use world::{RobotBodySpec, RobotState, RobotStats, World};
 

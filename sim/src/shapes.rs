@@ -25,15 +25,32 @@ pub enum SolidShape {
     },
 }
 
-/// A solid standing on the floor: footprint, height and colour.
+/// A solid standing on the floor: footprint, vertical extent and colour.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Solid {
     /// Footprint.
     pub shape: SolidShape,
-    /// Height above the floor.
+    /// Height of its bottom above the floor (0 for everything but raised boards).
+    pub base_mm: f64,
+    /// Height of its top above the floor.
     pub height_mm: f64,
     /// Colour.
     pub rgb: Rgb,
+    /// Index of the stripe board in [`crate::Layout::boards`] it carries, if any.
+    pub board: Option<usize>,
+}
+
+impl Solid {
+    /// A solid standing on the floor, plain-coloured.
+    pub fn standing(shape: SolidShape, height_mm: f64, rgb: Rgb) -> Self {
+        Self {
+            shape,
+            base_mm: 0.0,
+            height_mm,
+            rgb,
+            board: None,
+        }
+    }
 }
 
 impl SolidShape {

@@ -284,14 +284,14 @@ impl World {
             .filter(|&j| Some(j) != except)
             .map(|j| {
                 let spec = &self.robots[j].spec;
-                Solid {
-                    shape: SolidShape::Cylinder {
+                Solid::standing(
+                    SolidShape::Cylinder {
                         center_mm: Point2::from(self.robot_state(j).pose.translation.vector),
                         radius_mm: spec.radius_mm,
                     },
-                    height_mm: spec.height_mm,
-                    rgb: spec.rgb,
-                }
+                    spec.height_mm,
+                    spec.rgb,
+                )
             })
             .collect()
     }

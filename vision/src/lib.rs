@@ -1,1 +1,34 @@
+//! omniloop-vision: image processing and estimation for omnidirectional images of a floor.
+//!
+//! Everything here takes images (`image::RgbaImage`) and a calibration of the image-to-floor
+//! map, never a simulated world, so it works the same on a real camera's PNG.
 
+pub mod calibration;
+
+pub use calibration::{HyperbolicFit, RadialCalibration};
+
+/// Errors of the vision crate.
+#[derive(Debug, thiserror::Error)]
+pub enum VisionError {
+    /// A calibration that cannot be used.
+    #[error("calibration: {0}")]
+    Calibration(String),
+    /// A calibration file that cannot be read or parsed.
+    #[error("calibration file {path}: {message}")]
+    CalibrationFile {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// A parameter outside its range.
+    #[error("{name} = {value}: {rule}")]
+    InvalidParameter {
+        /// Name with unit.
+        name: &'static str,
+        /// Value.
+        value: f64,
+        /// The rule it breaks.
+        rule: &'static str,
+    },
+}

@@ -1,0 +1,94 @@
+//! Tracing the image-to-floor map `r = f(R)` of a mirror sensor: for image radii R along the
+//! image x axis, where the pixel's scene ray meets the floor, as distance from the sensor axis.
+
+use crate::SimError;
+use crate::optics::Optics;
+use crate::sensor::Sensor;
+
+/// `(R, r)` samples every `step_px` from 0 to just below the floor horizon, and the horizon's
+/// image radius (found by bisection to 1e-6 px).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RadialMap {
+    /// `(R_px, r_mm)` pairs.
+    pub samples: Vec<[f64; 2]>,
+    /// Image radius beyond which rays no longer reach the floor.
+    pub horizon_px: f64,
+}
+
+fn floor_distance(sensor: &Sensor, r_px: f64) -> Option<f64> {
+    let ray = sensor.optics.scene_ray(r_px.max(1e-9), 0.0)?;
+    let hit = ray.floor_hit()?;
+    Some(hit.coords.xy().norm())
+}
+
+/// Traces the radial map of a mirror sensor (hyperbolic, conical or spherical).
+pub fn trace_radial_map(sensor: &Sensor, step_px: f64) -> Result<RadialMap, SimError> {
+    if matches!(sensor.optics, Optics::Pinhole(_)) {
+        return Err(SimError::Invalid(format!(
+            "sensor {:?} is a pinhole camera; the radial image-to-floor map exists for mirror \
+             sensors only",
+            sensor.name
+        )));
+    }
+    if step_px.is_nan() || step_px <= 0.0 {
+        return Err(SimError::Invalid(format!("step {step_px} px must be > 0")));
+    }
+    let r_max = sensor.width_px.max(sensor.height_px) as f64;
+    // Last radius that still sees the floor, then bisect to the horizon.
+    let mut lo = None;
+    let mut k = 0;
+    let mut samples = Vec::new();
+    loop {
+        let big_r = k as f64 * step_px;
+        if big_r > r_max {
+            break;
+        }
+        match floor_distance(sensor, big_r) {
+            Some(r) if samples.last().is_none_or(|s: &[f64; 2]| r >= s[1]) => {
+                samples.push([big_r, r]);
+                lo = Some(big_r);
+            }
+            _ => break,
+        }
+        k += 1;
+    }
+    let Some(mut lo) = lo else {
+        return Err(SimError::Invalid(format!(
+            "sensor {:?} sees no floor along its image x axis",
+            sensor.name
+        )));
+    };
+    let mut hi = lo + step_px;
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if floor_distance(sensor, mid).is_some() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(RadialMap {
+        samples,
+        horizon_px: 0.5 * (lo + hi),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sensor::SensorSpec;
+
+    #[test]
+    fn the_corner_mirror_horizon_is_near_114_px() {
+        let s = SensorSpec::corner_paper("omni").build().unwrap();
+        let map = trace_radial_map(&s, 0.25).unwrap();
+        // A - B sqrt(C + R^2) = 0 at R = sqrt((A/B)^2 - C).
+        let expected = ((10.12f64 / 2.054e-2).powi(2) - 2.298e5).sqrt();
+        assert!(
+            (map.horizon_px - expected).abs() < 0.5,
+            "{}",
+            map.horizon_px
+        );
+        assert!(map.samples.len() > 400);
+    }
+}

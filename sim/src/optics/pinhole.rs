@@ -1,0 +1,70 @@
+//! A plain pinhole camera on the robot, panned about the vertical and tilted about its own
+//! horizontal axis (for forward-looking experiments).
+
+use super::Ray;
+use nalgebra::{Point3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// A pinhole camera looking out from the robot.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PinholeCamera {
+    /// Focal length in pixels.
+    pub focal_px: f64,
+    /// Height of the pinhole above the floor.
+    pub height_mm: f64,
+    /// Rotation about the vertical from the robot's forward axis (counter-clockwise).
+    #[serde(default)]
+    pub pan_deg: f64,
+    /// Elevation of the optical axis (negative looks down).
+    #[serde(default)]
+    pub tilt_deg: f64,
+}
+
+impl PinholeCamera {
+    /// Forward, right and up unit vectors of the camera in the robot frame.
+    pub fn basis(&self) -> [Vector3<f64>; 3] {
+        let (sp, cp) = self.pan_deg.to_radians().sin_cos();
+        let (st, ct) = self.tilt_deg.to_radians().sin_cos();
+        let forward = Vector3::new(cp * ct, sp * ct, st);
+        let right = Vector3::new(sp, -cp, 0.0);
+        let up = right.cross(&forward);
+        [forward, right, up]
+    }
+
+    /// The scene ray for image coordinates `(X, Y)` (X right, Y up).
+    pub fn scene_ray(&self, x_px: f64, y_px: f64) -> Option<Ray> {
+        let [f, r, u] = self.basis();
+        let dir = (f * self.focal_px + r * x_px + u * y_px).normalize();
+        Some(Ray {
+            origin: Point3::new(0.0, 0.0, self.height_mm),
+            dir,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tilted_camera_sees_the_floor_ahead_at_the_principal_point() {
+        let cam = PinholeCamera {
+            focal_px: 300.0,
+            height_mm: 100.0,
+            pan_deg: 0.0,
+            tilt_deg: -45.0,
+        };
+        let hit = cam.scene_ray(0.0, 0.0).unwrap().floor_hit().unwrap();
+        assert!((hit.x - 100.0).abs() < 1e-9 && hit.y.abs() < 1e-9);
+        // Image right is robot right (-y).
+        let hit = cam.scene_ray(50.0, 0.0).unwrap().floor_hit().unwrap();
+        assert!(hit.y < 0.0);
+        let panned = PinholeCamera {
+            pan_deg: 90.0,
+            ..cam
+        };
+        let hit = panned.scene_ray(0.0, 0.0).unwrap().floor_hit().unwrap();
+        assert!(hit.x.abs() < 1e-9 && (hit.y - 100.0).abs() < 1e-9);
+    }
+}

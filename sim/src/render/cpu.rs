@@ -1,0 +1,282 @@
+//! The CPU reference renderer (rayon over image rows).
+//!
+//! The mirror half of each pixel's path does not depend on the robot's pose, so it is traced
+//! once per sensor in `f64` and kept; every frame then transforms the cached rays to the world
+//! and traces the scene in `f32` with the functions of [`super::trace`]. Primitives are binned
+//! per frame into azimuth sectors around the sensor's axis and sorted by distance, so a ray
+//! that meets the floor near the robot tests only the few primitives nearer than that; the
+//! binning is conservative, so the image is the same as tracing every primitive.
+
+use super::scene::Scene;
+use super::trace::{self, BLACK, Hit, V3};
+use crate::sensor::Sensor;
+use nalgebra::Isometry2;
+use rayon::prelude::*;
+
+/// The cached mirror half of one pixel, in the robot frame.
+#[derive(Debug, Clone, Copy)]
+struct PixelRay {
+    o: V3,
+    d: V3,
+    /// Azimuth of `d` in the robot frame.
+    azimuth: f32,
+    /// Horizontal length of `d`.
+    d_xy: f32,
+    valid: bool,
+}
+
+/// Per-sensor cache of pixel rays.
+#[derive(Debug, Clone)]
+pub struct SensorRays {
+    width: u32,
+    height: u32,
+    rays: Vec<PixelRay>,
+    axis: [f32; 2],
+    max_offset_mm: f32,
+}
+
+impl SensorRays {
+    /// Traces the mirror half of every pixel of `sensor`.
+    pub fn new(sensor: &Sensor) -> Self {
+        let (w, h) = (sensor.width_px, sensor.height_px);
+        let mut rays = Vec::with_capacity((w * h) as usize);
+        for v in 0..h {
+            for u in 0..w {
+                rays.push(match sensor.pixel_ray(u, v) {
+                    Some(r) => {
+                        let d = [r.dir.x as f32, r.dir.y as f32, r.dir.z as f32];
+                        PixelRay {
+                            o: [r.origin.x as f32, r.origin.y as f32, r.origin.z as f32],
+                            d,
+                            azimuth: d[1].atan2(d[0]),
+                            d_xy: (d[0] * d[0] + d[1] * d[1]).sqrt(),
+                            valid: true,
+                        }
+                    }
+                    None => PixelRay {
+                        o: [0.0; 3],
+                        d: [0.0; 3],
+                        azimuth: 0.0,
+                        d_xy: 0.0,
+                        valid: false,
+                    },
+                });
+            }
+        }
+        Self {
+            width: w,
+            height: h,
+            rays,
+            axis: [sensor.mount_mm[0] as f32, sensor.mount_mm[1] as f32],
+            max_offset_mm: sensor.optics.max_origin_offset_mm() as f32,
+        }
+    }
+}
+
+const SECTORS: usize = 256;
+
+#[derive(Debug, Clone, Copy)]
+enum Prim {
+    Box(u32),
+    Cylinder(u32),
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Item {
+    d_min: f32,
+    prim: Prim,
+}
+
+/// Primitives binned by azimuth around the sensor axis, each bin sorted by distance.
+struct Sectors {
+    offsets: Vec<u32>,
+    items: Vec<Item>,
+}
+
+fn wrap(a: f32) -> f32 {
+    let t = std::f32::consts::TAU;
+    a - (a / t).floor() * t
+}
+
+impl Sectors {
+    fn new(scene: &Scene, axis: [f32; 2], rho: f32) -> Self {
+        let mut bins: Vec<Vec<Item>> = vec![Vec::new(); SECTORS];
+        let mut add = |prim: Prim, d_min: f32, centre: f32, half: f32| {
+            let item = Item { d_min, prim };
+            if d_min <= 2.0 * rho + 1.0 || half >= std::f32::consts::PI {
+                bins.iter_mut().for_each(|b| b.push(item));
+                return;
+            }
+            let half = half + (rho / d_min).min(1.0).asin();
+            let width = std::f32::consts::TAU / SECTORS as f32;
+            let start = ((wrap(centre - half)) / width).floor() as i64;
+            let n = ((2.0 * half) / width).ceil() as i64 + 1;
+            for k in start..=start + n {
+                bins[k.rem_euclid(SECTORS as i64) as usize].push(item);
+            }
+        };
+        for (i, b) in scene.boxes.iter().enumerate() {
+            let [cx, cy, hx, hy] = b.geom;
+            let [c, s, _, _] = b.frame;
+            let rx = axis[0] - cx;
+            let ry = axis[1] - cy;
+            let lx = (c * rx + s * ry).abs() - hx;
+            let ly = (-s * rx + c * ry).abs() - hy;
+            let d_min = (lx.max(0.0).powi(2) + ly.max(0.0).powi(2)).sqrt();
+            if lx <= 0.0 && ly <= 0.0 {
+                add(Prim::Box(i as u32), 0.0, 0.0, std::f32::consts::PI);
+                continue;
+            }
+            let centre = (cy - axis[1]).atan2(cx - axis[0]);
+            let mut half: f32 = 0.0;
+            for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let px = cx + c * sx * hx - s * sy * hy - axis[0];
+                let py = cy + s * sx * hx + c * sy * hy - axis[1];
+                let mut da = py.atan2(px) - centre;
+                da -= (da / std::f32::consts::TAU).round() * std::f32::consts::TAU;
+                half = half.max(da.abs());
+            }
+            add(Prim::Box(i as u32), d_min, centre, half);
+        }
+        for (i, cyl) in scene.cylinders.iter().enumerate() {
+            let [cx, cy, r, _] = cyl.geom;
+            let dx = cx - axis[0];
+            let dy = cy - axis[1];
+            let dc = (dx * dx + dy * dy).sqrt();
+            if dc <= r {
+                add(Prim::Cylinder(i as u32), 0.0, 0.0, std::f32::consts::PI);
+                continue;
+            }
+            add(
+                Prim::Cylinder(i as u32),
+                dc - r,
+                dy.atan2(dx),
+                (r / dc).asin(),
+            );
+        }
+        let mut offsets = Vec::with_capacity(SECTORS + 1);
+        let mut items = Vec::new();
+        offsets.push(0);
+        for mut b in bins {
+            b.sort_by(|a, b| a.d_min.total_cmp(&b.d_min));
+            items.extend(b);
+            offsets.push(items.len() as u32);
+        }
+        Self { offsets, items }
+    }
+}
+
+/// Renders RGBA8 frames on the CPU.
+#[derive(Debug, Default)]
+pub struct CpuRenderer {}
+
+impl CpuRenderer {
+    /// A renderer.
+    pub fn new() -> Self {
+        Self {}
+    }
+
+    /// Renders one frame: `rays` of a sensor on a robot at `pose`, into packed RGBA8 pixels
+    /// (`pixels.len() == width * height`).
+    pub fn render(
+        &self,
+        scene: &Scene,
+        rays: &SensorRays,
+        pose: &Isometry2<f64>,
+        pixels: &mut [u32],
+    ) {
+        assert_eq!(pixels.len(), rays.rays.len());
+        let px = pose.translation.x as f32;
+        let py = pose.translation.y as f32;
+        let theta = pose.rotation.angle();
+        let c = theta.cos() as f32;
+        let s = theta.sin() as f32;
+        let axis = [
+            px + c * rays.axis[0] - s * rays.axis[1],
+            py + s * rays.axis[0] + c * rays.axis[1],
+        ];
+        let rho = rays.max_offset_mm;
+        let sectors = Sectors::new(scene, axis, rho);
+        let theta = theta as f32;
+        let scale = SECTORS as f32 / std::f32::consts::TAU;
+        pixels
+            .par_chunks_mut(rays.width as usize)
+            .zip(rays.rays.par_chunks(rays.width as usize))
+            .for_each(|(row, row_rays)| {
+                for (out, r) in row.iter_mut().zip(row_rays) {
+                    if !r.valid {
+                        *out = BLACK;
+                        continue;
+                    }
+                    let o = [
+                        px + c * r.o[0] - s * r.o[1],
+                        py + s * r.o[0] + c * r.o[1],
+                        r.o[2],
+                    ];
+                    let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
+                    let sector = ((wrap(r.azimuth + theta) * scale) as usize).min(SECTORS - 1);
+                    *out = trace_culled(scene, &sectors, sector, o, d, r.d_xy, rho);
+                }
+            });
+        let _ = rays.height;
+    }
+}
+
+fn trace_culled(
+    scene: &Scene,
+    sectors: &Sectors,
+    sector: usize,
+    o: V3,
+    d: V3,
+    d_xy: f32,
+    rho: f32,
+) -> u32 {
+    let mut best: Option<Hit> = trace::hit_floor(scene, o, d);
+    let mut t_max = best.map_or(f32::INFINITY, |h| h.t);
+    let range = sectors.offsets[sector] as usize..sectors.offsets[sector + 1] as usize;
+    for item in &sectors.items[range] {
+        if item.d_min >= t_max * d_xy + rho + 1.0 {
+            break;
+        }
+        let h = match item.prim {
+            Prim::Box(i) => trace::hit_box(scene, &scene.boxes[i as usize], o, d, t_max),
+            Prim::Cylinder(i) => trace::hit_cylinder(&scene.cylinders[i as usize], o, d, t_max),
+        };
+        if let Some(h) = h {
+            t_max = h.t;
+            best = Some(h);
+        }
+    }
+    match best {
+        Some(h) => trace::pack(trace::shade(scene, &h)),
+        None => trace::pack([
+            scene.globals.sky_rgb[0],
+            scene.globals.sky_rgb[1],
+            scene.globals.sky_rgb[2],
+        ]),
+    }
+}
+
+/// Renders every primitive for every pixel, without binning (the reference of the tests).
+pub fn render_reference(scene: &Scene, rays: &SensorRays, pose: &Isometry2<f64>) -> Vec<u32> {
+    let px = pose.translation.x as f32;
+    let py = pose.translation.y as f32;
+    let theta = pose.rotation.angle();
+    let c = theta.cos() as f32;
+    let s = theta.sin() as f32;
+    rays.rays
+        .iter()
+        .map(|r| {
+            if !r.valid {
+                return BLACK;
+            }
+            let o = [
+                px + c * r.o[0] - s * r.o[1],
+                py + s * r.o[0] + c * r.o[1],
+                r.o[2],
+            ];
+            let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
+            trace::trace_all(scene, o, d)
+        })
+        .collect()
+}

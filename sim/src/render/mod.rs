@@ -1,0 +1,159 @@
+//! Rendering the image a sensor sees: a wgpu compute tracer and a CPU reference that computes
+//! the same thing, chosen with `--renderer auto|gpu|cpu`.
+
+pub mod cpu;
+pub mod gpu;
+pub mod noise;
+pub mod scene;
+pub mod trace;
+
+pub use cpu::{CpuRenderer, SensorRays};
+pub use gpu::GpuRenderer;
+pub use noise::SensorNoise;
+pub use scene::Scene;
+
+use crate::sensor::Sensor;
+use image::RgbaImage;
+use nalgebra::Isometry2;
+use std::str::FromStr;
+
+/// Why rendering is not possible.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// No GPU adapter (hardware or software driver) was found.
+    #[error(
+        "no GPU adapter found ({0}); on Debian/Ubuntu install Mesa's software Vulkan driver with \
+         `sudo apt-get install mesa-vulkan-drivers libvulkan1`, or use --renderer cpu"
+    )]
+    NoAdapter(String),
+    /// The device failed.
+    #[error("GPU device error: {0}")]
+    Device(String),
+}
+
+/// Which renderer to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RendererChoice {
+    /// The GPU when an adapter exists, else the CPU.
+    #[default]
+    Auto,
+    /// The GPU (fails without an adapter).
+    Gpu,
+    /// The CPU reference.
+    Cpu,
+}
+
+impl FromStr for RendererChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Self::Auto),
+            "gpu" => Ok(Self::Gpu),
+            "cpu" => Ok(Self::Cpu),
+            other => Err(format!("unknown renderer {other:?} (auto, gpu, cpu)")),
+        }
+    }
+}
+
+enum Backend {
+    Cpu(CpuRenderer),
+    Gpu(Box<GpuRenderer>),
+}
+
+/// A renderer with its per-sensor caches.
+pub struct Renderer {
+    backend: Backend,
+    name: String,
+    rays: Vec<(Sensor, SensorRays)>,
+    pixels: Vec<u32>,
+}
+
+impl Renderer {
+    /// Opens the chosen renderer. With `Auto` and no adapter, falls back to the CPU and reports
+    /// why through `notice`.
+    pub fn new(choice: RendererChoice, notice: impl FnOnce(&str)) -> Result<Self, RenderError> {
+        let backend = match choice {
+            RendererChoice::Cpu => Backend::Cpu(CpuRenderer::new()),
+            RendererChoice::Gpu => Backend::Gpu(Box::new(GpuRenderer::new()?)),
+            RendererChoice::Auto => match GpuRenderer::new() {
+                Ok(g) => Backend::Gpu(Box::new(g)),
+                Err(e) => {
+                    notice(&format!("renderer: {e}; using the CPU renderer"));
+                    Backend::Cpu(CpuRenderer::new())
+                }
+            },
+        };
+        let name = match &backend {
+            Backend::Cpu(_) => format!("cpu (rayon, {} threads)", rayon::current_num_threads()),
+            Backend::Gpu(g) => g.adapter_name().to_string(),
+        };
+        Ok(Self {
+            backend,
+            name,
+            rays: Vec::new(),
+            pixels: Vec::new(),
+        })
+    }
+
+    /// The CPU renderer.
+    pub fn cpu() -> Self {
+        Self::new(RendererChoice::Cpu, |_| {}).expect("the CPU renderer always opens")
+    }
+
+    /// Name of the renderer: the adapter for the GPU, `cpu (...)` otherwise.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Whether frames are traced on a GPU adapter.
+    pub fn is_gpu(&self) -> bool {
+        matches!(self.backend, Backend::Gpu(_))
+    }
+
+    /// Renders the clean frame (no noise) as packed RGBA8 into the renderer's scratch buffer.
+    pub fn render_packed(
+        &mut self,
+        scene: &Scene,
+        sensor: &Sensor,
+        pose: &Isometry2<f64>,
+    ) -> Result<&[u32], RenderError> {
+        let n = (sensor.width_px * sensor.height_px) as usize;
+        self.pixels.resize(n, 0);
+        match &mut self.backend {
+            Backend::Gpu(g) => g.render(scene, sensor, pose, &mut self.pixels)?,
+            Backend::Cpu(c) => {
+                let k = match self.rays.iter().position(|(s, _)| s == sensor) {
+                    Some(k) => k,
+                    None => {
+                        self.rays.push((sensor.clone(), SensorRays::new(sensor)));
+                        self.rays.len() - 1
+                    }
+                };
+                c.render(scene, &self.rays[k].1, pose, &mut self.pixels);
+            }
+        }
+        Ok(&self.pixels)
+    }
+
+    /// Renders a frame with the sensor's noise drawn from `noise` (or none when `None`).
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        sensor: &Sensor,
+        pose: &Isometry2<f64>,
+        noise: Option<&mut SensorNoise>,
+    ) -> Result<RgbaImage, RenderError> {
+        let mut img = RgbaImage::new(sensor.width_px, sensor.height_px);
+        let sigma = sensor.noise_sigma as f32;
+        let pixels = self.render_packed(scene, sensor, pose)?;
+        match noise {
+            Some(n) => n.apply(pixels, sigma, &mut img),
+            None => {
+                for (p, out) in pixels.iter().zip(img.chunks_exact_mut(4)) {
+                    out.copy_from_slice(&p.to_le_bytes());
+                }
+            }
+        }
+        Ok(img)
+    }
+}

@@ -1,0 +1,212 @@
+//! The 3-D scene a sensor sees, as flat `f32` arrays laid out for the GPU: the floor (floor
+//! region rectangles, field lines), boxes (walls, cubes, boards), upright cylinders (pillars,
+//! robots, the observer's own body) and the light.
+//!
+//! Both tracers, the WGSL one and the CPU reference, read exactly these arrays.
+
+use crate::layout::{Layout, Rgb};
+use crate::shapes::{Solid, SolidShape};
+use bytemuck::{Pod, Zeroable};
+
+/// A box: footprint rectangle rotated about z, from `base` to `top` above the floor.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct BoxPrim {
+    /// centre x, centre y, half extent x, half extent y (mm).
+    pub geom: [f32; 4],
+    /// cos(angle), sin(angle), base height, top height.
+    pub frame: [f32; 4],
+    /// r, g, b (0..1), stripe board index or -1.
+    pub color: [f32; 4],
+}
+
+/// An upright cylinder standing on the floor.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct CylinderPrim {
+    /// centre x, centre y, radius, top height (mm).
+    pub geom: [f32; 4],
+    /// r, g, b (0..1), unused.
+    pub color: [f32; 4],
+}
+
+/// The stripes of a board: a range of `stripe_edges` and the two alternating colours.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct BoardPrim {
+    /// first edge index, edge count, unused, unused.
+    pub range: [u32; 4],
+    /// Colour of even stripes.
+    pub color_a: [f32; 4],
+    /// Colour of odd stripes.
+    pub color_b: [f32; 4],
+}
+
+/// A floor-region rectangle.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct FloorRectPrim {
+    /// centre x, centre y, half size x, half size y.
+    pub geom: [f32; 4],
+    /// cos(angle), sin(angle), unused, unused.
+    pub frame: [f32; 4],
+}
+
+/// Everything about the scene that is not a list.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct SceneGlobals {
+    /// Field: A1, B, line width, centre circle radius.
+    pub field: [f32; 4],
+    /// field present (0/1), any floor region (0/1), box count, cylinder count.
+    pub flags: [u32; 4],
+    /// floor rectangle count, board count, unused, unused.
+    pub counts: [u32; 4],
+    /// Floor region colour.
+    pub floor_rgb: [f32; 4],
+    /// Floor colour outside the region.
+    pub outside_rgb: [f32; 4],
+    /// Field line colour.
+    pub line_rgb: [f32; 4],
+    /// Colour of rays that hit nothing.
+    pub sky_rgb: [f32; 4],
+    /// Unit direction toward the light (x, y, z), ambient term.
+    pub light: [f32; 4],
+    /// Diffuse term, normalisation so the floor shows its own colour, unused, unused.
+    pub light2: [f32; 4],
+}
+
+/// The scene of one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// Scalars.
+    pub globals: SceneGlobals,
+    /// Boxes.
+    pub boxes: Vec<BoxPrim>,
+    /// Cylinders.
+    pub cylinders: Vec<CylinderPrim>,
+    /// Boards.
+    pub boards: Vec<BoardPrim>,
+    /// Stripe edges of all boards, as fractions of the board length.
+    pub stripe_edges: Vec<f32>,
+    /// Floor-region rectangles.
+    pub floor_rects: Vec<FloorRectPrim>,
+}
+
+fn rgb4(c: Rgb, w: f32) -> [f32; 4] {
+    let [r, g, b] = c.to_unit();
+    [r, g, b, w]
+}
+
+/// Ambient and diffuse weights of the light, and its direction (from the floor toward it).
+const AMBIENT: f32 = 0.45;
+const DIFFUSE: f32 = 0.55;
+const LIGHT_DIR: [f32; 3] = [0.35, 0.25, 0.9];
+const SKY_RGB: Rgb = Rgb([150, 160, 175]);
+
+impl Scene {
+    /// The scene of a layout with extra solids (robots, the observer's body).
+    pub fn new(layout: &Layout, extra: &[Solid]) -> Self {
+        let mut boxes = Vec::new();
+        let mut cylinders = Vec::new();
+        for s in layout.solids().iter().chain(extra) {
+            match s.shape {
+                SolidShape::Box {
+                    center_mm,
+                    half_extents_mm,
+                    angle_rad,
+                } => boxes.push(BoxPrim {
+                    geom: [
+                        center_mm.x as f32,
+                        center_mm.y as f32,
+                        half_extents_mm.x as f32,
+                        half_extents_mm.y as f32,
+                    ],
+                    frame: [
+                        angle_rad.cos() as f32,
+                        angle_rad.sin() as f32,
+                        s.base_mm as f32,
+                        s.height_mm as f32,
+                    ],
+                    color: rgb4(s.rgb, s.board.map_or(-1.0, |b| b as f32)),
+                }),
+                SolidShape::Cylinder {
+                    center_mm,
+                    radius_mm,
+                } => cylinders.push(CylinderPrim {
+                    geom: [
+                        center_mm.x as f32,
+                        center_mm.y as f32,
+                        radius_mm as f32,
+                        s.height_mm as f32,
+                    ],
+                    color: rgb4(s.rgb, 0.0),
+                }),
+            }
+        }
+        let mut boards = Vec::new();
+        let mut stripe_edges = Vec::new();
+        for b in &layout.boards {
+            let edges = b.stripe_edges();
+            boards.push(BoardPrim {
+                range: [stripe_edges.len() as u32, edges.len() as u32, 0, 0],
+                color_a: rgb4(b.rgb_a, 0.0),
+                color_b: rgb4(b.rgb_b, 0.0),
+            });
+            stripe_edges.extend(edges.iter().map(|&e| e as f32));
+        }
+        let floor_rects: Vec<FloorRectPrim> = layout
+            .all_floor_rects()
+            .iter()
+            .map(|r| {
+                let a = r.angle_deg.to_radians();
+                FloorRectPrim {
+                    geom: [
+                        r.center_mm[0] as f32,
+                        r.center_mm[1] as f32,
+                        (r.size_mm[0] / 2.0) as f32,
+                        (r.size_mm[1] / 2.0) as f32,
+                    ],
+                    frame: [a.cos() as f32, a.sin() as f32, 0.0, 0.0],
+                }
+            })
+            .collect();
+        let n = (LIGHT_DIR[0] * LIGHT_DIR[0]
+            + LIGHT_DIR[1] * LIGHT_DIR[1]
+            + LIGHT_DIR[2] * LIGHT_DIR[2])
+            .sqrt();
+        let l = [LIGHT_DIR[0] / n, LIGHT_DIR[1] / n, LIGHT_DIR[2] / n];
+        let field = layout.field.as_ref();
+        let globals = SceneGlobals {
+            field: field.map_or([0.0; 4], |f| {
+                [
+                    f.half_length_mm as f32,
+                    f.half_width_mm as f32,
+                    f.line_width_mm as f32,
+                    f.centre_circle_radius_mm as f32,
+                ]
+            }),
+            flags: [
+                field.is_some() as u32,
+                (!floor_rects.is_empty()) as u32,
+                boxes.len() as u32,
+                cylinders.len() as u32,
+            ],
+            counts: [floor_rects.len() as u32, boards.len() as u32, 0, 0],
+            floor_rgb: rgb4(layout.floor_rgb, 0.0),
+            outside_rgb: rgb4(layout.outside_rgb, 0.0),
+            line_rgb: rgb4(layout.line_rgb, 0.0),
+            sky_rgb: rgb4(SKY_RGB, 0.0),
+            light: [l[0], l[1], l[2], AMBIENT],
+            light2: [DIFFUSE, 1.0 / (AMBIENT + DIFFUSE * l[2]), 0.0, 0.0],
+        };
+        Self {
+            globals,
+            boxes,
+            cylinders,
+            boards,
+            stripe_edges,
+            floor_rects,
+        }
+    }
+}

@@ -1,0 +1,224 @@
+//! The scene half of the tracer in `f32`, written to match `trace.wgsl` operation for
+//! operation: floor colouring, box, cylinder and floor intersections, stripe lookup, shading
+//! and packing. The CPU renderer calls these; the GPU runs the WGSL twin.
+
+use super::scene::{BoxPrim, CylinderPrim, Scene};
+
+/// A 3-vector in `f32`.
+pub type V3 = [f32; 3];
+
+/// Hits closer than this (mm) are ignored (the ray's own surface).
+pub const T_EPS: f32 = 1e-3;
+
+fn dot(a: V3, b: V3) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// What a ray hit: distance, normal and colour (before shading).
+#[derive(Debug, Clone, Copy)]
+pub struct Hit {
+    /// Ray parameter.
+    pub t: f32,
+    /// Unit normal.
+    pub n: V3,
+    /// Surface colour.
+    pub rgb: V3,
+}
+
+/// Colour of the floor at `(x, y)`: floor region, field lines or outside.
+pub fn floor_color(s: &Scene, x: f32, y: f32) -> V3 {
+    let g = &s.globals;
+    let mut inside = g.flags[1] == 0;
+    for r in &s.floor_rects {
+        let dx = x - r.geom[0];
+        let dy = y - r.geom[1];
+        let lx = r.frame[0] * dx + r.frame[1] * dy;
+        let ly = -r.frame[1] * dx + r.frame[0] * dy;
+        if lx.abs() <= r.geom[2] && ly.abs() <= r.geom[3] {
+            inside = true;
+        }
+    }
+    if !inside {
+        return [g.outside_rgb[0], g.outside_rgb[1], g.outside_rgb[2]];
+    }
+    if g.flags[0] != 0 {
+        let ax = x.abs();
+        let ay = y.abs();
+        let [a1, b, w, cr] = g.field;
+        if ax <= a1 && ay <= b {
+            let boundary = ax >= a1 - w || ay >= b - w;
+            let centre = ax <= 0.5 * w;
+            let circle = ((x * x + y * y).sqrt() - cr).abs() <= 0.5 * w;
+            if boundary || centre || circle {
+                return [g.line_rgb[0], g.line_rgb[1], g.line_rgb[2]];
+            }
+        }
+    }
+    [g.floor_rgb[0], g.floor_rgb[1], g.floor_rgb[2]]
+}
+
+/// Slab interval of `o + t d` in `[lo, hi]`; `None` when parallel and outside.
+fn slab(o: f32, d: f32, lo: f32, hi: f32) -> Option<(f32, f32)> {
+    if d.abs() < 1e-12 {
+        if o < lo || o > hi {
+            return None;
+        }
+        return Some((f32::NEG_INFINITY, f32::INFINITY));
+    }
+    let inv = 1.0 / d;
+    let ta = (lo - o) * inv;
+    let tb = (hi - o) * inv;
+    Some((ta.min(tb), ta.max(tb)))
+}
+
+/// Entry of the ray into a box, if before `t_max`.
+pub fn hit_box(s: &Scene, b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
+    let [cx, cy, hx, hy] = b.geom;
+    let [c, sn, base, top] = b.frame;
+    let rx = o[0] - cx;
+    let ry = o[1] - cy;
+    let lox = c * rx + sn * ry;
+    let loy = -sn * rx + c * ry;
+    let ldx = c * d[0] + sn * d[1];
+    let ldy = -sn * d[0] + c * d[1];
+    let (x0, x1) = slab(lox, ldx, -hx, hx)?;
+    let (y0, y1) = slab(loy, ldy, -hy, hy)?;
+    let (z0, z1) = slab(o[2], d[2], base, top)?;
+    let tn = x0.max(y0).max(z0);
+    let tf = x1.min(y1).min(z1);
+    if tn > tf || tn <= T_EPS || tn >= t_max {
+        return None;
+    }
+    let n = if tn == x0 {
+        let nx = -ldx.signum();
+        [c * nx, sn * nx, 0.0]
+    } else if tn == y0 {
+        let ny = -ldy.signum();
+        [-sn * ny, c * ny, 0.0]
+    } else {
+        [0.0, 0.0, -d[2].signum()]
+    };
+    let mut rgb = [b.color[0], b.color[1], b.color[2]];
+    if b.color[3] >= 0.0 && tn != x0 {
+        let board = &s.boards[b.color[3] as usize];
+        let f = (lox + tn * ldx + hx) / (2.0 * hx);
+        let first = board.range[0] as usize;
+        let count = board.range[1] as usize;
+        let mut k = count.saturating_sub(1);
+        for i in 0..count {
+            if f <= s.stripe_edges[first + i] {
+                k = i;
+                break;
+            }
+        }
+        let col = if k.is_multiple_of(2) {
+            board.color_a
+        } else {
+            board.color_b
+        };
+        rgb = [col[0], col[1], col[2]];
+    }
+    Some(Hit { t: tn, n, rgb })
+}
+
+/// Entry of the ray into an upright cylinder (side or top), if before `t_max`.
+pub fn hit_cylinder(cy: &CylinderPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
+    let [cx, cyy, r, top] = cy.geom;
+    let mx = o[0] - cx;
+    let my = o[1] - cyy;
+    let mut best: Option<Hit> = None;
+    let mut t_lim = t_max;
+    let a = d[0] * d[0] + d[1] * d[1];
+    if a > 1e-12 {
+        let b = mx * d[0] + my * d[1];
+        let c = mx * mx + my * my - r * r;
+        let disc = b * b - a * c;
+        if disc >= 0.0 {
+            let t = (-b - disc.sqrt()) / a;
+            let z = o[2] + t * d[2];
+            if t > T_EPS && t < t_lim && z >= 0.0 && z <= top {
+                t_lim = t;
+                best = Some(Hit {
+                    t,
+                    n: [(mx + t * d[0]) / r, (my + t * d[1]) / r, 0.0],
+                    rgb: [cy.color[0], cy.color[1], cy.color[2]],
+                });
+            }
+        }
+    }
+    if d[2] < 0.0 && o[2] > top {
+        let t = (top - o[2]) / d[2];
+        let px = mx + t * d[0];
+        let py = my + t * d[1];
+        if t > T_EPS && t < t_lim && px * px + py * py <= r * r {
+            best = Some(Hit {
+                t,
+                n: [0.0, 0.0, 1.0],
+                rgb: [cy.color[0], cy.color[1], cy.color[2]],
+            });
+        }
+    }
+    best
+}
+
+/// The floor hit, if the ray goes down.
+pub fn hit_floor(s: &Scene, o: V3, d: V3) -> Option<Hit> {
+    if d[2] >= 0.0 {
+        return None;
+    }
+    let t = -o[2] / d[2];
+    if t <= T_EPS {
+        return None;
+    }
+    let x = o[0] + t * d[0];
+    let y = o[1] + t * d[1];
+    Some(Hit {
+        t,
+        n: [0.0, 0.0, 1.0],
+        rgb: floor_color(s, x, y),
+    })
+}
+
+/// Lambert shading normalised so that the floor shows its own colour.
+pub fn shade(s: &Scene, h: &Hit) -> V3 {
+    let g = &s.globals;
+    let l = [g.light[0], g.light[1], g.light[2]];
+    let k = (g.light[3] + g.light2[0] * dot(h.n, l).max(0.0)) * g.light2[1];
+    [h.rgb[0] * k, h.rgb[1] * k, h.rgb[2] * k]
+}
+
+/// Packs a colour into RGBA8 (alpha 255), rounding to the nearest level.
+pub fn pack(c: V3) -> u32 {
+    let q = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u32;
+    q(c[0]) | (q(c[1]) << 8) | (q(c[2]) << 16) | (255 << 24)
+}
+
+/// The colour of a world ray traced against every primitive (the reference the culled CPU
+/// path and the GPU must agree with).
+pub fn trace_all(s: &Scene, o: V3, d: V3) -> u32 {
+    let mut best = hit_floor(s, o, d);
+    let mut t_max = best.map_or(f32::INFINITY, |h| h.t);
+    for b in &s.boxes {
+        if let Some(h) = hit_box(s, b, o, d, t_max) {
+            t_max = h.t;
+            best = Some(h);
+        }
+    }
+    for c in &s.cylinders {
+        if let Some(h) = hit_cylinder(c, o, d, t_max) {
+            t_max = h.t;
+            best = Some(h);
+        }
+    }
+    match best {
+        Some(h) => pack(shade(s, &h)),
+        None => pack([
+            s.globals.sky_rgb[0],
+            s.globals.sky_rgb[1],
+            s.globals.sky_rgb[2],
+        ]),
+    }
+}
+
+/// The packed value of a pixel that sees no mirror.
+pub const BLACK: u32 = 255 << 24;

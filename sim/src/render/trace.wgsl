@@ -1,0 +1,295 @@
+// omniloop catadioptric tracer: one invocation per pixel.
+// camera ray -> mirror (hyperbolic, conical, spherical) or pinhole -> scene (floor, boxes,
+// cylinders, striped boards) -> Lambert shading -> packed RGBA8.
+// The scene half matches sim/src/render/trace.rs operation for operation.
+
+struct Globals {
+    field: vec4<f32>,       // A1, B, line width, centre circle radius
+    flags: vec4<u32>,       // field present, any floor region, box count, cylinder count
+    counts: vec4<u32>,      // floor rect count, board count
+    floor_rgb: vec4<f32>,
+    outside_rgb: vec4<f32>,
+    line_rgb: vec4<f32>,
+    sky_rgb: vec4<f32>,
+    light: vec4<f32>,       // direction xyz, ambient
+    light2: vec4<f32>,      // diffuse, normalisation
+};
+
+struct SensorParams {
+    size: vec4<u32>,        // width, height, kind, unused
+    intr: vec4<f32>,        // cx, cy, focal, unused
+    p0: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+    mount: vec4<f32>,       // axis offset on the robot x, y
+    pose: vec4<f32>,        // robot x, y, cos(theta), sin(theta)
+};
+
+struct BoxPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
+struct CylinderPrim { geom: vec4<f32>, color: vec4<f32> };
+struct BoardPrim { range: vec4<u32>, color_a: vec4<f32>, color_b: vec4<f32> };
+struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32> };
+
+@group(0) @binding(0) var<uniform> g: Globals;
+@group(0) @binding(1) var<uniform> sensor: SensorParams;
+@group(0) @binding(2) var<storage, read> boxes: array<BoxPrim>;
+@group(0) @binding(3) var<storage, read> cylinders: array<CylinderPrim>;
+@group(0) @binding(4) var<storage, read> boards: array<BoardPrim>;
+@group(0) @binding(5) var<storage, read> stripe_edges: array<f32>;
+@group(0) @binding(6) var<storage, read> floor_rects: array<FloorRectPrim>;
+@group(0) @binding(7) var<storage, read_write> pixels: array<u32>;
+
+const T_EPS: f32 = 1e-3;
+const BIG: f32 = 3.0e38;
+const BLACK: u32 = 0xff000000u;
+
+struct Ray { o: vec3<f32>, d: vec3<f32>, ok: bool };
+struct Hit { t: f32, n: vec3<f32>, rgb: vec3<f32>, ok: bool };
+
+fn no_hit() -> Hit { return Hit(BIG, vec3<f32>(0.0), vec3<f32>(0.0), false); }
+
+fn reflect_n(d: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return d - n * (2.0 * dot(d, n));
+}
+
+// Roots of a t^2 + b t + c = 0 in increasing order (x, y); z > 0 when real.
+fn quadratic(a: f32, b: f32, c: f32) -> vec3<f32> {
+    if (abs(a) < 1e-30) {
+        if (abs(b) < 1e-30) { return vec3<f32>(0.0, 0.0, -1.0); }
+        let t = -c / b;
+        return vec3<f32>(t, t, 1.0);
+    }
+    let disc = b * b - 4.0 * a * c;
+    if (disc < 0.0) { return vec3<f32>(0.0, 0.0, -1.0); }
+    var sb = 1.0;
+    if (b < 0.0) { sb = -1.0; }
+    let q = -0.5 * (b + sb * sqrt(disc));
+    var t0 = 0.0;
+    var t1 = 0.0;
+    if (q != 0.0) { t0 = q / a; t1 = c / q; }
+    return vec3<f32>(min(t0, t1), max(t0, t1), 1.0);
+}
+
+// The scene ray of image coordinates (x, y) in the robot frame (see sim/src/optics).
+fn scene_ray(x: f32, y: f32) -> Ray {
+    let kind = sensor.size.z;
+    let f = sensor.intr.z;
+    var fail = Ray(vec3<f32>(0.0), vec3<f32>(0.0), false);
+    if (kind == 3u) {
+        let dir = normalize(sensor.p0.xyz * f + sensor.p1.xyz * x + sensor.p2.xyz * y);
+        return Ray(vec3<f32>(0.0, 0.0, sensor.p0.w), dir, true);
+    }
+    let d = normalize(vec3<f32>(x, y, f));
+    if (kind == 0u) {
+        // Hyperboloid Z^2/b^2 - rho^2/a^2 = 1, camera at (0, 0, -c).
+        let a = sensor.p0.x;
+        let b = sensor.p0.y;
+        let c = sensor.p0.z;
+        let rho2 = d.x * d.x + d.y * d.y;
+        let roots = quadratic(d.z * d.z - rho2 * b * b / (a * a), -2.0 * c * d.z, c * c - b * b);
+        if (roots.z < 0.0) { return fail; }
+        var t = -1.0;
+        if (roots.x > 0.0 && -c + roots.x * d.z > 0.0) {
+            t = roots.x;
+        } else if (roots.y > 0.0 && -c + roots.y * d.z > 0.0) {
+            t = roots.y;
+        }
+        if (t <= 0.0) { return fail; }
+        let p = vec3<f32>(t * d.x, t * d.y, -c + t * d.z);
+        let rim = sensor.p1.x;
+        if (p.x * p.x + p.y * p.y > rim * rim) { return fail; }
+        let n = normalize(vec3<f32>(p.x / (a * a), p.y / (a * a), -p.z / (b * b)));
+        return Ray(vec3<f32>(p.x, p.y, p.z + sensor.p0.w), reflect_n(d, n), true);
+    }
+    if (kind == 1u) {
+        // Cone rho = (z - tip) k, tip above the pinhole.
+        let k = sensor.p0.x;
+        let tip = sensor.p0.y;
+        let rho_d = sqrt(d.x * d.x + d.y * d.y);
+        let den = k * d.z - rho_d;
+        if (den <= 0.0) { return fail; }
+        let t = k * tip / den;
+        let p = d * t;
+        let rho = rho_d * t;
+        if (rho > sensor.p0.z || rho < 1e-12) { return fail; }
+        let n = normalize(vec3<f32>(p.x / rho, p.y / rho, -k));
+        return Ray(vec3<f32>(p.x, p.y, p.z + sensor.p0.w), reflect_n(d, n), true);
+    }
+    // Sphere of radius p0.x centred p0.y above the pinhole.
+    let r = sensor.p0.x;
+    let centre = vec3<f32>(0.0, 0.0, sensor.p0.y);
+    let roots = quadratic(1.0, -2.0 * dot(d, centre), dot(centre, centre) - r * r);
+    if (roots.z < 0.0 || roots.x <= 0.0) { return fail; }
+    let p = d * roots.x;
+    let n = (p - centre) / r;
+    return Ray(vec3<f32>(p.x, p.y, p.z + sensor.p0.z), reflect_n(d, n), true);
+}
+
+fn floor_color(x: f32, y: f32) -> vec3<f32> {
+    var inside = g.flags.y == 0u;
+    for (var i = 0u; i < g.counts.x; i = i + 1u) {
+        let r = floor_rects[i];
+        let dx = x - r.geom.x;
+        let dy = y - r.geom.y;
+        let lx = r.frame.x * dx + r.frame.y * dy;
+        let ly = -r.frame.y * dx + r.frame.x * dy;
+        if (abs(lx) <= r.geom.z && abs(ly) <= r.geom.w) { inside = true; }
+    }
+    if (!inside) { return g.outside_rgb.xyz; }
+    if (g.flags.x != 0u) {
+        let ax = abs(x);
+        let ay = abs(y);
+        let a1 = g.field.x;
+        let b = g.field.y;
+        let w = g.field.z;
+        if (ax <= a1 && ay <= b) {
+            let boundary = ax >= a1 - w || ay >= b - w;
+            let centre = ax <= 0.5 * w;
+            let circle = abs(sqrt(x * x + y * y) - g.field.w) <= 0.5 * w;
+            if (boundary || centre || circle) { return g.line_rgb.xyz; }
+        }
+    }
+    return g.floor_rgb.xyz;
+}
+
+// Slab interval (x, y); z < 0 when parallel and outside.
+fn slab(o: f32, d: f32, lo: f32, hi: f32) -> vec3<f32> {
+    if (abs(d) < 1e-12) {
+        if (o < lo || o > hi) { return vec3<f32>(0.0, 0.0, -1.0); }
+        return vec3<f32>(-BIG, BIG, 1.0);
+    }
+    let inv = 1.0 / d;
+    let ta = (lo - o) * inv;
+    let tb = (hi - o) * inv;
+    return vec3<f32>(min(ta, tb), max(ta, tb), 1.0);
+}
+
+fn sgn(x: f32) -> f32 {
+    if (x > 0.0) { return 1.0; }
+    if (x < 0.0) { return -1.0; }
+    return 0.0;
+}
+
+fn hit_box(b: BoxPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
+    let c = b.frame.x;
+    let s = b.frame.y;
+    let hx = b.geom.z;
+    let hy = b.geom.w;
+    let rx = o.x - b.geom.x;
+    let ry = o.y - b.geom.y;
+    let lox = c * rx + s * ry;
+    let loy = -s * rx + c * ry;
+    let ldx = c * d.x + s * d.y;
+    let ldy = -s * d.x + c * d.y;
+    let sx = slab(lox, ldx, -hx, hx);
+    let sy = slab(loy, ldy, -hy, hy);
+    let sz = slab(o.z, d.z, b.frame.z, b.frame.w);
+    if (sx.z < 0.0 || sy.z < 0.0 || sz.z < 0.0) { return no_hit(); }
+    let tn = max(max(sx.x, sy.x), sz.x);
+    let tf = min(min(sx.y, sy.y), sz.y);
+    if (tn > tf || tn <= T_EPS || tn >= t_max) { return no_hit(); }
+    var n = vec3<f32>(0.0, 0.0, -sgn(d.z));
+    if (tn == sx.x) {
+        let nx = -sgn(ldx);
+        n = vec3<f32>(c * nx, s * nx, 0.0);
+    } else if (tn == sy.x) {
+        let ny = -sgn(ldy);
+        n = vec3<f32>(-s * ny, c * ny, 0.0);
+    }
+    var rgb = b.color.xyz;
+    if (b.color.w >= 0.0 && tn != sx.x) {
+        let board = boards[u32(b.color.w)];
+        let f = (lox + tn * ldx + hx) / (2.0 * hx);
+        let first = board.range.x;
+        let count = board.range.y;
+        var k = 0u;
+        if (count > 0u) { k = count - 1u; }
+        for (var i = 0u; i < count; i = i + 1u) {
+            if (f <= stripe_edges[first + i]) { k = i; break; }
+        }
+        if (k % 2u == 0u) { rgb = board.color_a.xyz; } else { rgb = board.color_b.xyz; }
+    }
+    return Hit(tn, n, rgb, true);
+}
+
+fn hit_cylinder(cy: CylinderPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
+    let r = cy.geom.z;
+    let top = cy.geom.w;
+    let mx = o.x - cy.geom.x;
+    let my = o.y - cy.geom.y;
+    var best = no_hit();
+    var t_lim = t_max;
+    let a = d.x * d.x + d.y * d.y;
+    if (a > 1e-12) {
+        let b = mx * d.x + my * d.y;
+        let c = mx * mx + my * my - r * r;
+        let disc = b * b - a * c;
+        if (disc >= 0.0) {
+            let t = (-b - sqrt(disc)) / a;
+            let z = o.z + t * d.z;
+            if (t > T_EPS && t < t_lim && z >= 0.0 && z <= top) {
+                t_lim = t;
+                best = Hit(t, vec3<f32>((mx + t * d.x) / r, (my + t * d.y) / r, 0.0), cy.color.xyz, true);
+            }
+        }
+    }
+    if (d.z < 0.0 && o.z > top) {
+        let t = (top - o.z) / d.z;
+        let px = mx + t * d.x;
+        let py = my + t * d.y;
+        if (t > T_EPS && t < t_lim && px * px + py * py <= r * r) {
+            best = Hit(t, vec3<f32>(0.0, 0.0, 1.0), cy.color.xyz, true);
+        }
+    }
+    return best;
+}
+
+fn pack(c: vec3<f32>) -> u32 {
+    let q = vec3<u32>(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
+    return q.x | (q.y << 8u) | (q.z << 16u) | (255u << 24u);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = sensor.size.x;
+    let h = sensor.size.y;
+    if (id.x >= w || id.y >= h) { return; }
+    let index = id.y * w + id.x;
+    let x = f32(id.x) + 0.5 - sensor.intr.x;
+    let y = sensor.intr.y - (f32(id.y) + 0.5);
+    let ray = scene_ray(x, y);
+    if (!ray.ok) {
+        pixels[index] = BLACK;
+        return;
+    }
+    // Robot frame -> world.
+    let c = sensor.pose.z;
+    let s = sensor.pose.w;
+    let ro = vec3<f32>(ray.o.x + sensor.mount.x, ray.o.y + sensor.mount.y, ray.o.z);
+    let o = vec3<f32>(sensor.pose.x + c * ro.x - s * ro.y, sensor.pose.y + s * ro.x + c * ro.y, ro.z);
+    let d = vec3<f32>(c * ray.d.x - s * ray.d.y, s * ray.d.x + c * ray.d.y, ray.d.z);
+
+    var best = no_hit();
+    var t_max = BIG;
+    if (d.z < 0.0) {
+        let t = -o.z / d.z;
+        if (t > T_EPS) {
+            best = Hit(t, vec3<f32>(0.0, 0.0, 1.0), floor_color(o.x + t * d.x, o.y + t * d.y), true);
+            t_max = t;
+        }
+    }
+    for (var i = 0u; i < g.flags.z; i = i + 1u) {
+        let hb = hit_box(boxes[i], o, d, t_max);
+        if (hb.ok) { best = hb; t_max = hb.t; }
+    }
+    for (var i = 0u; i < g.flags.w; i = i + 1u) {
+        let hc = hit_cylinder(cylinders[i], o, d, t_max);
+        if (hc.ok) { best = hc; t_max = hc.t; }
+    }
+    if (!best.ok) {
+        pixels[index] = pack(g.sky_rgb.xyz);
+        return;
+    }
+    let k = (g.light.w + g.light2.x * max(dot(best.n, g.light.xyz), 0.0)) * g.light2.y;
+    pixels[index] = pack(best.rgb * k);
+}

@@ -1,0 +1,41 @@
+//! Calibrating a mirror sensor: its traced image-to-floor map as the `vision` crate's
+//! [`RadialCalibration`], with the paper's closed form fitted for hyperbolic mirrors.
+
+use omniloop_sim::calibration::trace_radial_map;
+use omniloop_sim::optics::Optics;
+use omniloop_sim::{SensorSpec, SimError};
+use omniloop_vision::RadialCalibration;
+use omniloop_vision::calibration::fit_hyperbolic_form;
+
+/// Sample spacing of calibration tables, px.
+pub const CALIBRATION_STEP_PX: f64 = 0.25;
+
+/// Traces the radial map of `spec` and, for a hyperbolic mirror, fits
+/// `f(R) = R / (A - B sqrt(C + R^2))` to the samples below 95% of the horizon radius.
+pub fn calibrate_sensor(spec: &SensorSpec) -> Result<RadialCalibration, SimError> {
+    let sensor = spec.build()?;
+    let map = trace_radial_map(&sensor, CALIBRATION_STEP_PX)?;
+    let fit = match sensor.optics {
+        Optics::Hyperbolic(_) => {
+            let limit = 0.95 * map.horizon_px;
+            let pts: Vec<[f64; 2]> = map
+                .samples
+                .iter()
+                .copied()
+                .filter(|s| s[0] <= limit)
+                .collect();
+            fit_hyperbolic_form(&pts)
+        }
+        _ => None,
+    };
+    Ok(RadialCalibration {
+        sensor: sensor.name.clone(),
+        width_px: sensor.width_px,
+        height_px: sensor.height_px,
+        principal_point_px: [sensor.cx_px, sensor.cy_px],
+        mount_mm: sensor.mount_mm,
+        samples: map.samples,
+        horizon_px: map.horizon_px,
+        fit,
+    })
+}

@@ -1,0 +1,359 @@
+//! End-to-end checks of the catadioptric renderer: the hyperbolic mirror's image-to-floor map
+//! against the paper's f(R), the calibration fit, conical omnistereo range (eqs. (1)-(2) of
+//! Spacek and Burbridge), GPU/CPU agreement and golden images of the render examples.
+
+use nalgebra::{Isometry2, Vector2};
+use omniloop::calibrate::calibrate_sensor;
+use omniloop::load_scenario;
+use omniloop::runner::render_snapshot;
+use omniloop_sim::optics::HyperbolicMirror;
+use omniloop_sim::render::SensorRays;
+use omniloop_sim::{
+    FloorRect, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorSpec, Wall,
+};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn scenario(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenarios")
+        .join(name)
+}
+
+/// The paper's f(R) and its inverse.
+fn paper_f(r_px: f64) -> f64 {
+    r_px / (10.12 - 2.054e-2 * (2.298e5 + r_px * r_px).sqrt())
+}
+
+fn paper_f_inverse(r_mm: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, 113.0);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if paper_f(mid) < r_mm {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[test]
+fn every_pixel_of_the_corner_mirror_sees_the_floor_where_the_papers_f_says() {
+    // The renderer's own scene rays, pixel by pixel: the floor point a pixel at image radius R
+    // sees must image back, through the paper's f, within 0.5 px of R.
+    let sensor = SensorSpec::corner_paper("omni").build().unwrap();
+    let mut worst: f64 = 0.0;
+    let mut n = 0;
+    for v in 0..sensor.height_px {
+        for u in 0..sensor.width_px {
+            let (x, y) = sensor.image_coords(u, v);
+            let big_r = x.hypot(y);
+            if big_r > 105.0 {
+                continue;
+            }
+            let hit = sensor.pixel_ray(u, v).unwrap().floor_hit().unwrap();
+            let r = hit.coords.xy().norm();
+            worst = worst.max((paper_f_inverse(r) - big_r).abs());
+            n += 1;
+        }
+    }
+    assert!(n > 30_000);
+    assert!(worst < 0.5, "worst deviation {worst} px");
+    // The reconstruction is in fact exact up to the rounding of the paper's constants.
+    assert!(worst < 0.05, "worst deviation {worst} px");
+}
+
+#[test]
+fn rendered_floor_edges_lie_between_the_pixels_the_papers_f_puts_them() {
+    // Floor stripes (floor colour on a different colour) with edges at known distances ahead of
+    // the robot; along the image row through the principal point, each colour change between
+    // two neighbouring pixels must bracket f^-1(distance).
+    let edges: Vec<f64> = vec![
+        150.0, 230.0, 320.0, 450.0, 600.0, 800.0, 1000.0, 1300.0, 1600.0, 2000.0, 2300.0, 2550.0,
+    ];
+    let rects: Vec<FloorRect> = edges
+        .chunks(2)
+        .map(|p| FloorRect {
+            center_mm: [(p[0] + p[1]) / 2.0, 0.0],
+            size_mm: [p[1] - p[0], 400.0],
+            angle_deg: 0.0,
+        })
+        .collect();
+    let layout = Layout {
+        floor_rects: rects,
+        ..Layout::default()
+    };
+    let sensor = SensorSpec::corner_paper("omni").build().unwrap();
+    let scene = Scene::new(&layout, &[]);
+    let mut r = Renderer::cpu();
+    let pose = Isometry2::new(Vector2::zeros(), 0.0);
+    let img = r.render(&scene, &sensor, &pose, None).unwrap();
+    let row = 109; // pixel centres at Y = +0.5, next to the principal point
+    let green = layout.floor_rgb.0;
+    let is_floor = |u: u32| img.get_pixel(u, row).0[..3] == green;
+    let mut checked = 0;
+    for e in &edges {
+        let big_r = paper_f_inverse(*e);
+        assert!(big_r <= 105.0);
+        // Pixel u has its centre at X = u + 0.5 - 128.
+        let x = big_r;
+        let u0 = (x + 128.0 - 0.5).floor() as u32;
+        assert_ne!(
+            is_floor(u0),
+            is_floor(u0 + 1),
+            "edge at {e} mm (R = {big_r:.2} px) not between pixels {u0} and {}",
+            u0 + 1
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, edges.len());
+}
+
+#[test]
+fn calibrate_prints_the_papers_constants_within_one_percent() {
+    let out = Command::new(env!("CARGO_BIN_EXE_omniloop"))
+        .args(["calibrate", "--out"])
+        .arg(Path::new(env!("CARGO_TARGET_TMPDIR")).join("calibration_omni.json"))
+        .arg(scenario("render_hyperbolic.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let value = |key: &str| -> f64 {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(key))
+            .unwrap_or_else(|| panic!("no {key} in {text}"));
+        line[key.len()..].trim().parse().unwrap()
+    };
+    for (key, paper) in [("A=", 10.12), ("B=", 2.054e-2), ("C=", 2.298e5)] {
+        let v = value(key);
+        assert!(
+            (v / paper - 1.0).abs() < 0.01,
+            "{key} {v} vs {paper}\n{text}"
+        );
+    }
+    // The written table is what the vision crate reads.
+    let cal = omniloop_vision::RadialCalibration::load(
+        &Path::new(env!("CARGO_TARGET_TMPDIR")).join("calibration_omni.json"),
+    )
+    .unwrap();
+    let r = cal.floor_distance_mm(80.0).unwrap();
+    assert!((r - paper_f(80.0)).abs() < 0.01 * paper_f(80.0));
+}
+
+#[test]
+fn the_closed_form_of_the_reconstructed_mirror_is_the_papers() {
+    let spec = SensorSpec::corner_paper("omni");
+    let cal = calibrate_sensor(&spec).unwrap();
+    let fit = cal.fit.unwrap();
+    let (a, b, c) = HyperbolicMirror::corner_paper().closed_form_abc();
+    assert!((fit.a / a - 1.0).abs() < 1e-4 && (fit.b / b - 1.0).abs() < 1e-4);
+    assert!((fit.c / c - 1.0).abs() < 1e-3);
+}
+
+/// Two coaxial 90-degree cones of the E4 geometry: R = 30, d = 100, s = 150.
+fn cone(name: &str, lens_height_mm: f64) -> SensorSpec {
+    let text = format!(
+        "name = \"{name}\"\nwidth_px = 256\nheight_px = 256\nnoise_sigma = 0.0\n\
+         [conical]\napex_angle_deg = 90.0\nradius_mm = 30.0\ntip_distance_mm = 100.0\n\
+         focal_px = 520.0\nlens_height_mm = {lens_height_mm}\n"
+    );
+    toml::from_str(&text).unwrap()
+}
+
+/// Radius of the mirror rim and of the outermost pixel of the red pillar, along +x.
+fn measure(img: &image::RgbaImage) -> (f64, f64) {
+    let (cx, cy) = (128.0, 128.0);
+    let mut rim: f64 = 0.0;
+    let mut top: f64 = 0.0;
+    for (u, v, p) in img.enumerate_pixels() {
+        let x = u as f64 + 0.5 - cx;
+        let y = cy - (v as f64 + 0.5);
+        let r = x.hypot(y);
+        let [red, green, blue, _] = p.0;
+        if (red, green, blue) != (0, 0, 0) {
+            rim = rim.max(r);
+        }
+        if red > 100 && green < 40 && blue < 40 && x > 0.0 {
+            top = top.max(r);
+        }
+    }
+    (rim, top)
+}
+
+#[test]
+fn conical_omnistereo_range_follows_eqs_1_and_2() {
+    let lower = cone("lower", 100.0).build().unwrap();
+    let upper = cone("upper", 250.0).build().unwrap();
+    let (d, big_r, s) = (100.0, 30.0, 150.0);
+    let mut r = Renderer::cpu();
+    for range in [1000.0, 1500.0, 2000.0, 3000.0] {
+        let radius = 60.0;
+        // Tall enough that its top images near h1 = 100 px in the lower mirror, well inside
+        // the common region of both mirrors.
+        let top = 200.0 + 100.0 * (range + d) / 520.0;
+        let layout = Layout {
+            walls: vec![Wall {
+                from_mm: [6000.0, -6000.0],
+                to_mm: [6000.0, 6000.0],
+                thickness_mm: 100.0,
+                height_mm: 3000.0,
+                rgb: Rgb([120, 120, 120]),
+            }],
+            pillars: vec![Pillar {
+                center_mm: [range + radius, 0.0],
+                radius_mm: radius,
+                height_mm: top,
+                rgb: Rgb([230, 10, 10]),
+            }],
+            ..Layout::default()
+        };
+        let scene = Scene::new(&layout, &[]);
+        let pose = Isometry2::new(Vector2::zeros(), 0.0);
+        let (rim1, h1) = measure(&r.render(&scene, &lower, &pose, None).unwrap());
+        let (rim2, h2) = measure(&r.render(&scene, &upper, &pose, None).unwrap());
+        // Eq. (2): v = (d / R + 1) r_m, from the rim's radius in the image.
+        let r_m = 0.5 * (rim1 + rim2);
+        let v = (d / big_r + 1.0) * r_m;
+        assert!((v - 520.0).abs() < 0.01 * 520.0, "v = {v}");
+        // Eq. (1): r = v s / (h1 - h2) - d, the range to the pillar's near face.
+        let est = v * s / (h1 - h2) - d;
+        // One pixel of disparity error moves r by (r + d)^2 / (v s).
+        let one_px = (range + d) * (range + d) / (v * s);
+        eprintln!(
+            "range {range} mm: v = {v:.1} px, h1 = {h1:.2}, h2 = {h2:.2}, estimate {est:.1} mm \
+             (error {:.1}, one pixel of disparity = {one_px:.1} mm)",
+            est - range
+        );
+        assert!(
+            (est - range).abs() <= one_px,
+            "range {range}: estimated {est:.1} (h1 {h1:.2}, h2 {h2:.2}); one pixel = {one_px:.1} mm"
+        );
+    }
+}
+
+#[test]
+fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
+    for name in [
+        "render_hyperbolic.toml",
+        "render_conical.toml",
+        "render_spherical.toml",
+        "render_pinhole.toml",
+    ] {
+        let s = load_scenario(&scenario(name)).unwrap();
+        let world = omniloop_sim::World::new(&s.world, &s.robot_bodies(), 0.002).unwrap();
+        let scene = Scene::new(world.layout(), &world.robot_solids(None));
+        let pose = world.robot_state(0).pose;
+        for spec in &s.robot.sensors {
+            let sensor = spec.build().unwrap();
+            let mut r = Renderer::cpu();
+            let culled = r.render_packed(&scene, &sensor, &pose).unwrap().to_vec();
+            let rays = SensorRays::new(&sensor);
+            let reference = omniloop_sim::render::cpu::render_reference(&scene, &rays, &pose);
+            let diff = culled
+                .iter()
+                .zip(&reference)
+                .filter(|(a, b)| a != b)
+                .count();
+            assert_eq!(diff, 0, "{name}/{}", spec.name);
+        }
+    }
+}
+
+fn gpu_or_skip() -> Option<Renderer> {
+    match Renderer::new(RendererChoice::Gpu, |_| {}) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            if std::env::var_os("OMNILOOP_REQUIRE_GPU").is_some() {
+                panic!("OMNILOOP_REQUIRE_GPU is set but no adapter opened: {e}");
+            }
+            eprintln!("skipping the GPU comparison: {e}");
+            None
+        }
+    }
+}
+
+#[test]
+fn gpu_and_cpu_renders_agree() {
+    let Some(mut gpu) = gpu_or_skip() else {
+        return;
+    };
+    let mut cpu = Renderer::cpu();
+    for name in [
+        "render_hyperbolic.toml",
+        "render_conical.toml",
+        "render_spherical.toml",
+        "render_pinhole.toml",
+    ] {
+        let s = load_scenario(&scenario(name)).unwrap();
+        for spec in &s.robot.sensors {
+            // Noise on: both draw it from the same seeded generator.
+            let a = render_snapshot(&s, &mut cpu, Some(&spec.name), None, true).unwrap();
+            let b = render_snapshot(&s, &mut gpu, Some(&spec.name), None, true).unwrap();
+            let total = (a.width() * a.height()) as usize;
+            let close = a
+                .pixels()
+                .zip(b.pixels())
+                .filter(|(p, q)| (0..3).all(|c| (p.0[c] as i32 - q.0[c] as i32).abs() <= 2))
+                .count();
+            let frac = close as f64 / total as f64;
+            eprintln!(
+                "{name}/{}: {:.4}% of pixels within 2 levels ({})",
+                spec.name,
+                100.0 * frac,
+                gpu.name()
+            );
+            assert!(
+                frac >= 0.999,
+                "{name}/{}: only {:.3}% within 2 levels",
+                spec.name,
+                100.0 * frac
+            );
+        }
+    }
+}
+
+/// Golden images: the CPU render (no noise) of each render example. A render passes when at
+/// most 0.5% of its pixels differ from the golden image by more than 2 levels in some channel
+/// (room for floating-point differences between machines; a wrong mirror, pose or scene changes
+/// far more). `OMNILOOP_BLESS=1 cargo test --test renderer golden` rewrites them.
+#[test]
+fn golden_images_of_the_render_examples() {
+    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
+    let bless = std::env::var_os("OMNILOOP_BLESS").is_some();
+    let mut cpu = Renderer::cpu();
+    for name in [
+        "render_hyperbolic",
+        "render_conical",
+        "render_spherical",
+        "render_pinhole",
+    ] {
+        let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
+        let img = render_snapshot(&s, &mut cpu, None, None, false).unwrap();
+        let path = golden_dir.join(format!("{name}.png"));
+        if bless {
+            img.save(&path).unwrap();
+            continue;
+        }
+        let golden = image::open(&path)
+            .unwrap_or_else(|e| panic!("{}: {e} (OMNILOOP_BLESS=1 writes it)", path.display()))
+            .to_rgba8();
+        assert_eq!(golden.dimensions(), img.dimensions(), "{name}");
+        let off = img
+            .pixels()
+            .zip(golden.pixels())
+            .filter(|(p, q)| (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 2))
+            .count();
+        let total = (img.width() * img.height()) as usize;
+        assert!(
+            off * 200 <= total,
+            "{name}: {off} of {total} pixels differ from the golden image by more than 2 levels"
+        );
+    }
+}
