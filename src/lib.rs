@@ -8,8 +8,10 @@
 
 pub mod calibrate;
 pub mod load;
+pub mod metrics;
 pub mod output;
 pub mod record;
+pub mod replay;
 pub mod runner;
 pub mod scenario;
 pub mod topview;

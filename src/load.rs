@@ -96,6 +96,16 @@ pub fn parse_scenario(text: &str, file: &Path, default_name: &str) -> Result<Sce
     if scenario.name.is_empty() {
         scenario.name = default_name.to_string();
     }
+    // Paths in a scenario are relative to its file.
+    if let Some(f) = scenario
+        .vision
+        .calibration_file
+        .as_ref()
+        .filter(|f| f.is_relative())
+    {
+        let dir = file.parent().unwrap_or(Path::new(""));
+        scenario.vision.calibration_file = Some(dir.join(f));
+    }
     let violations = validate(&scenario);
     if violations.is_empty() {
         return Ok(scenario);

@@ -6,6 +6,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::{Isometry2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
 use omniloop::output::{default_out_dir, write_run};
+use omniloop::replay::{EXPERIMENTS, corner_table, replay_corner55};
 use omniloop::runner::{RunOptions, render_snapshot};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice};
@@ -75,6 +76,23 @@ enum Command {
         /// Leave out the sensor noise.
         #[arg(long)]
         no_noise: bool,
+    },
+    /// Replay an experiment of the papers: `corner55` (E1, Fig. 7).
+    Replay {
+        /// The experiment.
+        experiment: String,
+        /// Output folder (default: runs/<experiment>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Seed overriding the scenarios'.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Renderer for the sensors' images: auto, gpu or cpu.
+        #[arg(long, default_value = "auto")]
+        renderer: RendererChoice,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate.
     Calibrate {
@@ -233,6 +251,45 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 r.name(),
                 out.display()
             );
+            Ok(())
+        }
+        Command::Replay {
+            experiment,
+            out,
+            seed,
+            renderer,
+            quiet,
+        } => {
+            if experiment != "corner55" {
+                let known: Vec<String> = EXPERIMENTS
+                    .iter()
+                    .map(|(n, d)| format!("  {n}: {d}"))
+                    .collect();
+                bail!(
+                    "unknown experiment {experiment:?}; known:\n{}",
+                    known.join("\n")
+                );
+            }
+            let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&experiment));
+            let options = RunOptions {
+                renderer,
+                ..RunOptions::default()
+            };
+            let bar = progress_bar(0, quiet);
+            let runs = replay_corner55(
+                &dir,
+                &options,
+                seed,
+                |name, k, n| {
+                    bar.set_length(n);
+                    bar.set_prefix(name.to_string());
+                    bar.set_position(k);
+                },
+                &mut |msg| eprintln!("{msg}"),
+            )?;
+            bar.finish_and_clear();
+            print!("{}", corner_table(&runs));
+            println!("\nwritten to {}", dir.display());
             Ok(())
         }
         Command::Calibrate {

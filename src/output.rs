@@ -42,18 +42,14 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
         .iter()
         .filter_map(|r| Some(Point2::new(r.est_x_mm?, r.est_y_mm?)))
         .collect();
-    let mut layers = vec![PathLayer {
-        label: "true path".into(),
-        rgb: [220, 30, 30],
-        points: &truth,
-        dots: false,
-    }];
+    let mut layers = Vec::new();
     if !estimate.is_empty() {
         layers.push(PathLayer {
             label: "estimated".into(),
             rgb: [30, 80, 230],
             points: &estimate,
             dots: true,
+            discs: None,
         });
     }
     for (k, p) in out.other_paths.iter().enumerate() {
@@ -62,8 +58,16 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
             rgb: [200, 40, 160],
             points: p,
             dots: false,
+            discs: None,
         });
     }
+    layers.push(PathLayer {
+        label: "true path".into(),
+        rgb: [220, 30, 30],
+        points: &truth,
+        dots: false,
+        discs: None,
+    });
     let mut markers = vec![Marker {
         at: scenario.robot.start.point(),
         radius_mm: scenario.robot.radius_mm,

@@ -91,4 +91,14 @@ pub struct Summary {
     pub path_length_mm: f64,
     /// The renderer that traced the sensors' images (adapter name or `cpu (...)`), if any.
     pub renderer: Option<String>,
+    /// E1: `(K - p).u1` where the robot starts giving up speed along the first leg.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub turn_onset_mm: Option<f64>,
+    /// E1: how far past the corner point the robot centre went along the first leg.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub overshoot_mm: Option<f64>,
+    /// Median over the run of |detected free distance - true free distance| over all directions
+    /// (truth ray-cast in the world, clipped at the template's range).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub freespace_error_mm: Option<f64>,
 }

@@ -1,12 +1,20 @@
 //! The closed loop: sense, decide, act, record, once a control period.
 
+use crate::metrics::{corner_metrics, median};
 use crate::record::{Summary, TrajectoryRow};
 use crate::scenario::{ControllerKind, Scenario, controller_name};
-use nalgebra::Point2;
-use omniloop_control::{AccelLimitedDrive, GoToGoal, VelocityCommand};
+use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
+use omniloop_control::{
+    AccelLimitedDrive, DeadReckoning, GoToGoal, GoalDirection, Surroundings, VelocityAware,
+    VelocityCommand,
+};
 use omniloop_sim::{
     RenderError, Renderer, RendererChoice, Scene, Sensor, SensorNoise, SimError, World,
 };
+use omniloop_vision::{FreeSpace, FreeSpaceDetector, RadialCalibration, VisionError};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use rand_distr::StandardNormal;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -22,6 +30,9 @@ pub enum RunError {
     /// The renderer could not open or render.
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// Vision could not be set up.
+    #[error("vision: {0}")]
+    Vision(#[from] VisionError),
     /// A frame could not be written.
     #[error("writing frame {path}: {source}")]
     Frame {
@@ -73,18 +84,76 @@ pub struct RunOutput {
     pub other_paths: Vec<Vec<Point2<f64>>>,
 }
 
+/// What chooses the robot's command.
+enum Brain {
+    Idle,
+    Truth(GoToGoal),
+    GoalDirection(GoalDirection),
+    VelocityAware(VelocityAware),
+}
+
+/// Free-space detection on one sensor's images.
+struct Vision {
+    sensor: usize,
+    detector: FreeSpaceDetector,
+    range_mm: f64,
+    mount_mm: [f64; 2],
+}
+
+/// Wheel odometry: the true body velocity with seeded errors, dead-reckoned.
+struct Odometry {
+    reckoning: DeadReckoning,
+    rng: StdRng,
+    speed_noise_frac: f64,
+    omega_noise_rad_s: f64,
+    start: Isometry2<f64>,
+}
+
+impl Odometry {
+    fn measure(&mut self, v_world: Vector2<f64>, heading: f64, omega: f64, dt: f64) {
+        let v_body = Rotation2::new(-heading) * v_world;
+        let mut n = || self.rng.sample::<f64, _>(StandardNormal);
+        let noisy = Vector2::new(
+            v_body.x * (1.0 + self.speed_noise_frac * n()),
+            v_body.y * (1.0 + self.speed_noise_frac * n()),
+        );
+        let w = omega + self.omega_noise_rad_s * n();
+        self.reckoning.update(noisy, w, dt);
+    }
+
+    /// The dead-reckoned pose in the world frame.
+    fn world_pose(&self) -> Isometry2<f64> {
+        self.start * self.reckoning.pose()
+    }
+}
+
 /// A scenario being run, one control cycle at a time.
 pub struct Simulation {
     scenario: Scenario,
     world: World,
-    goal_controller: Option<GoToGoal>,
+    brain: Brain,
+    vision: Option<Vision>,
+    odometry: Odometry,
+    goal_start: Option<Vector2<f64>>,
     movers: Vec<Mover>,
     cycle: u64,
     time_to_goal_s: Option<f64>,
     trajectory: Vec<TrajectoryRow>,
     other_paths: Vec<Vec<Point2<f64>>>,
+    freespace_errors_mm: Vec<f64>,
     eyes: Option<Eyes>,
     options: RunOptions,
+    last_freespace: Option<FreeSpace>,
+}
+
+/// The calibration vision uses: the scenario's file, or the sensor's traced map.
+fn vision_calibration(scenario: &Scenario, index: usize) -> Result<RadialCalibration, RunError> {
+    match &scenario.vision.calibration_file {
+        Some(path) => Ok(RadialCalibration::load(path)?),
+        None => Ok(crate::calibrate::calibrate_sensor(
+            &scenario.robot.sensors[index],
+        )?),
+    }
 }
 
 impl Simulation {
@@ -102,9 +171,41 @@ impl Simulation {
         )?;
         let r = &scenario.robot;
         let drive = AccelLimitedDrive::new(r.accel_limit_mm_s2, r.angular_accel_limit_rad_s2)?;
-        let goal_controller = match scenario.control.kind {
-            ControllerKind::GoToGoalTruth => Some(GoToGoal::new(r.max_speed_mm_s, drive)?),
-            ControllerKind::Idle => None,
+        let avoid = scenario.control.avoidance.clone();
+        let brain = match scenario.control.kind {
+            ControllerKind::Idle => Brain::Idle,
+            ControllerKind::GoToGoalTruth => Brain::Truth(GoToGoal::new(r.max_speed_mm_s, drive)?),
+            ControllerKind::GoalDirection => Brain::GoalDirection(GoalDirection::new(
+                avoid,
+                drive,
+                r.max_speed_mm_s,
+                r.radius_mm,
+            )?),
+            ControllerKind::VelocityAware => Brain::VelocityAware(VelocityAware::new(
+                avoid,
+                drive,
+                r.max_speed_mm_s,
+                r.radius_mm,
+                scenario.run.control_period_s,
+            )?),
+        };
+        let vision = if scenario.control.kind.uses_vision() {
+            let index = match &scenario.vision.sensor {
+                Some(n) => r.sensors.iter().position(|s| &s.name == n),
+                None => (!r.sensors.is_empty()).then_some(0),
+            }
+            .ok_or_else(|| SimError::Invalid("vision needs a sensor".into()))?;
+            let cal = vision_calibration(scenario, index)?;
+            let detector = FreeSpaceDetector::new(scenario.vision.freespace.clone(), &cal)?;
+            let range_mm = *detector.template().edges_mm().last().expect("edges");
+            Some(Vision {
+                sensor: index,
+                detector,
+                range_mm,
+                mount_mm: cal.mount_mm,
+            })
+        } else {
+            None
         };
         let mut movers = Vec::new();
         for o in &scenario.other_robots {
@@ -120,8 +221,8 @@ impl Simulation {
                 controller: GoToGoal::new(o.max_speed_mm_s, drive)?,
             });
         }
-        let needs_images =
-            !scenario.robot.sensors.is_empty() && options.save_frames_every.is_some();
+        let needs_images = !scenario.robot.sensors.is_empty()
+            && (vision.is_some() || options.save_frames_every.is_some());
         let eyes = if needs_images {
             let renderer = Renderer::new(options.renderer, notice)?;
             let mut sensors = Vec::new();
@@ -135,17 +236,33 @@ impl Simulation {
         } else {
             None
         };
+        let start = scenario.robot.start.isometry();
+        let goal_start = scenario
+            .goal
+            .as_ref()
+            .map(|g| start.inverse_transform_point(&g.point()).coords);
         Ok(Self {
             scenario: scenario.clone(),
+            brain,
+            vision,
+            odometry: Odometry {
+                reckoning: DeadReckoning::new(),
+                rng: StdRng::seed_from_u64(scenario.seed ^ 0x0D0_3E7E_u64),
+                speed_noise_frac: scenario.odometry.speed_noise_frac,
+                omega_noise_rad_s: scenario.odometry.omega_noise_rad_s,
+                start,
+            },
+            goal_start,
             eyes,
             options: options.clone(),
             world,
-            goal_controller,
             other_paths: vec![Vec::new(); movers.len()],
             movers,
             cycle: 0,
             time_to_goal_s: None,
             trajectory: Vec::new(),
+            freespace_errors_mm: Vec::new(),
+            last_freespace: None,
         })
     }
 
@@ -157,6 +274,11 @@ impl Simulation {
     /// Control cycles run so far.
     pub fn cycle(&self) -> u64 {
         self.cycle
+    }
+
+    /// The free space detected in the last cycle, if the controller uses vision.
+    pub fn last_freespace(&self) -> Option<&FreeSpace> {
+        self.last_freespace.as_ref()
     }
 
     /// Whether the run is over: time is up, or the goal is reached and the run stops there.
@@ -203,18 +325,75 @@ impl Simulation {
         Ok(())
     }
 
+    /// Compares the detected free distances with the world's, direction by direction (truth
+    /// clipped at the template's range).
+    fn score_freespace(&mut self, fs: &FreeSpace, range_mm: f64, mount: [f64; 2]) {
+        let pose = self.world.robot_state(0).pose;
+        let axis = pose * Point2::new(mount[0], mount[1]);
+        let heading = pose.rotation.angle();
+        for (a, free) in fs.direction_rad.iter().zip(&fs.free_mm) {
+            let dir = Vector2::new((heading + a).cos(), (heading + a).sin());
+            let truth = self
+                .world
+                .ray_cast_mm(axis, dir, range_mm, Some(0))
+                .unwrap_or(range_mm);
+            self.freespace_errors_mm.push((free - truth).abs());
+        }
+    }
+
     /// One control cycle: observe, choose commands, record, advance the world one period.
     pub fn step(&mut self) -> Result<(), RunError> {
         let frames = self.sense()?;
         self.save_frames(&frames)?;
         let t = self.world.time_s();
         let state = self.world.robot_state(0);
-        let position = Point2::from(state.pose.translation.vector);
-        let command = match (&self.goal_controller, &self.scenario.goal) {
-            (Some(c), Some(g)) => c.command(position.coords, g.point().coords),
+        let heading = state.pose.rotation.angle();
+
+        let freespace = match &mut self.vision {
+            Some(v) => {
+                let fs = v.detector.detect(&frames[v.sensor])?;
+                Some((fs, v.range_mm, v.mount_mm))
+            }
+            None => None,
+        };
+        if let Some((fs, range, mount)) = &freespace {
+            self.score_freespace(fs, *range, *mount);
+        }
+
+        let goal_body = self.goal_start.map(|g| self.odometry.reckoning.to_body(g));
+        let v_body = self.odometry.reckoning.velocity_body_mm_s();
+        let body_command =
+            |v: Vector2<f64>| VelocityCommand::translate(Rotation2::new(heading) * v);
+        let command = match (&self.brain, &freespace, goal_body) {
+            (Brain::Truth(c), _, _) => match &self.scenario.goal {
+                Some(g) => c.command(state.pose.translation.vector, g.point().coords),
+                None => VelocityCommand::STOP,
+            },
+            (Brain::GoalDirection(c), Some((fs, range, _)), Some(goal)) => {
+                let pts: Vec<Vector2<f64>> = fs.obstacle_points.iter().map(|p| p.coords).collect();
+                let s = Surroundings {
+                    direction_rad: &fs.direction_rad,
+                    free_mm: &fs.free_mm,
+                    range_mm: *range,
+                    obstacle_points: &pts,
+                };
+                body_command(c.decide(&s, goal).v_mm_s)
+            }
+            (Brain::VelocityAware(c), Some((fs, range, _)), Some(goal)) => {
+                let pts: Vec<Vector2<f64>> = fs.obstacle_points.iter().map(|p| p.coords).collect();
+                let s = Surroundings {
+                    direction_rad: &fs.direction_rad,
+                    free_mm: &fs.free_mm,
+                    range_mm: *range,
+                    obstacle_points: &pts,
+                };
+                body_command(c.decide(&s, goal, v_body).v_mm_s)
+            }
             _ => VelocityCommand::STOP,
         };
         self.world.set_command(0, command);
+        self.last_freespace = freespace.map(|(fs, _, _)| fs);
+
         for (k, m) in self.movers.iter_mut().enumerate() {
             let p = Point2::from(self.world.robot_state(k + 1).pose.translation.vector);
             self.other_paths[k].push(p);
@@ -230,23 +409,21 @@ impl Simulation {
             };
             self.world.set_command(k + 1, cmd);
         }
-        self.trajectory.push(TrajectoryRow {
-            t_s: t,
-            x_mm: state.pose.translation.x,
-            y_mm: state.pose.translation.y,
-            theta_rad: state.pose.rotation.angle(),
-            vx_mm_s: state.velocity_mm_s.x,
-            vy_mm_s: state.velocity_mm_s.y,
-            cmd_vx_mm_s: command.v_mm_s.x,
-            cmd_vy_mm_s: command.v_mm_s.y,
-            est_x_mm: None,
-            est_y_mm: None,
-            est_theta_rad: None,
-        });
-        self.world.advance(self.scenario.run.control_period_s);
+        let row = self.row(t, command);
+        self.trajectory.push(row);
+
+        let dt = self.scenario.run.control_period_s;
+        self.world.advance(dt);
         self.cycle += 1;
+        let after = self.world.robot_state(0);
+        self.odometry.measure(
+            after.velocity_mm_s,
+            after.pose.rotation.angle(),
+            after.omega_rad_s,
+            dt,
+        );
         if let (None, Some(g)) = (self.time_to_goal_s, &self.scenario.goal) {
-            let p = self.world.robot_state(0).pose.translation.vector;
+            let p = after.pose.translation.vector;
             if (p - g.point().coords).norm() <= g.tolerance_mm {
                 self.time_to_goal_s = Some(self.world.time_s());
             }
@@ -254,30 +431,49 @@ impl Simulation {
         Ok(())
     }
 
-    /// Ends the run: the summary and everything recorded.
-    pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
-        // The final state closes the trajectory.
+    /// The trajectory row of the current state with `command`.
+    fn row(&self, t: f64, command: VelocityCommand) -> TrajectoryRow {
         let s = self.world.robot_state(0);
-        let last_cmd = self.world.command(0);
-        self.trajectory.push(TrajectoryRow {
-            t_s: self.world.time_s(),
+        let est = self
+            .scenario
+            .control
+            .kind
+            .uses_vision()
+            .then(|| self.odometry.world_pose());
+        TrajectoryRow {
+            t_s: t,
             x_mm: s.pose.translation.x,
             y_mm: s.pose.translation.y,
             theta_rad: s.pose.rotation.angle(),
             vx_mm_s: s.velocity_mm_s.x,
             vy_mm_s: s.velocity_mm_s.y,
-            cmd_vx_mm_s: last_cmd.v_mm_s.x,
-            cmd_vy_mm_s: last_cmd.v_mm_s.y,
-            est_x_mm: None,
-            est_y_mm: None,
-            est_theta_rad: None,
-        });
+            cmd_vx_mm_s: command.v_mm_s.x,
+            cmd_vy_mm_s: command.v_mm_s.y,
+            est_x_mm: est.map(|e| e.translation.x),
+            est_y_mm: est.map(|e| e.translation.y),
+            est_theta_rad: est.map(|e| e.rotation.angle()),
+        }
+    }
+
+    /// Ends the run: the summary and everything recorded.
+    pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
+        // The final state closes the trajectory.
+        let last = self.row(self.world.time_s(), self.world.command(0));
+        self.trajectory.push(last);
         for (k, path) in self.other_paths.iter_mut().enumerate() {
             path.push(Point2::from(
                 self.world.robot_state(k + 1).pose.translation.vector,
             ));
         }
         let stats = self.world.stats(0);
+        let corner = self.scenario.metrics.corner.as_ref().map(|c| {
+            let a = c.leg1_heading_deg.to_radians();
+            corner_metrics(
+                &self.trajectory,
+                Vector2::from(c.k_mm),
+                Vector2::new(a.cos(), a.sin()),
+            )
+        });
         let summary = Summary {
             scenario: self.scenario.name.clone(),
             seed: self.scenario.seed,
@@ -298,6 +494,9 @@ impl Simulation {
             min_clearance_mm: stats.min_clearance_mm,
             path_length_mm: stats.path_length_mm,
             renderer: self.eyes.as_ref().map(|e| e.renderer.name().to_string()),
+            turn_onset_mm: corner.and_then(|c| c.turn_onset_mm),
+            overshoot_mm: corner.map(|c| c.overshoot_mm),
+            freespace_error_mm: median(&self.freespace_errors_mm),
         };
         RunOutput {
             summary,

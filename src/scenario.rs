@@ -4,8 +4,11 @@
 //! and column, and the dotted path of the field ([`crate::scenario_error`]).
 
 use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_control::AvoidanceConfig;
 use omniloop_sim::{Layout, Rgb, SensorSpec};
+use omniloop_vision::FreeSpaceConfig;
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// A complete scenario: the world, the robot, what it should do and for how long.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -34,9 +37,18 @@ pub struct Scenario {
     /// Where the robot should go, if anywhere.
     #[serde(default)]
     pub goal: Option<GoalSpec>,
+    /// Image processing.
+    #[serde(default)]
+    pub vision: VisionSpec,
     /// How the robot chooses its velocity.
     #[serde(default)]
     pub control: ControlSpec,
+    /// The robot's wheel odometry.
+    #[serde(default)]
+    pub odometry: OdometrySpec,
+    /// Experiment metrics to compute.
+    #[serde(default)]
+    pub metrics: MetricsSpec,
 }
 
 fn default_seed() -> u64 {
@@ -213,6 +225,18 @@ pub enum ControllerKind {
     /// Straight to the goal on the true pose (a reference that needs no vision).
     #[default]
     GoToGoalTruth,
+    /// Free direction closest to the goal direction, from the image (ref. [4] of the corner
+    /// paper); goal dead-reckoned from odometry.
+    GoalDirection,
+    /// Velocity-aware avoidance of Sect. 3.2, from the image; goal dead-reckoned.
+    VelocityAware,
+}
+
+impl ControllerKind {
+    /// Whether the controller needs the free-space detection.
+    pub fn uses_vision(self) -> bool {
+        matches!(self, Self::GoalDirection | Self::VelocityAware)
+    }
 }
 
 /// How the robot chooses its velocity.
@@ -221,6 +245,58 @@ pub enum ControllerKind {
 pub struct ControlSpec {
     /// The controller.
     pub kind: ControllerKind,
+    /// Settings of the avoidance controllers.
+    pub avoidance: AvoidanceConfig,
+}
+
+/// Image processing settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct VisionSpec {
+    /// The sensor whose images vision uses (default: the robot's first).
+    pub sensor: Option<String>,
+    /// A calibration table written by `omniloop calibrate` (relative to the scenario file);
+    /// default: traced from the sensor's optics at start.
+    pub calibration_file: Option<PathBuf>,
+    /// Free-space detection (Sect. 3.1 of the corner paper).
+    pub freespace: FreeSpaceConfig,
+}
+
+/// The robot's wheel odometry: the true body velocity with seeded Gaussian errors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OdometrySpec {
+    /// Standard deviation of the relative error of each velocity component.
+    pub speed_noise_frac: f64,
+    /// Standard deviation of the rotation-rate error.
+    pub omega_noise_rad_s: f64,
+}
+
+impl Default for OdometrySpec {
+    fn default() -> Self {
+        Self {
+            speed_noise_frac: 0.01,
+            omega_noise_rad_s: 0.0,
+        }
+    }
+}
+
+/// Experiment metrics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct MetricsSpec {
+    /// The corner metrics of E1 (`turn_onset_mm`, `overshoot_mm`).
+    pub corner: Option<CornerSpec>,
+}
+
+/// The corner of E1: the corner point K and the direction of the first leg.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CornerSpec {
+    /// K, where the legs' centre lines meet.
+    pub k_mm: [f64; 2],
+    /// Direction u1 of the first leg.
+    pub leg1_heading_deg: f64,
 }
 
 impl Scenario {

@@ -50,6 +50,8 @@ pub struct PathLayer<'a> {
     pub points: &'a [Point2<f64>],
     /// Draw as dots instead of a line.
     pub dots: bool,
+    /// Also draw the robot's outline (`radius` mm) at every `n`-th point.
+    pub discs: Option<(usize, f64)>,
 }
 
 /// A marker: a circle of given radius (mm) with a label.
@@ -138,8 +140,214 @@ fn bounds(layout: &Layout, paths: &[PathLayer<'_>], markers: &[Marker]) -> (f64,
     (x0 - m, x1 + m, y0 - m, y1 + m)
 }
 
-/// Draws the world with paths and markers into a PNG `width` pixels wide (height follows the
-/// world's aspect ratio, so millimetres are square).
+/// One panel of a figure: a title, the world, paths and markers.
+#[derive(Debug, Clone)]
+pub struct Panel<'a> {
+    /// Title above the panel.
+    pub title: String,
+    /// The world.
+    pub layout: &'a Layout,
+    /// Paths.
+    pub paths: Vec<PathLayer<'a>>,
+    /// Markers.
+    pub markers: Vec<Marker>,
+}
+
+type Area<'b> = DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>;
+
+fn draw_panel(
+    area: &Area<'_>,
+    panel: &Panel<'_>,
+    bounds: (f64, f64, f64, f64),
+) -> Result<(), String> {
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let (x0, x1, y0, y1) = bounds;
+    let layout = panel.layout;
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, ("sans-serif", 18))
+        .margin_right(20)
+        .x_label_area_size(50)
+        .y_label_area_size(85)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x [mm]")
+        .y_desc("y [mm]")
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(|e| err(&e))?;
+    let plot = chart.plotting_area().clone();
+    plot.draw(&Rectangle::new(
+        [(x0, y0), (x1, y1)],
+        rgb(layout.outside_rgb).filled(),
+    ))
+    .map_err(|e| err(&e))?;
+    let rects = layout.all_floor_rects();
+    if rects.is_empty() {
+        plot.draw(&Rectangle::new(
+            [(x0, y0), (x1, y1)],
+            rgb(layout.floor_rgb).filled(),
+        ))
+        .map_err(|e| err(&e))?;
+    }
+    for r in rects {
+        let pts = rect_corners(
+            Point2::from(r.center_mm),
+            [r.size_mm[0] / 2.0, r.size_mm[1] / 2.0],
+            r.angle_deg.to_radians(),
+        );
+        plot.draw(&Polygon::new(pts, rgb(layout.floor_rgb).filled()))
+            .map_err(|e| err(&e))?;
+    }
+    if let Some(f) = &layout.field {
+        let line = rgb(layout.line_rgb).stroke_width(1);
+        let (a, b) = (f.half_length_mm, f.half_width_mm);
+        plot.draw(&PathElement::new(
+            vec![(-a, -b), (a, -b), (a, b), (-a, b), (-a, -b)],
+            line,
+        ))
+        .map_err(|e| err(&e))?;
+        plot.draw(&PathElement::new(vec![(0.0, -b), (0.0, b)], line))
+            .map_err(|e| err(&e))?;
+        plot.draw(&PathElement::new(
+            circle_points(Point2::origin(), f.centre_circle_radius_mm, 72),
+            line,
+        ))
+        .map_err(|e| err(&e))?;
+    }
+    for s in layout.solids() {
+        let fill = rgb(s.rgb).filled();
+        let edge = RGBColor(60, 60, 60).stroke_width(1);
+        match s.shape {
+            SolidShape::Box {
+                center_mm,
+                half_extents_mm,
+                angle_rad,
+            } => {
+                let pts =
+                    rect_corners(center_mm, [half_extents_mm.x, half_extents_mm.y], angle_rad);
+                plot.draw(&Polygon::new(pts.clone(), fill))
+                    .map_err(|e| err(&e))?;
+                let mut closed = pts;
+                closed.push(closed[0]);
+                plot.draw(&PathElement::new(closed, edge))
+                    .map_err(|e| err(&e))?;
+            }
+            SolidShape::Cylinder {
+                center_mm,
+                radius_mm,
+            } => {
+                plot.draw(&Polygon::new(circle_points(center_mm, radius_mm, 36), fill))
+                    .map_err(|e| err(&e))?;
+            }
+        }
+    }
+    for m in &panel.markers {
+        plot.draw(&PathElement::new(
+            circle_points(m.at, m.radius_mm, 48),
+            color(m.rgb).stroke_width(2),
+        ))
+        .map_err(|e| err(&e))?;
+        if !m.label.is_empty() {
+            plot.draw(&Text::new(
+                m.label.clone(),
+                (m.at.x + m.radius_mm, m.at.y + m.radius_mm),
+                ("sans-serif", 13).into_font().color(&BLACK),
+            ))
+            .map_err(|e| err(&e))?;
+        }
+    }
+    for p in &panel.paths {
+        let c = color(p.rgb);
+        if let Some((every, radius)) = p.discs {
+            for q in p.points.iter().step_by(every.max(1)) {
+                chart
+                    .plotting_area()
+                    .draw(&PathElement::new(
+                        circle_points(*q, radius, 36),
+                        c.stroke_width(1),
+                    ))
+                    .map_err(|e| err(&e))?;
+            }
+        }
+        let pts: Vec<(f64, f64)> = p.points.iter().map(|q| (q.x, q.y)).collect();
+        let series = if p.dots {
+            chart
+                .draw_series(pts.iter().map(|&q| Circle::new(q, 1, c.filled())))
+                .map_err(|e| err(&e))?
+        } else {
+            chart
+                .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                .map_err(|e| err(&e))?
+        };
+        series
+            .label(p.label.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+    }
+    if !panel.paths.is_empty() {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(|e| err(&e))?;
+    }
+    Ok(())
+}
+
+fn circle_points(c: Point2<f64>, r: f64, n: usize) -> Vec<(f64, f64)> {
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 * std::f64::consts::TAU / n as f64;
+            (c.x + r * t.cos(), c.y + r * t.sin())
+        })
+        .collect()
+}
+
+/// Draws panels side by side into a PNG; each panel is `width` pixels wide and all share the
+/// bounds of everything drawn, with millimetres square.
+pub fn draw_panels(file: &Path, panels: &[Panel<'_>], width: u32) -> Result<(), FigureError> {
+    register_font();
+    let name = file.display().to_string();
+    let fail = |message: String| FigureError::Draw {
+        file: name.clone(),
+        message,
+    };
+    let mut b = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in panels {
+        let (x0, x1, y0, y1) = bounds(p.layout, &p.paths, &p.markers);
+        b = (b.0.min(x0), b.1.max(x1), b.2.min(y0), b.3.max(y1));
+    }
+    let plot_w = width.saturating_sub(105).max(100);
+    let plot_h = ((plot_w as f64) * (b.3 - b.2) / (b.1 - b.0))
+        .round()
+        .max(100.0) as u32;
+    let height = plot_h + 90;
+    let total_w = width * panels.len().max(1) as u32;
+    let mut buf = vec![255u8; (total_w * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (total_w, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+        let areas = root.split_evenly((1, panels.len().max(1)));
+        for (area, panel) in areas.iter().zip(panels) {
+            draw_panel(area, panel, b).map_err(fail)?;
+        }
+        root.present().map_err(|e| fail(e.to_string()))?;
+    }
+    image::RgbImage::from_raw(total_w, height, buf)
+        .expect("buffer size matches the image")
+        .save(file)
+        .map_err(|source| FigureError::Write {
+            file: file.display().to_string(),
+            source,
+        })
+}
+
+/// Draws one panel into a PNG `width` pixels wide.
 pub fn draw_topview(
     file: &Path,
     title: &str,
@@ -148,170 +356,14 @@ pub fn draw_topview(
     markers: &[Marker],
     width: u32,
 ) -> Result<(), FigureError> {
-    register_font();
-    let (x0, x1, y0, y1) = bounds(layout, paths, markers);
-    let (left, bottom, top, right) = (85u32, 50u32, 40u32, 20u32);
-    let plot_w = width - left - right;
-    let plot_h = ((plot_w as f64) * (y1 - y0) / (x1 - x0)).round().max(100.0) as u32;
-    let height = plot_h + top + bottom;
-    let mut buf = vec![255u8; (width * height * 3) as usize];
-    let name = file.display().to_string();
-    let err = |e: &dyn std::fmt::Display| FigureError::Draw {
-        file: name.clone(),
-        message: e.to_string(),
-    };
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| err(&e))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin_right(right)
-            .x_label_area_size(bottom)
-            .y_label_area_size(left)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("x [mm]")
-            .y_desc("y [mm]")
-            .label_style(("sans-serif", 12))
-            .draw()
-            .map_err(|e| err(&e))?;
-        let area = chart.plotting_area();
-        area.draw(&Rectangle::new(
-            [(x0, y0), (x1, y1)],
-            rgb(layout.outside_rgb).filled(),
-        ))
-        .map_err(|e| err(&e))?;
-        let rects = layout.all_floor_rects();
-        if rects.is_empty() {
-            area.draw(&Rectangle::new(
-                [(x0, y0), (x1, y1)],
-                rgb(layout.floor_rgb).filled(),
-            ))
-            .map_err(|e| err(&e))?;
-        }
-        for r in rects {
-            let pts = rect_corners(
-                Point2::from(r.center_mm),
-                [r.size_mm[0] / 2.0, r.size_mm[1] / 2.0],
-                r.angle_deg.to_radians(),
-            );
-            area.draw(&Polygon::new(pts, rgb(layout.floor_rgb).filled()))
-                .map_err(|e| err(&e))?;
-        }
-        if let Some(f) = &layout.field {
-            let line = rgb(layout.line_rgb).stroke_width(1);
-            let (a, b) = (f.half_length_mm, f.half_width_mm);
-            area.draw(&PathElement::new(
-                vec![(-a, -b), (a, -b), (a, b), (-a, b), (-a, -b)],
-                line,
-            ))
-            .map_err(|e| err(&e))?;
-            area.draw(&PathElement::new(vec![(0.0, -b), (0.0, b)], line))
-                .map_err(|e| err(&e))?;
-            let circle: Vec<(f64, f64)> = (0..=72)
-                .map(|k| {
-                    let t = k as f64 * std::f64::consts::TAU / 72.0;
-                    (
-                        f.centre_circle_radius_mm * t.cos(),
-                        f.centre_circle_radius_mm * t.sin(),
-                    )
-                })
-                .collect();
-            area.draw(&PathElement::new(circle, line))
-                .map_err(|e| err(&e))?;
-        }
-        for s in layout.solids() {
-            let fill = rgb(s.rgb).filled();
-            let edge = RGBColor(60, 60, 60).stroke_width(1);
-            match s.shape {
-                SolidShape::Box {
-                    center_mm,
-                    half_extents_mm,
-                    angle_rad,
-                } => {
-                    let pts =
-                        rect_corners(center_mm, [half_extents_mm.x, half_extents_mm.y], angle_rad);
-                    area.draw(&Polygon::new(pts.clone(), fill))
-                        .map_err(|e| err(&e))?;
-                    let mut closed = pts;
-                    closed.push(closed[0]);
-                    area.draw(&PathElement::new(closed, edge))
-                        .map_err(|e| err(&e))?;
-                }
-                SolidShape::Cylinder {
-                    center_mm,
-                    radius_mm,
-                } => {
-                    let pts: Vec<(f64, f64)> = (0..36)
-                        .map(|k| {
-                            let t = k as f64 * std::f64::consts::TAU / 36.0;
-                            (
-                                center_mm.x + radius_mm * t.cos(),
-                                center_mm.y + radius_mm * t.sin(),
-                            )
-                        })
-                        .collect();
-                    area.draw(&Polygon::new(pts, fill)).map_err(|e| err(&e))?;
-                }
-            }
-        }
-        for m in markers {
-            let pts: Vec<(f64, f64)> = (0..=48)
-                .map(|k| {
-                    let t = k as f64 * std::f64::consts::TAU / 48.0;
-                    (
-                        m.at.x + m.radius_mm * t.cos(),
-                        m.at.y + m.radius_mm * t.sin(),
-                    )
-                })
-                .collect();
-            area.draw(&PathElement::new(pts, color(m.rgb).stroke_width(2)))
-                .map_err(|e| err(&e))?;
-            if !m.label.is_empty() {
-                area.draw(&Text::new(
-                    m.label.clone(),
-                    (m.at.x + m.radius_mm, m.at.y + m.radius_mm),
-                    ("sans-serif", 13).into_font().color(&BLACK),
-                ))
-                .map_err(|e| err(&e))?;
-            }
-        }
-        for p in paths {
-            let c = color(p.rgb);
-            let pts: Vec<(f64, f64)> = p.points.iter().map(|q| (q.x, q.y)).collect();
-            let series = if p.dots {
-                chart
-                    .draw_series(pts.iter().map(|&q| Circle::new(q, 2, c.filled())))
-                    .map_err(|e| err(&e))?
-            } else {
-                chart
-                    .draw_series(LineSeries::new(pts, c.stroke_width(2)))
-                    .map_err(|e| err(&e))?
-            };
-            series.label(p.label.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
-            });
-        }
-        if !paths.is_empty() {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 13))
-                .position(SeriesLabelPosition::UpperLeft)
-                .draw()
-                .map_err(|e| err(&e))?;
-        }
-        root.present().map_err(|e| err(&e))?;
-    }
-    image::RgbImage::from_raw(width, height, buf)
-        .expect("buffer size matches the image")
-        .save(file)
-        .map_err(|source| FigureError::Write {
-            file: file.display().to_string(),
-            source,
-        })
+    draw_panels(
+        file,
+        &[Panel {
+            title: title.to_string(),
+            layout,
+            paths: paths.to_vec(),
+            markers: markers.to_vec(),
+        }],
+        width,
+    )
 }

@@ -242,6 +242,7 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             );
         }
     }
+    check_vision_and_control(&mut c, s);
     if s.control.kind != ControllerKind::Idle && s.goal.is_none() {
         c.fail(
             "control.kind",
@@ -252,6 +253,154 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         );
     }
     c.out
+}
+
+fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
+    let fs = &s.vision.freespace;
+    if fs.directions < 4 {
+        c.fail(
+            "vision.freespace.directions",
+            format!("must be >= 4 (got {})", fs.directions),
+        );
+    }
+    if fs.rings < 1 {
+        c.fail("vision.freespace.rings", "must be >= 1");
+    }
+    c.positive("vision.freespace.inner_mm", fs.inner_mm);
+    if fs.outer_mm.is_nan() || fs.outer_mm <= fs.inner_mm {
+        c.fail(
+            "vision.freespace.outer_mm",
+            format!(
+                "must exceed inner_mm = {} (got {})",
+                fs.inner_mm, fs.outer_mm
+            ),
+        );
+    }
+    if fs.r_th.is_nan() || fs.r_th <= 0.0 || fs.r_th > 1.0 {
+        c.fail(
+            "vision.freespace.r_th",
+            format!("must lie in (0, 1] (got {})", fs.r_th),
+        );
+    }
+    if !fs.ring_edges_mm.is_empty() && !fs.ring_edges_px.is_empty() {
+        c.fail(
+            "vision.freespace.ring_edges_px",
+            "give ring_edges_mm or ring_edges_px, not both",
+        );
+    }
+    for (key, edges) in [
+        ("ring_edges_mm", &fs.ring_edges_mm),
+        ("ring_edges_px", &fs.ring_edges_px),
+    ] {
+        if !edges.is_empty() && edges.len() != fs.rings + 1 {
+            c.fail(
+                format!("vision.freespace.{key}"),
+                format!(
+                    "needs rings + 1 = {} values (got {})",
+                    fs.rings + 1,
+                    edges.len()
+                ),
+            );
+        }
+    }
+    for k in 0..3 {
+        if fs.floor.rgb_min[k] > fs.floor.rgb_max[k] {
+            c.fail(
+                "vision.freespace.floor.rgb_min",
+                format!(
+                    "channel {k}: {} exceeds rgb_max {}",
+                    fs.floor.rgb_min[k], fs.floor.rgb_max[k]
+                ),
+            );
+        }
+    }
+    let a = &s.control.avoidance;
+    if !(a.margin_mm.is_finite() && a.margin_mm >= 0.0) {
+        c.fail(
+            "control.avoidance.margin_mm",
+            format!("must be >= 0 (got {})", a.margin_mm),
+        );
+    }
+    c.positive("control.avoidance.free_distance_mm", a.free_distance_mm);
+    c.positive("control.avoidance.prediction_step_s", a.prediction_step_s);
+    if a.candidates < 4 {
+        c.fail(
+            "control.avoidance.candidates",
+            format!("must be >= 4 (got {})", a.candidates),
+        );
+    }
+    if !(a.extra_horizon_s.is_finite() && a.extra_horizon_s >= 0.0) {
+        c.fail(
+            "control.avoidance.extra_horizon_s",
+            format!("must be >= 0 (got {})", a.extra_horizon_s),
+        );
+    }
+    let o = &s.odometry;
+    for (key, v) in [
+        ("speed_noise_frac", o.speed_noise_frac),
+        ("omega_noise_rad_s", o.omega_noise_rad_s),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            c.fail(format!("odometry.{key}"), format!("must be >= 0 (got {v})"));
+        }
+    }
+    if !s.control.kind.uses_vision() {
+        return;
+    }
+    // The controller sees through a mirror sensor: its calibration and the template must work.
+    let sensors = &s.robot.sensors;
+    let index = match &s.vision.sensor {
+        Some(name) => match sensors.iter().position(|x| &x.name == name) {
+            Some(i) => i,
+            None => {
+                c.fail("vision.sensor", format!("the robot has no sensor {name:?}"));
+                return;
+            }
+        },
+        None if sensors.is_empty() => {
+            c.fail(
+                "control.kind",
+                format!(
+                    "controller {:?} sees through a camera: add a [[robot.sensors]]",
+                    crate::scenario::controller_name(s.control.kind)
+                ),
+            );
+            return;
+        }
+        None => 0,
+    };
+    if sensors[index].pinhole.is_some() || sensors[index].optics_present().len() != 1 {
+        c.fail(
+            "vision.sensor",
+            format!(
+                "free space needs a mirror sensor; {:?} is not one",
+                sensors[index].name
+            ),
+        );
+        return;
+    }
+    let cal = match &s.vision.calibration_file {
+        Some(path) => match omniloop_vision::RadialCalibration::load(path) {
+            Ok(cal) => cal,
+            Err(e) => {
+                c.fail("vision.calibration_file", e.to_string());
+                return;
+            }
+        },
+        None => match crate::calibrate::calibrate_sensor(&sensors[index]) {
+            Ok(cal) => cal,
+            Err(e) => {
+                c.fail(format!("robot.sensors[{index}]"), e.to_string());
+                return;
+            }
+        },
+    };
+    if !c.out.is_empty() {
+        return;
+    }
+    if let Err(e) = omniloop_vision::freespace::PolarTemplate::new(fs, &cal) {
+        c.fail("vision.freespace", e.to_string());
+    }
 }
 
 fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {

@@ -5,11 +5,15 @@
 //! so the same code drives the simulated robot and a real one. Nothing in this crate knows the
 //! simulator.
 
+pub mod avoidance;
 pub mod drive;
 pub mod go_to_goal;
+pub mod odometry;
 
+pub use avoidance::{AvoidanceConfig, Decision, GoalDirection, Surroundings, VelocityAware};
 pub use drive::{AccelLimitedDrive, VelocityCommand};
 pub use go_to_goal::GoToGoal;
+pub use odometry::DeadReckoning;
 
 /// A 2-D vector in millimetres (positions) or millimetres per second (velocities).
 pub type Vec2 = nalgebra::Vector2<f64>;

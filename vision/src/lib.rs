@@ -4,8 +4,12 @@
 //! map, never a simulated world, so it works the same on a real camera's PNG.
 
 pub mod calibration;
+pub mod freespace;
+pub mod mask;
 
 pub use calibration::{HyperbolicFit, RadialCalibration};
+pub use freespace::{FreeSpace, FreeSpaceConfig, FreeSpaceDetector, FreeSpaceMethod};
+pub use mask::{FloorColor, Mask};
 
 /// Errors of the vision crate.
 #[derive(Debug, thiserror::Error)]

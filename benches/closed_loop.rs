@@ -1,0 +1,58 @@
+//! Closed-loop benchmark: control cycles per second of the E1 corner runs (render, free space,
+//! controller, physics, recording) with the CPU renderer and, when an adapter exists, the GPU.
+//!
+//!     cargo bench --bench closed_loop
+
+use omniloop::load_scenario;
+use omniloop::runner::{RunOptions, run_scenario};
+use omniloop_sim::RendererChoice;
+use std::path::Path;
+
+fn main() {
+    println!(
+        "{:<28} {:<44} {:>8} {:>10}",
+        "scenario", "renderer", "cycles", "cycles/s"
+    );
+    for choice in [RendererChoice::Cpu, RendererChoice::Gpu] {
+        for name in ["corner55_goal_direction", "corner55_velocity_aware"] {
+            let rel = Path::new("scenarios").join(format!("{name}.toml"));
+            let path = if rel.exists() {
+                rel
+            } else {
+                Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+            };
+            let s = load_scenario(&path).expect("scenario loads");
+            let options = RunOptions {
+                renderer: choice,
+                ..RunOptions::default()
+            };
+            // Best of three runs (the machine may be shared).
+            let mut best: Option<omniloop::Summary> = None;
+            for _ in 0..3 {
+                match run_scenario(&s, &options, |_| {}, |_, _| {}) {
+                    Ok(out) => {
+                        if best
+                            .as_ref()
+                            .is_none_or(|b| out.summary.cycles_per_s > b.cycles_per_s)
+                        {
+                            best = Some(out.summary);
+                        }
+                    }
+                    Err(e) => {
+                        println!("{name:<28} {choice:?}: not measured ({e})");
+                        break;
+                    }
+                }
+            }
+            if let Some(m) = best {
+                println!(
+                    "{:<28} {:<44} {:>8} {:>10.0}",
+                    name,
+                    m.renderer.unwrap_or_default(),
+                    m.cycles,
+                    m.cycles_per_s
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,112 @@
+//! E1 end to end: the 55-degree corner with both controllers, on vision alone.
+
+use omniloop::replay::{CORNER55, builtin_scenario};
+use omniloop::runner::{RunOptions, run_scenario};
+use omniloop::{Summary, load_scenario};
+use omniloop_sim::RendererChoice;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn cpu() -> RunOptions {
+    RunOptions {
+        renderer: RendererChoice::Cpu,
+        ..RunOptions::default()
+    }
+}
+
+fn run(file: &str) -> Summary {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenarios")
+        .join(file);
+    let s = load_scenario(&path).unwrap();
+    run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary
+}
+
+#[test]
+fn both_controllers_turn_the_corner_and_the_velocity_aware_one_turns_earlier_and_tighter() {
+    let gd = run("corner55_goal_direction.toml");
+    let va = run("corner55_velocity_aware.toml");
+    for m in [&gd, &va] {
+        assert!(m.reached_goal, "{m:?}");
+        assert_eq!(m.wall_contacts, 0, "{m:?}");
+        assert!(m.peak_accel_mm_s2 <= 303.0, "{m:?}");
+        assert!(m.min_clearance_mm > 0.0, "{m:?}");
+        assert_eq!(
+            m.renderer.as_deref().map(|r| r.starts_with("cpu")),
+            Some(true)
+        );
+        // Free space on the rendered frames against the ray-cast truth, along the whole run.
+        let e = m.freespace_error_mm.unwrap();
+        assert!(e < 40.0, "median free-space error {e} mm");
+    }
+    let (gd_onset, va_onset) = (gd.turn_onset_mm.unwrap(), va.turn_onset_mm.unwrap());
+    assert!(va_onset > gd_onset, "turn onset {va_onset} vs {gd_onset}");
+    let (gd_over, va_over) = (gd.overshoot_mm.unwrap(), va.overshoot_mm.unwrap());
+    assert!(va_over < gd_over, "overshoot {va_over} vs {gd_over}");
+}
+
+#[test]
+fn the_built_in_replay_scenarios_are_the_files_in_scenarios() {
+    for (name, text) in CORNER55 {
+        let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios")
+            .join(format!("corner55_{name}.toml"));
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), text);
+        builtin_scenario(name, text).unwrap();
+    }
+}
+
+fn replay(dir: &Path) {
+    let out = Command::new(env!("CARGO_BIN_EXE_omniloop"))
+        .args([
+            "replay",
+            "corner55",
+            "--renderer",
+            "cpu",
+            "--quiet",
+            "--out",
+        ])
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("velocity-aware turns earlier: yes"), "{text}");
+}
+
+/// The summary without the wall-clock fields.
+fn deterministic_part(path: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let m = v.as_object_mut().unwrap();
+    m.remove("wall_time_s");
+    m.remove("cycles_per_s");
+    v
+}
+
+#[test]
+fn the_replay_run_twice_on_the_cpu_gives_identical_results() {
+    let base = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let dirs = [base.join("corner55_a"), base.join("corner55_b")];
+    for d in &dirs {
+        let _ = std::fs::remove_dir_all(d);
+        replay(d);
+        for f in ["comparison.png", "comparison.md"] {
+            assert!(d.join(f).exists(), "{f}");
+        }
+    }
+    for name in ["goal_direction", "velocity_aware"] {
+        let a = deterministic_part(&dirs[0].join(name).join("summary.json"));
+        let b = deterministic_part(&dirs[1].join(name).join("summary.json"));
+        assert_eq!(a, b, "{name}");
+        for key in ["turn_onset_mm", "overshoot_mm", "freespace_error_mm"] {
+            assert!(a[key].is_number(), "{name}: {key} missing");
+        }
+        let ta = std::fs::read(dirs[0].join(name).join("trajectory.csv")).unwrap();
+        let tb = std::fs::read(dirs[1].join(name).join("trajectory.csv")).unwrap();
+        assert_eq!(ta, tb, "{name}");
+    }
+}

@@ -1,0 +1,648 @@
+//! Free space around the robot from the floor region of an omnidirectional image
+//! (Sect. 3.1 of the corner paper, steps 1-4).
+//!
+//! 1. Binarize by floor colour and clean with dilation/erosion ([`crate::mask`]).
+//! 2. A polar template of I rings by J directions is laid on the image; each pixel belongs to
+//!    one cell S_ij (ring i from the inside, direction j centred on the robot-frame angle
+//!    `2 pi j / J`); one-pixel lines between cells keep them apart, as in Fig. 3 (c).
+//! 3. The AND of floor mask and template is labelled into connected areas A_k with centroids
+//!    p_k; eq. (5) `r_ij = (1 / A_ij) sum_{p_k in S_ij} A_k`, eq. (6) `q_ij = [r_ij >= r_th]`.
+//!    The direct variant counts the floor pixels of each cell instead; since the template's
+//!    lines keep every area inside one cell the two agree.
+//! 4. Eq. (7): `a_j = min_{q_nj = 0} (n - 1)`, `n = 1..I+1`, `q_(I+1)j = 0`: the number of free
+//!    cells from the inside before the first obstacle cell in direction j.
+//!
+//! Ring edges come from floor distances through `f^-1` or directly in pixels; the free distance
+//! of direction j is the inner edge (mm) of its first obstacle cell, and the obstacle points are
+//! that edge's arc (both ends and middle) in the robot frame.
+
+use crate::VisionError;
+use crate::calibration::RadialCalibration;
+use crate::mask::{FloorColor, Mask};
+use image::RgbaImage;
+use nalgebra::Point2;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::TAU;
+
+/// How the ring edges are spaced between `inner_mm` and `outer_mm`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum RingSpacing {
+    /// Equal steps of image radius (the paper's template, Fig. 3 (c)).
+    #[default]
+    Image,
+    /// Equal steps of floor distance.
+    Floor,
+}
+
+/// How r_ij is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum FreeSpaceMethod {
+    /// Count the floor pixels of each cell.
+    #[default]
+    Count,
+    /// Label the AND of floor mask and template and sum the areas by centroid (eq. (5)).
+    Labeling,
+}
+
+/// Free-space settings (`[vision.freespace]` in scenarios).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FreeSpaceConfig {
+    /// J: directions around the robot.
+    pub directions: usize,
+    /// I: rings from the inside out.
+    pub rings: usize,
+    /// Inner edge of the template on the floor (outside the blind zone of the robot's body).
+    pub inner_mm: f64,
+    /// Outer edge of the template on the floor.
+    pub outer_mm: f64,
+    /// Spacing of the ring edges between `inner_mm` and `outer_mm`.
+    pub spacing: RingSpacing,
+    /// Explicit ring edges on the floor (I + 1 increasing values), instead of the above.
+    pub ring_edges_mm: Vec<f64>,
+    /// Explicit ring edges in image radius (I + 1 increasing values), instead of the above.
+    pub ring_edges_px: Vec<f64>,
+    /// r_th of eq. (6): a cell with less floor than this fraction holds an obstacle.
+    pub r_th: f64,
+    /// How r_ij is computed.
+    pub method: FreeSpaceMethod,
+    /// Floor colour thresholds.
+    pub floor: FloorColor,
+    /// Dilation/erosion passes when cleaning the mask.
+    pub morphology_iterations: u32,
+}
+
+impl Default for FreeSpaceConfig {
+    fn default() -> Self {
+        Self {
+            directions: 32,
+            rings: 6,
+            inner_mm: 200.0,
+            outer_mm: 1000.0,
+            spacing: RingSpacing::Image,
+            ring_edges_mm: Vec::new(),
+            ring_edges_px: Vec::new(),
+            r_th: 0.5,
+            method: FreeSpaceMethod::Count,
+            floor: FloorColor::default(),
+            morphology_iterations: 1,
+        }
+    }
+}
+
+/// The result for one image.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FreeSpace {
+    /// Centre angle of each direction j in the robot frame.
+    pub direction_rad: Vec<f64>,
+    /// a_j of eq. (7).
+    pub a: Vec<usize>,
+    /// Distance (mm, from the sensor axis) to the first obstacle cell of each direction, or to
+    /// the template's outer edge when the direction is free throughout.
+    pub free_mm: Vec<f64>,
+    /// r_ij, ring-major (`r[i * J + j]`).
+    pub ratio: Vec<f64>,
+    /// Points on the near edge of each direction's first obstacle cell, robot frame.
+    pub obstacle_points: Vec<Point2<f64>>,
+}
+
+impl FreeSpace {
+    /// Whether direction j is free all through the template.
+    pub fn is_clear(&self, j: usize, rings: usize) -> bool {
+        self.a[j] >= rings
+    }
+}
+
+const NONE: u16 = u16::MAX;
+
+/// The polar template laid on the image.
+#[derive(Debug, Clone)]
+pub struct PolarTemplate {
+    rings: usize,
+    directions: usize,
+    edges_px: Vec<f64>,
+    edges_mm: Vec<f64>,
+    mount_mm: [f64; 2],
+    /// Bounding box of the template, [x0, y0, x1, y1) in pixels.
+    bbox: [usize; 4],
+    /// Cell of each pixel in the bounding box (`NONE` outside or on a cell boundary).
+    cells: Vec<u16>,
+    /// A_ij: template pixels per cell.
+    area: Vec<u32>,
+}
+
+impl PolarTemplate {
+    /// Lays the template of `config` on images of the calibrated sensor.
+    pub fn new(config: &FreeSpaceConfig, cal: &RadialCalibration) -> Result<Self, VisionError> {
+        let (i_n, j_n) = (config.rings, config.directions);
+        if i_n == 0 || j_n < 4 || i_n * j_n >= NONE as usize {
+            return Err(VisionError::InvalidParameter {
+                name: "rings x directions",
+                value: (i_n * j_n) as f64,
+                rule: "need rings >= 1, directions >= 4 and fewer than 65535 cells",
+            });
+        }
+        let to_px = |mm: f64| {
+            cal.image_radius_px(mm)
+                .ok_or(VisionError::InvalidParameter {
+                    name: "ring edge (mm)",
+                    value: mm,
+                    rule: "must lie on the floor the sensor sees (inside the calibration table)",
+                })
+        };
+        let to_mm = |px: f64| {
+            cal.floor_distance_mm(px)
+                .ok_or(VisionError::InvalidParameter {
+                    name: "ring edge (px)",
+                    value: px,
+                    rule: "must lie below the floor horizon of the calibration table",
+                })
+        };
+        let (edges_px, edges_mm): (Vec<f64>, Vec<f64>) = if !config.ring_edges_mm.is_empty() {
+            let px = config
+                .ring_edges_mm
+                .iter()
+                .map(|&m| to_px(m))
+                .collect::<Result<Vec<_>, _>>()?;
+            (px, config.ring_edges_mm.clone())
+        } else if !config.ring_edges_px.is_empty() {
+            let mm = config
+                .ring_edges_px
+                .iter()
+                .map(|&p| to_mm(p))
+                .collect::<Result<Vec<_>, _>>()?;
+            (config.ring_edges_px.clone(), mm)
+        } else {
+            match config.spacing {
+                RingSpacing::Image => {
+                    let (a, b) = (to_px(config.inner_mm)?, to_px(config.outer_mm)?);
+                    let px: Vec<f64> = (0..=i_n)
+                        .map(|k| a + (b - a) * k as f64 / i_n as f64)
+                        .collect();
+                    let mm = px
+                        .iter()
+                        .map(|&p| to_mm(p))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    (px, mm)
+                }
+                RingSpacing::Floor => {
+                    let (a, b) = (config.inner_mm, config.outer_mm);
+                    let mm: Vec<f64> = (0..=i_n)
+                        .map(|k| a + (b - a) * k as f64 / i_n as f64)
+                        .collect();
+                    let px = mm
+                        .iter()
+                        .map(|&m| to_px(m))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    (px, mm)
+                }
+            }
+        };
+        if edges_px.len() != i_n + 1 {
+            return Err(VisionError::InvalidParameter {
+                name: "ring edges",
+                value: edges_px.len() as f64,
+                rule: "need rings + 1 edges",
+            });
+        }
+        if edges_px.windows(2).any(|w| w[1] <= w[0]) || edges_px[0] < 0.0 {
+            return Err(VisionError::InvalidParameter {
+                name: "ring edges",
+                value: edges_px[0],
+                rule: "must be non-negative and strictly increasing",
+            });
+        }
+        let (w, h) = (cal.width_px as usize, cal.height_px as usize);
+        let [cx, cy] = cal.principal_point_px;
+        let r_out = edges_px[i_n];
+        let x0 = ((cx - r_out).floor().max(0.0)) as usize;
+        let y0 = ((cy - r_out).floor().max(0.0)) as usize;
+        let x1 = ((cx + r_out).ceil() as usize + 1).min(w);
+        let y1 = ((cy + r_out).ceil() as usize + 1).min(h);
+        let (bw, bh) = (x1 - x0, y1 - y0);
+        let dir_step = TAU / j_n as f64;
+        let mut raw = vec![NONE; bw * bh];
+        for y in 0..bh {
+            for x in 0..bw {
+                let (px, py) = cal.image_coords((x + x0) as f64, (y + y0) as f64);
+                let r = px.hypot(py);
+                if r < edges_px[0] || r >= r_out {
+                    continue;
+                }
+                let i = edges_px.partition_point(|&e| e <= r) - 1;
+                let phi = py.atan2(px);
+                let j = ((phi / dir_step).round() as i64).rem_euclid(j_n as i64) as usize;
+                raw[y * bw + x] = (i * j_n + j) as u16;
+            }
+        }
+        // One-pixel lines between cells: a pixel whose 4-neighbour is in another cell (or
+        // outside) is left out.
+        let mut cells = raw.clone();
+        for y in 0..bh {
+            for x in 0..bw {
+                let c = raw[y * bw + x];
+                if c == NONE {
+                    continue;
+                }
+                let differs = |xx: isize, yy: isize| {
+                    if xx < 0 || yy < 0 || xx >= bw as isize || yy >= bh as isize {
+                        return true;
+                    }
+                    raw[yy as usize * bw + xx as usize] != c
+                };
+                let (xi, yi) = (x as isize, y as isize);
+                // Only the right/down neighbours mark a line, so lines are one pixel wide.
+                if differs(xi + 1, yi) || differs(xi, yi + 1) {
+                    cells[y * bw + x] = NONE;
+                }
+            }
+        }
+        let mut area = vec![0u32; i_n * j_n];
+        for &c in &cells {
+            if c != NONE {
+                area[c as usize] += 1;
+            }
+        }
+        if let Some(k) = area.iter().position(|&a| a == 0) {
+            return Err(VisionError::InvalidParameter {
+                name: "template cell area (px)",
+                value: k as f64,
+                rule: "every cell needs pixels inside the image: use fewer rings or directions, \
+                       or edges inside the image",
+            });
+        }
+        Ok(Self {
+            rings: i_n,
+            directions: j_n,
+            edges_px,
+            edges_mm,
+            mount_mm: cal.mount_mm,
+            bbox: [x0, y0, x1, y1],
+            cells,
+            area,
+        })
+    }
+
+    /// I.
+    pub fn rings(&self) -> usize {
+        self.rings
+    }
+
+    /// J.
+    pub fn directions(&self) -> usize {
+        self.directions
+    }
+
+    /// Ring edges in image radius.
+    pub fn edges_px(&self) -> &[f64] {
+        &self.edges_px
+    }
+
+    /// Ring edges on the floor.
+    pub fn edges_mm(&self) -> &[f64] {
+        &self.edges_mm
+    }
+
+    /// Cell index of pixel `(x, y)` of the image, if it lies inside a cell.
+    pub fn cell_at(&self, x: usize, y: usize) -> Option<(usize, usize)> {
+        let [x0, y0, x1, y1] = self.bbox;
+        if x < x0 || y < y0 || x >= x1 || y >= y1 {
+            return None;
+        }
+        let c = self.cells[(y - y0) * (x1 - x0) + (x - x0)];
+        (c != NONE).then(|| (c as usize / self.directions, c as usize % self.directions))
+    }
+}
+
+/// Detects free space in images of one calibrated sensor.
+#[derive(Debug, Clone)]
+pub struct FreeSpaceDetector {
+    config: FreeSpaceConfig,
+    template: PolarTemplate,
+    principal_point_px: [f64; 2],
+    mask: Mask,
+    scratch: Vec<u8>,
+    labels: Vec<u32>,
+    parent: Vec<u32>,
+    counts: Vec<u32>,
+}
+
+impl FreeSpaceDetector {
+    /// A detector for images of the sensor `cal` describes.
+    pub fn new(config: FreeSpaceConfig, cal: &RadialCalibration) -> Result<Self, VisionError> {
+        if !(config.r_th > 0.0 && config.r_th <= 1.0) {
+            return Err(VisionError::InvalidParameter {
+                name: "r_th",
+                value: config.r_th,
+                rule: "must lie in (0, 1]",
+            });
+        }
+        let template = PolarTemplate::new(&config, cal)?;
+        Ok(Self {
+            counts: vec![0; config.rings * config.directions],
+            config,
+            template,
+            principal_point_px: cal.principal_point_px,
+            mask: Mask::new(0, 0),
+            scratch: Vec::new(),
+            labels: Vec::new(),
+            parent: Vec::new(),
+        })
+    }
+
+    /// The template.
+    pub fn template(&self) -> &PolarTemplate {
+        &self.template
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &FreeSpaceConfig {
+        &self.config
+    }
+
+    /// The cleaned floor mask of the template's bounding box from the last image.
+    pub fn mask(&self) -> &Mask {
+        &self.mask
+    }
+
+    /// Runs steps 1-4 on one image.
+    pub fn detect(&mut self, img: &RgbaImage) -> Result<FreeSpace, VisionError> {
+        let [_, _, x1, y1] = self.template.bbox;
+        if (img.width() as usize) < x1 || (img.height() as usize) < y1 {
+            return Err(VisionError::InvalidParameter {
+                name: "image size (px)",
+                value: (img.width() * img.height()) as f64,
+                rule: "smaller than the calibrated sensor's image",
+            });
+        }
+        // Step 1 on the template's bounding box only.
+        self.mask
+            .binarize_region(img, &self.config.floor, self.template.bbox);
+        self.mask
+            .clean(self.config.morphology_iterations, &mut self.scratch);
+
+        // Steps 2-3.
+        let n_cells = self.config.rings * self.config.directions;
+        self.counts.clear();
+        self.counts.resize(n_cells, 0);
+        match self.config.method {
+            FreeSpaceMethod::Count => {
+                for (&c, &m) in self.template.cells.iter().zip(&self.mask.data) {
+                    if c != NONE && m != 0 {
+                        self.counts[c as usize] += 1;
+                    }
+                }
+            }
+            FreeSpaceMethod::Labeling => self.label_areas(),
+        }
+        let ratio: Vec<f64> = self
+            .counts
+            .iter()
+            .zip(&self.template.area)
+            .map(|(&n, &a)| n as f64 / a as f64)
+            .collect();
+
+        // Step 4.
+        let (i_n, j_n) = (self.config.rings, self.config.directions);
+        let dir_step = TAU / j_n as f64;
+        let mut out = FreeSpace {
+            direction_rad: (0..j_n).map(|j| j as f64 * dir_step).collect(),
+            a: vec![i_n; j_n],
+            free_mm: vec![0.0; j_n],
+            ratio,
+            obstacle_points: Vec::new(),
+        };
+        let [mx, my] = self.template.mount_mm;
+        for j in 0..j_n {
+            let a = (0..i_n)
+                .find(|&i| out.ratio[i * j_n + j] < self.config.r_th)
+                .unwrap_or(i_n);
+            out.a[j] = a;
+            let d = self.template.edges_mm[a];
+            out.free_mm[j] = d;
+            if a < i_n {
+                let c = out.direction_rad[j];
+                for phi in [c - 0.5 * dir_step, c, c + 0.5 * dir_step] {
+                    out.obstacle_points
+                        .push(Point2::new(mx + d * phi.cos(), my + d * phi.sin()));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Eq. (5) by labelling: 4-connected areas of (floor AND template), each area's pixels
+    /// credited to the cell holding its centroid.
+    fn label_areas(&mut self) {
+        let [x0, y0, x1, _] = self.template.bbox;
+        let bw = x1 - x0;
+        let cells = &self.template.cells;
+        let mask = &self.mask.data;
+        let n = cells.len();
+        self.labels.clear();
+        self.labels.resize(n, u32::MAX);
+        self.parent.clear();
+        fn find(parent: &mut [u32], mut x: u32) -> u32 {
+            while parent[x as usize] != x {
+                parent[x as usize] = parent[parent[x as usize] as usize];
+                x = parent[x as usize];
+            }
+            x
+        }
+        for k in 0..n {
+            if cells[k] == NONE || mask[k] == 0 {
+                continue;
+            }
+            let left = (k % bw > 0 && self.labels[k - 1] != u32::MAX).then(|| self.labels[k - 1]);
+            let up = (k >= bw && self.labels[k - bw] != u32::MAX).then(|| self.labels[k - bw]);
+            let label = match (left, up) {
+                (None, None) => {
+                    self.parent.push(self.parent.len() as u32);
+                    self.parent.len() as u32 - 1
+                }
+                (Some(a), None) | (None, Some(a)) => a,
+                (Some(a), Some(b)) => {
+                    let (ra, rb) = (find(&mut self.parent, a), find(&mut self.parent, b));
+                    if ra != rb {
+                        self.parent[ra.max(rb) as usize] = ra.min(rb);
+                    }
+                    ra.min(rb)
+                }
+            };
+            self.labels[k] = label;
+        }
+        // Area and centroid of each component.
+        let m = self.parent.len();
+        let mut area = vec![0u32; m];
+        let mut sx = vec![0f64; m];
+        let mut sy = vec![0f64; m];
+        for k in 0..n {
+            let l = self.labels[k];
+            if l == u32::MAX {
+                continue;
+            }
+            let root = find(&mut self.parent, l) as usize;
+            area[root] += 1;
+            sx[root] += (k % bw) as f64;
+            sy[root] += (k / bw) as f64;
+        }
+        let [cx, cy] = self.principal_point_px;
+        let (i_n, j_n) = (self.config.rings, self.config.directions);
+        let edges = &self.template.edges_px;
+        let dir_step = TAU / j_n as f64;
+        for root in 0..m {
+            if area[root] == 0 {
+                continue;
+            }
+            let a = area[root] as f64;
+            let u = sx[root] / a + x0 as f64;
+            let v = sy[root] / a + y0 as f64;
+            let (px, py) = (u + 0.5 - cx, cy - (v + 0.5));
+            let r = px.hypot(py);
+            if r < edges[0] || r >= edges[i_n] {
+                continue;
+            }
+            let i = edges.partition_point(|&e| e <= r) - 1;
+            let j = ((py.atan2(px) / dir_step).round() as i64).rem_euclid(j_n as i64) as usize;
+            self.counts[i * j_n + j] += area[root];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibration::HyperbolicFit;
+    use image::Rgba;
+
+    /// The corner paper's f(R) as a table, 256 x 220, principal point at the centre.
+    pub(crate) fn paper_calibration() -> RadialCalibration {
+        let f = HyperbolicFit {
+            a: 10.12,
+            b: 2.054e-2,
+            c: 2.298e5,
+            rms_mm: 0.0,
+        };
+        RadialCalibration {
+            sensor: "omni".into(),
+            width_px: 256,
+            height_px: 220,
+            principal_point_px: [128.0, 110.0],
+            mount_mm: [0.0, 0.0],
+            samples: (0..=440)
+                .map(|k| k as f64 * 0.25)
+                .map(|r| [r, f.floor_distance_mm(r).unwrap()])
+                .collect(),
+            horizon_px: 113.9,
+            fit: None,
+        }
+    }
+
+    const GREEN: Rgba<u8> = Rgba([30, 130, 55, 255]);
+    const GREY: Rgba<u8> = Rgba([90, 90, 90, 255]);
+
+    /// An image whose pixels are floor unless `obstacle(floor point)` says otherwise.
+    fn synthetic(cal: &RadialCalibration, obstacle: impl Fn(Point2<f64>) -> bool) -> RgbaImage {
+        let mut img = RgbaImage::from_pixel(cal.width_px, cal.height_px, GREEN);
+        for (u, v, p) in img.enumerate_pixels_mut() {
+            let (x, y) = cal.image_coords(u as f64, v as f64);
+            match cal.image_to_floor(x, y) {
+                Some(q) if obstacle(q) => *p = GREY,
+                None => *p = GREY,
+                _ => {}
+            }
+        }
+        img
+    }
+
+    #[test]
+    fn an_open_floor_is_free_in_every_direction() {
+        let cal = paper_calibration();
+        let mut d = FreeSpaceDetector::new(FreeSpaceConfig::default(), &cal).unwrap();
+        let fs = d.detect(&synthetic(&cal, |_| false)).unwrap();
+        assert!(fs.a.iter().all(|&a| a == 6), "{:?}", fs.a);
+        assert!(fs.obstacle_points.is_empty());
+        assert!(fs.free_mm.iter().all(|&m| (m - 1000.0).abs() < 1e-6));
+    }
+
+    #[test]
+    fn obstacles_filling_cells_give_the_rings_they_stand_in() {
+        let cal = paper_calibration();
+        for method in [FreeSpaceMethod::Count, FreeSpaceMethod::Labeling] {
+            let config = FreeSpaceConfig {
+                method,
+                spacing: RingSpacing::Floor,
+                ..FreeSpaceConfig::default()
+            };
+            // Edges 200, 333, 467, 600, 733, 867, 1000 mm. Obstacles: beyond 480 mm within 20
+            // degrees of straight ahead (fills ring 2 of directions 31, 0, 1 but only 28% of
+            // direction 2), and beyond 620 mm between 40 and 50 degrees (direction 4, ring 3).
+            let mut d = FreeSpaceDetector::new(config, &cal).unwrap();
+            let img = synthetic(&cal, |q| {
+                let r = q.coords.norm();
+                let phi = q.y.atan2(q.x).to_degrees();
+                (r >= 480.0 && phi.abs() < 20.0) || (r >= 620.0 && (40.0..50.0).contains(&phi))
+            });
+            let fs = d.detect(&img).unwrap();
+            for j in [31, 0, 1] {
+                assert_eq!(fs.a[j], 2, "{method:?} direction {j}: {:?}", fs.a);
+                assert!((fs.free_mm[j] - 1400.0 / 3.0).abs() < 1e-6);
+            }
+            assert_eq!(fs.a[2], 6, "{method:?}: {:?}", fs.a);
+            assert_eq!(fs.a[4], 3, "{method:?}: {:?}", fs.a);
+            assert!((fs.free_mm[4] - 600.0).abs() < 1e-6);
+            for j in 6..=29 {
+                assert_eq!(fs.a[j], 6, "{method:?} direction {j}");
+            }
+            // Obstacle points lie on the near edge of the first obstacle cell, three a direction.
+            assert_eq!(fs.obstacle_points.len(), 12);
+            assert!(
+                fs.obstacle_points
+                    .iter()
+                    .all(|p| (p.coords.norm() - 1400.0 / 3.0).abs() < 1e-6
+                        || (p.coords.norm() - 600.0).abs() < 1e-6)
+            );
+        }
+    }
+
+    #[test]
+    fn small_holes_are_closed_but_a_cube_is_seen() {
+        let cal = paper_calibration();
+        let mut d = FreeSpaceDetector::new(FreeSpaceConfig::default(), &cal).unwrap();
+        // A 130 mm cube at 500 mm to the left, plus single-pixel salt.
+        let mut img = synthetic(&cal, |q| (q.x).abs() <= 65.0 && (q.y - 565.0).abs() <= 65.0);
+        for k in 0..200u32 {
+            img.put_pixel((k * 37) % 256, (k * 53) % 220, GREY);
+        }
+        let fs = d.detect(&img).unwrap();
+        // Direction 8 (90 degrees) sees the cube; its neighbours at +-22.5 degrees do not.
+        assert!(fs.a[8] < 6, "{:?}", fs.a);
+        // The first obstacle ring overlaps the cube's radial extent, 500..630 mm.
+        let edges = d.template().edges_mm();
+        let a = fs.a[8];
+        assert!(
+            edges[a] < 630.0 && edges[a + 1] > 500.0,
+            "{edges:?} a = {a}"
+        );
+        assert_eq!(fs.a[6], 6);
+        assert_eq!(fs.a[10], 6);
+        assert_eq!(fs.a[0], 6);
+    }
+
+    #[test]
+    fn degenerate_templates_are_refused() {
+        let cal = paper_calibration();
+        let bad = FreeSpaceConfig {
+            outer_mm: 1e6,
+            ..FreeSpaceConfig::default()
+        };
+        assert!(FreeSpaceDetector::new(bad, &cal).is_err());
+        let bad = FreeSpaceConfig {
+            r_th: 0.0,
+            ..FreeSpaceConfig::default()
+        };
+        assert!(FreeSpaceDetector::new(bad, &cal).is_err());
+    }
+}
