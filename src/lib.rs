@@ -7,6 +7,7 @@
 //! controllers in `omniloop-control`.
 
 pub mod calibrate;
+pub mod estimator;
 pub mod load;
 pub mod metrics;
 pub mod output;

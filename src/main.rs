@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::{Isometry2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
 use omniloop::output::{default_out_dir, write_run};
-use omniloop::replay::{EXPERIMENTS, corner_table, replay_corner55};
+use omniloop::replay::{EXPERIMENTS, corner_table, places_table, replay_corner55, replay_selfloc};
 use omniloop::runner::{RunOptions, render_snapshot};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice};
@@ -77,7 +77,7 @@ enum Command {
         #[arg(long)]
         no_noise: bool,
     },
-    /// Replay an experiment of the papers: `corner55` (E1, Fig. 7).
+    /// Replay an experiment of the papers: `corner55` (E1, Fig. 7) or `selfloc` (E2, Fig. 8).
     Replay {
         /// The experiment.
         experiment: String,
@@ -207,6 +207,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             bar.finish_and_clear();
             write_run(&dir, &s, &output)?;
             let m = &output.summary;
+            if m.places.is_some() {
+                print!("{}", places_table(m));
+                println!("results in {}", dir.display());
+                return Ok(());
+            }
             println!(
                 "{}: {} cycles, {:.2} s simulated in {:.2} s ({:.0} cycles/s); goal {}; \
                  contacts {}; min clearance {:.1} mm; results in {}",
@@ -260,7 +265,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             renderer,
             quiet,
         } => {
-            if experiment != "corner55" {
+            if !EXPERIMENTS.iter().any(|(n, _)| *n == experiment) {
                 let known: Vec<String> = EXPERIMENTS
                     .iter()
                     .map(|(n, d)| format!("  {n}: {d}"))
@@ -276,19 +281,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 ..RunOptions::default()
             };
             let bar = progress_bar(0, quiet);
-            let runs = replay_corner55(
-                &dir,
-                &options,
-                seed,
-                |name, k, n| {
-                    bar.set_length(n);
-                    bar.set_prefix(name.to_string());
-                    bar.set_position(k);
-                },
-                &mut |msg| eprintln!("{msg}"),
-            )?;
-            bar.finish_and_clear();
-            print!("{}", corner_table(&runs));
+            let progress = |name: &str, k: u64, n: u64| {
+                bar.set_length(n);
+                bar.set_prefix(name.to_string());
+                bar.set_position(k);
+            };
+            let mut notice = |msg: &str| eprintln!("{msg}");
+            if experiment == "selfloc" {
+                let run = replay_selfloc(&dir, &options, seed, progress, &mut notice)?;
+                bar.finish_and_clear();
+                print!("{}", places_table(&run.output.summary));
+            } else {
+                let runs = replay_corner55(&dir, &options, seed, progress, &mut notice)?;
+                bar.finish_and_clear();
+                print!("{}", corner_table(&runs));
+            }
             println!("\nwritten to {}", dir.display());
             Ok(())
         }

@@ -75,6 +75,14 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
         label: "start".into(),
     }];
     if let Some(g) = &scenario.goal {
+        for (k, w) in g.waypoints_mm.iter().enumerate() {
+            markers.push(Marker {
+                at: Point2::new(w[0], w[1]),
+                radius_mm: g.tolerance_mm,
+                rgb: [250, 200, 0],
+                label: format!("waypoint {}", k + 1),
+            });
+        }
         markers.push(Marker {
             at: g.point(),
             radius_mm: g.tolerance_mm,

@@ -101,4 +101,34 @@ pub struct Summary {
     /// (truth ray-cast in the world, clipped at the template's range).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub freespace_error_mm: Option<f64>,
+    /// Median over the run of the distance between the controller's pose estimate and the
+    /// truth.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_error_mm: Option<f64>,
+    /// With waypoints: how many of the targets (waypoints, then the goal) were reached.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub targets_reached: Option<usize>,
+    /// With localization in the loop: how many localizations corrected the pose.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub localization_fixes: Option<usize>,
+    /// Experiment mode: the results at each place.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub places: Option<Vec<PlaceResult>>,
+}
+
+/// Self-localization at one place of an experiment (E2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlaceResult {
+    /// The true pose: x_mm, y_mm, theta_deg.
+    pub true_pose: [f64; 3],
+    /// RMS distance of the localized estimates from the true position.
+    pub rms_position_mm: f64,
+    /// RMS heading error of the localized estimates.
+    pub rms_heading_deg: f64,
+    /// Estimates that took the wrong one of the two half-turn solutions.
+    pub ambiguity_errors: usize,
+    /// Frames taken here.
+    pub frames: usize,
+    /// Frames that gave no estimate.
+    pub not_localized: usize,
 }

@@ -13,10 +13,19 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The experiments `omniloop replay` knows.
-pub const EXPERIMENTS: &[(&str, &str)] = &[(
-    "corner55",
-    "E1: the 55-degree corner, goal-direction vs velocity-aware avoidance (Fig. 7)",
-)];
+pub const EXPERIMENTS: &[(&str, &str)] = &[
+    (
+        "corner55",
+        "E1: the 55-degree corner, goal-direction vs velocity-aware avoidance (Fig. 7)",
+    ),
+    (
+        "selfloc",
+        "E2: floor-region self-localization at six places on the field (Fig. 8)",
+    ),
+];
+
+/// The E2 scenario file, built into the binary.
+pub const SELFLOC: &str = include_str!("../scenarios/selfloc_field.toml");
 
 /// The E1 scenario files, built into the binary so the replay runs from anywhere.
 pub const CORNER55: [(&str, &str); 2] = [
@@ -30,10 +39,118 @@ pub const CORNER55: [(&str, &str); 2] = [
     ),
 ];
 
-/// Parses one of the built-in scenarios.
+/// Parses one of the built-in corner scenarios (`goal_direction`, `velocity_aware`).
 pub fn builtin_scenario(name: &str, text: &str) -> Result<Scenario, LoadError> {
     let file = PathBuf::from(format!("scenarios/corner55_{name}.toml"));
     parse_scenario(text, &file, &format!("corner55_{name}"))
+}
+
+/// Runs E2 (`scenarios/selfloc_field.toml`), writes the run into `out/` and the figure of the
+/// places with their errors (like Fig. 8) and a table into `out/places.png`, `out/places.md`.
+pub fn replay_selfloc(
+    out: &Path,
+    options: &RunOptions,
+    seed: Option<u64>,
+    mut progress: impl FnMut(&str, u64, u64),
+    notice: &mut dyn FnMut(&str),
+) -> anyhow::Result<ReplayRun> {
+    let mut scenario = parse_scenario(
+        SELFLOC,
+        Path::new("scenarios/selfloc_field.toml"),
+        "selfloc_field",
+    )?;
+    if let Some(seed) = seed {
+        scenario.seed = seed;
+    }
+    let output = run_scenario(&scenario, options, &mut *notice, |k, n| {
+        progress("selfloc_field", k, n)
+    })
+    .context("running selfloc_field")?;
+    write_run(out, &scenario, &output)?;
+    draw_places(&out.join("places.png"), &scenario, &output)?;
+    std::fs::write(out.join("places.md"), places_table(&output.summary))
+        .with_context(|| format!("writing {}", out.join("places.md").display()))?;
+    Ok(ReplayRun {
+        name: "selfloc_field".into(),
+        scenario,
+        output,
+    })
+}
+
+/// Fig. 8: the field with its cubes, each place with the robot's outline, its estimates, and
+/// its RMS errors written beside it.
+fn draw_places(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
+    let estimates: Vec<Point2<f64>> = out
+        .trajectory
+        .iter()
+        .filter_map(|r| Some(Point2::new(r.est_x_mm?, r.est_y_mm?)))
+        .collect();
+    let places = out.summary.places.clone().unwrap_or_default();
+    let mut markers = Vec::new();
+    for (k, p) in places.iter().enumerate() {
+        markers.push(Marker {
+            at: Point2::new(p.true_pose[0], p.true_pose[1]),
+            radius_mm: scenario.robot.radius_mm,
+            rgb: [20, 20, 20],
+            label: format!(
+                "{}: {:.1} mm, {:.2} deg",
+                k + 1,
+                p.rms_position_mm,
+                p.rms_heading_deg
+            ),
+        });
+    }
+    let panel = Panel {
+        title: format!("{}: RMS error at each place", scenario.name),
+        layout: &scenario.world,
+        paths: vec![PathLayer {
+            label: "estimates".into(),
+            rgb: [30, 80, 230],
+            points: &estimates,
+            dots: true,
+            discs: None,
+        }],
+        markers,
+    };
+    draw_panels(file, &[panel], 1100)?;
+    Ok(())
+}
+
+/// E2 per place as a Markdown table.
+pub fn places_table(m: &Summary) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# E2: self-localization on the field
+"
+    );
+    let _ = writeln!(
+        s,
+        "Renderer: {}. Seed {}. Paper: errors of \"dozens of mm\" at each place.\n",
+        m.renderer.clone().unwrap_or_else(|| "-".into()),
+        m.seed
+    );
+    let _ = writeln!(
+        s,
+        "| place | x_mm | y_mm | theta_deg | frames | not localized | RMS position (mm) | RMS heading (deg) | ambiguity errors |"
+    );
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for (k, p) in m.places.iter().flatten().enumerate() {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {} |",
+            k + 1,
+            p.true_pose[0],
+            p.true_pose[1],
+            p.true_pose[2],
+            p.frames,
+            p.not_localized,
+            p.rms_position_mm,
+            p.rms_heading_deg,
+            p.ambiguity_errors
+        );
+    }
+    s
 }
 
 /// One run of a replay.

@@ -1,20 +1,21 @@
 //! The closed loop: sense, decide, act, record, once a control period.
 
+use crate::estimator::PoseTracker;
 use crate::metrics::{corner_metrics, median};
+use crate::record::PlaceResult;
 use crate::record::{Summary, TrajectoryRow};
+use crate::scenario::PoseSource;
 use crate::scenario::{ControllerKind, Scenario, controller_name};
-use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
+use nalgebra::{Point2, Rotation2, Vector2};
 use omniloop_control::{
-    AccelLimitedDrive, DeadReckoning, GoToGoal, GoalDirection, Surroundings, VelocityAware,
-    VelocityCommand,
+    AccelLimitedDrive, GoToGoal, GoalDirection, Surroundings, VelocityAware, VelocityCommand,
 };
 use omniloop_sim::{
     RenderError, Renderer, RendererChoice, Scene, Sensor, SensorNoise, SimError, World,
 };
-use omniloop_vision::{FreeSpace, FreeSpaceDetector, RadialCalibration, VisionError};
-use rand::rngs::StdRng;
-use rand::{RngExt, SeedableRng};
-use rand_distr::StandardNormal;
+use omniloop_vision::{
+    FloorLocalizer, FreeSpace, FreeSpaceDetector, Localization, RadialCalibration, VisionError,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -100,31 +101,10 @@ struct Vision {
     mount_mm: [f64; 2],
 }
 
-/// Wheel odometry: the true body velocity with seeded errors, dead-reckoned.
-struct Odometry {
-    reckoning: DeadReckoning,
-    rng: StdRng,
-    speed_noise_frac: f64,
-    omega_noise_rad_s: f64,
-    start: Isometry2<f64>,
-}
-
-impl Odometry {
-    fn measure(&mut self, v_world: Vector2<f64>, heading: f64, omega: f64, dt: f64) {
-        let v_body = Rotation2::new(-heading) * v_world;
-        let mut n = || self.rng.sample::<f64, _>(StandardNormal);
-        let noisy = Vector2::new(
-            v_body.x * (1.0 + self.speed_noise_frac * n()),
-            v_body.y * (1.0 + self.speed_noise_frac * n()),
-        );
-        let w = omega + self.omega_noise_rad_s * n();
-        self.reckoning.update(noisy, w, dt);
-    }
-
-    /// The dead-reckoned pose in the world frame.
-    fn world_pose(&self) -> Isometry2<f64> {
-        self.start * self.reckoning.pose()
-    }
+/// Floor-region self-localization on one sensor's images.
+struct Localizer {
+    sensor: usize,
+    localizer: FloorLocalizer,
 }
 
 /// A scenario being run, one control cycle at a time.
@@ -133,8 +113,11 @@ pub struct Simulation {
     world: World,
     brain: Brain,
     vision: Option<Vision>,
-    odometry: Odometry,
-    goal_start: Option<Vector2<f64>>,
+    localizer: Option<Localizer>,
+    tracker: PoseTracker,
+    targets: Vec<Point2<f64>>,
+    next_target: usize,
+    pose_errors_mm: Vec<f64>,
     movers: Vec<Mover>,
     cycle: u64,
     time_to_goal_s: Option<f64>,
@@ -189,12 +172,28 @@ impl Simulation {
                 scenario.run.control_period_s,
             )?),
         };
-        let vision = if scenario.control.kind.uses_vision() {
-            let index = match &scenario.vision.sensor {
+        let localizes = scenario.experiment.is_some()
+            || (scenario.control.kind.uses_vision()
+                && scenario.control.pose_source == PoseSource::Localization);
+        let vision_sensor = || -> Result<usize, RunError> {
+            Ok(match &scenario.vision.sensor {
                 Some(n) => r.sensors.iter().position(|s| &s.name == n),
                 None => (!r.sensors.is_empty()).then_some(0),
             }
-            .ok_or_else(|| SimError::Invalid("vision needs a sensor".into()))?;
+            .ok_or_else(|| SimError::Invalid("vision needs a sensor".into()))?)
+        };
+        let localizer = if localizes {
+            let index = vision_sensor()?;
+            let cal = vision_calibration(scenario, index)?;
+            Some(Localizer {
+                sensor: index,
+                localizer: FloorLocalizer::new(scenario.vision.localization.clone(), &cal)?,
+            })
+        } else {
+            None
+        };
+        let vision = if scenario.control.kind.uses_vision() && scenario.experiment.is_none() {
+            let index = vision_sensor()?;
             let cal = vision_calibration(scenario, index)?;
             let detector = FreeSpaceDetector::new(scenario.vision.freespace.clone(), &cal)?;
             let range_mm = *detector.template().edges_mm().last().expect("edges");
@@ -222,7 +221,7 @@ impl Simulation {
             });
         }
         let needs_images = !scenario.robot.sensors.is_empty()
-            && (vision.is_some() || options.save_frames_every.is_some());
+            && (vision.is_some() || localizer.is_some() || options.save_frames_every.is_some());
         let eyes = if needs_images {
             let renderer = Renderer::new(options.renderer, notice)?;
             let mut sensors = Vec::new();
@@ -236,23 +235,22 @@ impl Simulation {
         } else {
             None
         };
-        let start = scenario.robot.start.isometry();
-        let goal_start = scenario
-            .goal
-            .as_ref()
-            .map(|g| start.inverse_transform_point(&g.point()).coords);
+        let tracker = PoseTracker::new(
+            scenario.robot.start.isometry(),
+            &scenario.odometry,
+            scenario.control.pose_source,
+            scenario.control.localization_gain,
+            scenario.seed,
+        );
         Ok(Self {
             scenario: scenario.clone(),
             brain,
             vision,
-            odometry: Odometry {
-                reckoning: DeadReckoning::new(),
-                rng: StdRng::seed_from_u64(scenario.seed ^ 0x0D0_3E7E_u64),
-                speed_noise_frac: scenario.odometry.speed_noise_frac,
-                omega_noise_rad_s: scenario.odometry.omega_noise_rad_s,
-                start,
-            },
-            goal_start,
+            localizer,
+            tracker,
+            targets: scenario.goal.as_ref().map_or(Vec::new(), |g| g.targets()),
+            next_target: 0,
+            pose_errors_mm: Vec::new(),
             eyes,
             options: options.clone(),
             world,
@@ -360,13 +358,22 @@ impl Simulation {
             self.score_freespace(fs, *range, *mount);
         }
 
-        let goal_body = self.goal_start.map(|g| self.odometry.reckoning.to_body(g));
-        let v_body = self.odometry.reckoning.velocity_body_mm_s();
+        if let Some(l) = &mut self.localizer {
+            let prior = self.tracker.estimate();
+            if let Localization::Localized(e) =
+                l.localizer.locate(&frames[l.sensor], Some(&prior))?
+            {
+                self.tracker.correct(&e);
+            }
+        }
+        let target = self.targets.get(self.next_target).copied();
+        let goal_body = target.map(|g| self.tracker.to_body(g));
+        let v_body = self.tracker.velocity_body_mm_s();
         let body_command =
             |v: Vector2<f64>| VelocityCommand::translate(Rotation2::new(heading) * v);
         let command = match (&self.brain, &freespace, goal_body) {
-            (Brain::Truth(c), _, _) => match &self.scenario.goal {
-                Some(g) => c.command(state.pose.translation.vector, g.point().coords),
+            (Brain::Truth(c), _, _) => match target {
+                Some(g) => c.command(state.pose.translation.vector, g.coords),
                 None => VelocityCommand::STOP,
             },
             (Brain::GoalDirection(c), Some((fs, range, _)), Some(goal)) => {
@@ -410,36 +417,106 @@ impl Simulation {
             self.world.set_command(k + 1, cmd);
         }
         let row = self.row(t, command);
+        if let (Some(x), Some(y)) = (row.est_x_mm, row.est_y_mm) {
+            self.pose_errors_mm.push((x - row.x_mm).hypot(y - row.y_mm));
+        }
         self.trajectory.push(row);
 
         let dt = self.scenario.run.control_period_s;
         self.world.advance(dt);
         self.cycle += 1;
         let after = self.world.robot_state(0);
-        self.odometry.measure(
+        self.tracker.measure(
             after.velocity_mm_s,
             after.pose.rotation.angle(),
             after.omega_rad_s,
             dt,
         );
-        if let (None, Some(g)) = (self.time_to_goal_s, &self.scenario.goal) {
+        if let (Some(g), Some(t)) = (&self.scenario.goal, self.targets.get(self.next_target)) {
             let p = after.pose.translation.vector;
-            if (p - g.point().coords).norm() <= g.tolerance_mm {
-                self.time_to_goal_s = Some(self.world.time_s());
+            if (p - t.coords).norm() <= g.tolerance_mm {
+                self.next_target += 1;
+                if self.next_target == self.targets.len() {
+                    self.time_to_goal_s = Some(self.world.time_s());
+                }
             }
         }
         Ok(())
     }
 
+    /// Experiment mode (E2): carries the robot to each place, localizes it there in
+    /// `frames_per_place` frames with fresh noise, and scores the estimates per place.
+    pub fn run_places(
+        &mut self,
+        mut progress: impl FnMut(u64, u64),
+    ) -> Result<Vec<PlaceResult>, RunError> {
+        let Some(exp) = self.scenario.experiment.clone() else {
+            return Ok(Vec::new());
+        };
+        let total = exp.places.len() as u64 * exp.frames_per_place as u64;
+        let dt = self.scenario.run.control_period_s;
+        let mut results = Vec::new();
+        for place in &exp.places {
+            let truth = place.isometry();
+            self.world.place_robot(0, truth);
+            let (mut sq_pos, mut sq_head, mut n_ok, mut ambiguous, mut missing) =
+                (0.0, 0.0, 0usize, 0usize, 0usize);
+            for _ in 0..exp.frames_per_place {
+                let frames = self.sense()?;
+                self.save_frames(&frames)?;
+                let t = self.world.time_s();
+                let mut row = self.row(t, VelocityCommand::STOP);
+                let l = self.localizer.as_mut().expect("experiment mode localizes");
+                match l.localizer.locate(&frames[l.sensor], None)? {
+                    Localization::Localized(e) => {
+                        let err = |q: &nalgebra::Isometry2<f64>| {
+                            (q.translation.vector - truth.translation.vector).norm()
+                        };
+                        if err(&e.alternative) < err(&e.pose) {
+                            ambiguous += 1;
+                        }
+                        let dh = (e.pose.rotation.angle() - truth.rotation.angle())
+                            .sin()
+                            .atan2((e.pose.rotation.angle() - truth.rotation.angle()).cos());
+                        sq_pos += err(&e.pose).powi(2);
+                        sq_head += dh.powi(2);
+                        n_ok += 1;
+                        row.est_x_mm = Some(e.pose.translation.x);
+                        row.est_y_mm = Some(e.pose.translation.y);
+                        row.est_theta_rad = Some(e.pose.rotation.angle());
+                        self.pose_errors_mm.push(err(&e.pose));
+                    }
+                    Localization::NotLocalized(_) => missing += 1,
+                }
+                self.trajectory.push(row);
+                self.world.advance(dt);
+                self.cycle += 1;
+                progress(self.cycle, total);
+            }
+            let rms = |sq: f64| {
+                if n_ok > 0 {
+                    (sq / n_ok as f64).sqrt()
+                } else {
+                    f64::NAN
+                }
+            };
+            results.push(PlaceResult {
+                true_pose: [place.x_mm, place.y_mm, place.heading_deg],
+                rms_position_mm: rms(sq_pos),
+                rms_heading_deg: rms(sq_head).to_degrees(),
+                ambiguity_errors: ambiguous,
+                frames: exp.frames_per_place as usize,
+                not_localized: missing,
+            });
+        }
+        Ok(results)
+    }
+
     /// The trajectory row of the current state with `command`.
     fn row(&self, t: f64, command: VelocityCommand) -> TrajectoryRow {
         let s = self.world.robot_state(0);
-        let est = self
-            .scenario
-            .control
-            .kind
-            .uses_vision()
-            .then(|| self.odometry.world_pose());
+        let est = (self.scenario.control.kind.uses_vision() && self.scenario.experiment.is_none())
+            .then(|| self.tracker.estimate());
         TrajectoryRow {
             t_s: t,
             x_mm: s.pose.translation.x,
@@ -457,9 +534,11 @@ impl Simulation {
 
     /// Ends the run: the summary and everything recorded.
     pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
-        // The final state closes the trajectory.
-        let last = self.row(self.world.time_s(), self.world.command(0));
-        self.trajectory.push(last);
+        // The final state closes the trajectory (driving runs only).
+        if self.scenario.experiment.is_none() {
+            let last = self.row(self.world.time_s(), self.world.command(0));
+            self.trajectory.push(last);
+        }
         for (k, path) in self.other_paths.iter_mut().enumerate() {
             path.push(Point2::from(
                 self.world.robot_state(k + 1).pose.translation.vector,
@@ -497,6 +576,10 @@ impl Simulation {
             turn_onset_mm: corner.and_then(|c| c.turn_onset_mm),
             overshoot_mm: corner.map(|c| c.overshoot_mm),
             freespace_error_mm: median(&self.freespace_errors_mm),
+            pose_error_mm: median(&self.pose_errors_mm),
+            targets_reached: (self.targets.len() > 1).then_some(self.next_target),
+            localization_fixes: self.localizer.as_ref().map(|_| self.tracker.fixes().0),
+            places: None,
         };
         RunOutput {
             summary,
@@ -521,6 +604,12 @@ pub fn run_scenario(
         })?;
     }
     let mut sim = Simulation::new(scenario, options, notice)?;
+    if scenario.experiment.is_some() {
+        let places = sim.run_places(progress)?;
+        let mut out = sim.finish(start.elapsed().as_secs_f64());
+        out.summary.places = Some(places);
+        return Ok(out);
+    }
     let max = scenario.max_cycles();
     while !sim.finished() {
         sim.step()?;

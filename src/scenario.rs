@@ -6,7 +6,7 @@
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::AvoidanceConfig;
 use omniloop_sim::{Layout, Rgb, SensorSpec};
-use omniloop_vision::FreeSpaceConfig;
+use omniloop_vision::{FreeSpaceConfig, LocalizationConfig};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -49,6 +49,26 @@ pub struct Scenario {
     /// Experiment metrics to compute.
     #[serde(default)]
     pub metrics: MetricsSpec,
+    /// Experiment mode: carry the robot to places and estimate its pose there, instead of
+    /// driving.
+    #[serde(default)]
+    pub experiment: Option<ExperimentSpec>,
+}
+
+/// Experiment mode (E2): the robot is put at each place in turn and estimates its pose
+/// `frames_per_place` times there, with fresh sensor noise in every frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentSpec {
+    /// The places (field frame).
+    pub places: Vec<PoseSpec>,
+    /// Estimates at each place.
+    #[serde(default = "default_frames_per_place")]
+    pub frames_per_place: u32,
+}
+
+fn default_frames_per_place() -> u32 {
+    10
 }
 
 fn default_seed() -> u64 {
@@ -192,10 +212,13 @@ fn default_other_rgb() -> Rgb {
     Rgb([200, 40, 160])
 }
 
-/// The goal point.
+/// The goal point, reached through optional waypoints.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GoalSpec {
+    /// Points to pass (within the tolerance) in order before the goal point.
+    #[serde(default)]
+    pub waypoints_mm: Vec<[f64; 2]>,
     /// x of the goal point (world frame).
     pub x_mm: f64,
     /// y of the goal point (world frame).
@@ -213,6 +236,15 @@ impl GoalSpec {
     /// The goal point.
     pub fn point(&self) -> Point2<f64> {
         Point2::new(self.x_mm, self.y_mm)
+    }
+
+    /// The waypoints and then the goal point.
+    pub fn targets(&self) -> Vec<Point2<f64>> {
+        self.waypoints_mm
+            .iter()
+            .map(|w| Point2::new(w[0], w[1]))
+            .chain(std::iter::once(self.point()))
+            .collect()
     }
 }
 
@@ -240,13 +272,41 @@ impl ControllerKind {
 }
 
 /// How the robot chooses its velocity.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ControlSpec {
     /// The controller.
     pub kind: ControllerKind,
     /// Settings of the avoidance controllers.
     pub avoidance: AvoidanceConfig,
+    /// Where the vision controllers' pose comes from.
+    pub pose_source: PoseSource,
+    /// With `pose_source = "localization"`: how far each localization pulls the dead-reckoned
+    /// pose toward itself (0: odometry only, 1: jump to the measurement).
+    pub localization_gain: f64,
+}
+
+/// Where the vision controllers' pose estimate comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseSource {
+    /// Dead reckoning from wheel odometry alone (the goal is given in the start frame).
+    #[default]
+    Odometry,
+    /// Odometry corrected by floor-region self-localization every cycle (the goal and the
+    /// start are in the field frame).
+    Localization,
+}
+
+impl Default for ControlSpec {
+    fn default() -> Self {
+        Self {
+            kind: ControllerKind::default(),
+            avoidance: AvoidanceConfig::default(),
+            pose_source: PoseSource::Odometry,
+            localization_gain: 0.3,
+        }
+    }
 }
 
 /// Image processing settings.
@@ -260,9 +320,12 @@ pub struct VisionSpec {
     pub calibration_file: Option<PathBuf>,
     /// Free-space detection (Sect. 3.1 of the corner paper).
     pub freespace: FreeSpaceConfig,
+    /// Self-localization from the floor region (Sect. 4 of the corner paper).
+    pub localization: LocalizationConfig,
 }
 
-/// The robot's wheel odometry: the true body velocity with seeded Gaussian errors.
+/// The robot's wheel odometry: the true body velocity with systematic and seeded Gaussian
+/// errors.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct OdometrySpec {
@@ -270,6 +333,10 @@ pub struct OdometrySpec {
     pub speed_noise_frac: f64,
     /// Standard deviation of the rotation-rate error.
     pub omega_noise_rad_s: f64,
+    /// Systematic scale error of the measured speed (e.g. a wheel radius off by this fraction).
+    pub scale_bias_frac: f64,
+    /// Systematic rotation-rate error (gyro bias, wheel slip).
+    pub omega_bias_rad_s: f64,
 }
 
 impl Default for OdometrySpec {
@@ -277,6 +344,8 @@ impl Default for OdometrySpec {
         Self {
             speed_noise_frac: 0.01,
             omega_noise_rad_s: 0.0,
+            scale_bias_frac: 0.0,
+            omega_bias_rad_s: 0.0,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Validation of a parsed scenario: every rule a value must satisfy, checked once, each
 //! failure naming the dotted path of the field it concerns.
 
-use crate::scenario::{ControllerKind, PoseSpec, Scenario};
+use crate::scenario::{ControllerKind, PoseSource, PoseSpec, Scenario};
 use nalgebra::Point2;
 use omniloop_sim::{Layout, SensorSpec};
 use std::fmt;
@@ -335,6 +335,7 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
             format!("must be >= 0 (got {})", a.extra_horizon_s),
         );
     }
+    check_localization(c, s);
     let o = &s.odometry;
     for (key, v) in [
         ("speed_noise_frac", o.speed_noise_frac),
@@ -344,6 +345,13 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
             c.fail(format!("odometry.{key}"), format!("must be >= 0 (got {v})"));
         }
     }
+    if !(o.scale_bias_frac.is_finite() && o.scale_bias_frac > -1.0) {
+        c.fail(
+            "odometry.scale_bias_frac",
+            format!("must be > -1 (got {})", o.scale_bias_frac),
+        );
+    }
+    c.finite("odometry.omega_bias_rad_s", o.omega_bias_rad_s);
     if !s.control.kind.uses_vision() {
         return;
     }
@@ -400,6 +408,115 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
     }
     if let Err(e) = omniloop_vision::freespace::PolarTemplate::new(fs, &cal) {
         c.fail("vision.freespace", e.to_string());
+    }
+}
+
+fn check_localization(c: &mut Checker, s: &Scenario) {
+    let l = &s.vision.localization;
+    let f = &l.field;
+    c.positive("vision.localization.field.a1_mm", f.a1_mm);
+    if f.a2_mm.is_nan() || f.a2_mm <= f.a1_mm {
+        c.fail(
+            "vision.localization.field.a2_mm",
+            format!("must exceed a1_mm = {} (got {})", f.a1_mm, f.a2_mm),
+        );
+    }
+    c.positive(
+        "vision.localization.field.goal_half_width_mm",
+        f.goal_half_width_mm,
+    );
+    if f.b_mm.is_nan() || f.b_mm <= f.goal_half_width_mm {
+        c.fail(
+            "vision.localization.field.b_mm",
+            format!(
+                "must exceed goal_half_width_mm = {} (got {})",
+                f.goal_half_width_mm, f.b_mm
+            ),
+        );
+    }
+    for (key, class) in [("goal_pos_x", &l.goal_pos_x), ("goal_neg_x", &l.goal_neg_x)] {
+        for (sub, r) in [("r", class.r), ("g", class.g)] {
+            if !(0.0..=1.0).contains(&r[0]) || !(0.0..=1.0).contains(&r[1]) || r[0] > r[1] {
+                c.fail(
+                    format!("vision.localization.{key}.{sub}"),
+                    format!("must be [min, max] within 0..1 (got [{}, {}])", r[0], r[1]),
+                );
+            }
+        }
+    }
+    if l.max_radius_frac.is_nan() || l.max_radius_frac <= 0.0 || l.max_radius_frac > 1.0 {
+        c.fail(
+            "vision.localization.max_radius_frac",
+            format!("must lie in (0, 1] (got {})", l.max_radius_frac),
+        );
+    }
+    c.positive("vision.localization.gate_initial_mm", l.gate_initial_mm);
+    c.positive("vision.localization.gate_mm", l.gate_mm);
+    c.positive(
+        "vision.localization.offset_threshold_mm",
+        l.offset_threshold_mm,
+    );
+    c.positive(
+        "vision.localization.rotation_threshold_rad",
+        l.rotation_threshold_rad,
+    );
+    if l.max_iterations == 0 {
+        c.fail("vision.localization.max_iterations", "must be >= 1");
+    }
+    let g = s.control.localization_gain;
+    if g.is_nan() || !(0.0..=1.0).contains(&g) {
+        c.fail(
+            "control.localization_gain",
+            format!("must lie in [0, 1] (got {g})"),
+        );
+    }
+    let localizes = s.experiment.is_some() || s.control.pose_source == PoseSource::Localization;
+    if localizes && s.world.field.is_none() {
+        c.fail(
+            if s.experiment.is_some() {
+                "experiment"
+            } else {
+                "control.pose_source"
+            },
+            "self-localization matches the floor region to the field: add [world.field]",
+        );
+    }
+    if s.control.pose_source == PoseSource::Localization && !s.control.kind.uses_vision() {
+        c.fail(
+            "control.pose_source",
+            "only the vision controllers (goal_direction, velocity_aware) use a pose estimate",
+        );
+    }
+    if let Some(e) = &s.experiment {
+        if e.places.is_empty() {
+            c.fail("experiment.places", "needs at least one place");
+        }
+        if e.frames_per_place == 0 {
+            c.fail("experiment.frames_per_place", "must be >= 1");
+        }
+        for (i, p) in e.places.iter().enumerate() {
+            c.pose_in_world(
+                &format!("experiment.places[{i}]"),
+                p,
+                s.robot.radius_mm,
+                &s.world,
+            );
+        }
+        let mirror = s
+            .vision
+            .sensor
+            .as_ref()
+            .map_or(s.robot.sensors.first(), |n| {
+                s.robot.sensors.iter().find(|x| &x.name == n)
+            })
+            .is_some_and(|x| x.pinhole.is_none() && x.optics_present().len() == 1);
+        if !mirror {
+            c.fail(
+                "experiment",
+                "localization needs a mirror sensor on the robot ([[robot.sensors]], or \
+                 vision.sensor naming one)",
+            );
+        }
     }
 }
 

@@ -226,6 +226,20 @@ impl World {
         self.robots[i].command
     }
 
+    /// Puts robot `i` at `pose`, at rest, with its command cleared (an experimenter carrying
+    /// the robot to a place). Contacts and statistics carry on.
+    pub fn place_robot(&mut self, i: usize, pose: Isometry2<f64>) {
+        let r = &mut self.robots[i];
+        r.command = VelocityCommand::STOP;
+        let body = &mut self.physics.bodies[r.body];
+        body.set_position(
+            Pose::new(vec(pose.translation.vector), pose.rotation.angle() as Real),
+            true,
+        );
+        body.set_linvel(Vector::ZERO, true);
+        body.set_angvel(0.0, true);
+    }
+
     /// Position, heading and velocity of robot `i`.
     pub fn robot_state(&self, i: usize) -> RobotState {
         let body = &self.physics.bodies[self.robots[i].body];
@@ -458,6 +472,20 @@ mod tests {
         w.advance(3.0);
         assert_eq!(w.stats(0).contacts, 0);
         assert!((w.stats(0).min_clearance_mm - 10.0).abs() < 0.5);
+    }
+
+    #[test]
+    fn a_placed_robot_is_where_it_was_put_and_at_rest() {
+        let mut w = World::new(&Layout::default(), &[robot_at(0.0, 0.0)], 0.002).unwrap();
+        w.set_command(0, VelocityCommand::translate(Vector2::new(300.0, 0.0)));
+        w.advance(0.5);
+        w.place_robot(0, Isometry2::new(Vector2::new(-400.0, 250.0), 1.0));
+        let s = w.robot_state(0);
+        assert!((s.pose.translation.vector - Vector2::new(-400.0, 250.0)).norm() < 1e-3);
+        assert!((s.pose.rotation.angle() - 1.0).abs() < 1e-6);
+        assert_eq!(s.velocity_mm_s, Vector2::zeros());
+        w.advance(0.1);
+        assert!((w.robot_state(0).pose.translation.x + 400.0).abs() < 1e-3);
     }
 
     #[test]

@@ -512,7 +512,7 @@ impl FreeSpaceDetector {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::calibration::HyperbolicFit;
     use image::Rgba;

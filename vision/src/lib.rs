@@ -4,10 +4,15 @@
 //! map, never a simulated world, so it works the same on a real camera's PNG.
 
 pub mod calibration;
+pub mod floor_localization;
 pub mod freespace;
+pub mod geometry;
 pub mod mask;
 
 pub use calibration::{HyperbolicFit, RadialCalibration};
+pub use floor_localization::{
+    ColorClass, FieldModel, FloorLocalizer, Localization, LocalizationConfig, PoseEstimate,
+};
 pub use freespace::{FreeSpace, FreeSpaceConfig, FreeSpaceDetector, FreeSpaceMethod};
 pub use mask::{FloorColor, Mask};
 

@@ -1,0 +1,697 @@
+//! Self-localization from the shape of the floor region (Sect. 4 of the corner paper).
+//!
+//! 1. Extract the floor by colour and clean it with dilation/erosion.
+//! 2. Boundary points: the outermost floor pixels of every image row (`X_min`, `X_max`) and, so
+//!    that the near-horizontal parts of the boundary are sampled too, of every column.
+//! 3. (with 4.) Convert the points to the floor through `f(R)` (eqs. (1)-(4)) and take their
+//!    convex hull there. The hull restores the parts of the boundary hidden by obstacles; it is
+//!    taken on the floor rather than in the image because the mirror bows straight floor lines
+//!    toward the image centre, so the floor region is not convex in the image.
+//! 5. Area moments of the hull by triangles (eq. (9)), centre of gravity (eq. (10)) and the long
+//!    principal axis (eqs. (11)-(12)): a first estimate of where the field centre and axis are.
+//! 6. In the frame of that estimate (eqs. (13)-(14)) each boundary point is assigned to the
+//!    nearest of the six lines of Fig. 6 (goal backs x = +-A2 within the goal mouth, goal lines
+//!    x = +-A1 beside it, touchlines y = +-B) when it is near enough, and eq. (15),
+//!    `J = sum w_i d_i^2` with `w_i = 1 / (df/dR(R_i))^2`, is minimised over the offset and
+//!    rotation of the field, linearised for small rotation; the estimate is updated (eqs.
+//!    (16)-(18)) and the step repeated until the update is below its thresholds.
+//! 7. The robot's pose in the field frame (eqs. (19)-(21)) has two solutions a half turn apart;
+//!    the blue and yellow goals seen in the image choose between them.
+
+use crate::VisionError;
+use crate::calibration::RadialCalibration;
+use crate::geometry::{Moments, convex_hull};
+use crate::mask::{FloorColor, Mask};
+use image::RgbaImage;
+use nalgebra::{Isometry2, Matrix3, Point2, Rotation2, Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+
+/// The floor region's outline (Fig. 6 of the corner paper).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FieldModel {
+    /// A1: field centre to goal line.
+    pub a1_mm: f64,
+    /// A2: field centre to goal back.
+    pub a2_mm: f64,
+    /// B: field centre to touchline.
+    pub b_mm: f64,
+    /// Half the width of the goal mouth.
+    pub goal_half_width_mm: f64,
+}
+
+impl Default for FieldModel {
+    fn default() -> Self {
+        Self {
+            a1_mm: 1370.0,
+            a2_mm: 1550.0,
+            b_mm: 762.5,
+            goal_half_width_mm: 250.0,
+        }
+    }
+}
+
+/// A colour class by chromaticity: `r = R / (R + G + B)` and `g = G / (R + G + B)` within their
+/// ranges, and `R + G + B` at least `min_sum` (so dark, noisy pixels are left out). Shading
+/// changes brightness, not chromaticity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColorClass {
+    /// Range of `R / (R + G + B)`.
+    pub r: [f64; 2],
+    /// Range of `G / (R + G + B)`.
+    pub g: [f64; 2],
+    /// Smallest `R + G + B`.
+    pub min_sum: u32,
+}
+
+impl ColorClass {
+    /// Whether a pixel belongs to the class.
+    pub fn contains(&self, p: [u8; 3]) -> bool {
+        let s = p[0] as u32 + p[1] as u32 + p[2] as u32;
+        if s < self.min_sum.max(1) {
+            return false;
+        }
+        // r in [r0, r1] <=> r0 s <= R <= r1 s (no division).
+        let (rr, gg, ss) = (p[0] as f64, p[1] as f64, s as f64);
+        rr >= self.r[0] * ss && rr <= self.r[1] * ss && gg >= self.g[0] * ss && gg <= self.g[1] * ss
+    }
+}
+
+/// Settings of the self-localization (`[vision.localization]` in scenarios).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LocalizationConfig {
+    /// Floor colour.
+    pub floor: FloorColor,
+    /// Dilation/erosion passes cleaning the floor mask.
+    pub morphology_iterations: u32,
+    /// The field's outline.
+    pub field: FieldModel,
+    /// Colour of the goal at +x (yellow).
+    pub goal_pos_x: ColorClass,
+    /// Colour of the goal at -x (blue).
+    pub goal_neg_x: ColorClass,
+    /// Fewest pixels of a goal colour that count as seeing that goal.
+    pub min_goal_pixels: usize,
+    /// Boundary points beyond this fraction of the horizon radius are left out.
+    pub max_radius_frac: f64,
+    /// Fewest floor pixels for an attempt.
+    pub min_floor_pixels: usize,
+    /// A point joins a line when it is this close to it, in the first two iterations.
+    pub gate_initial_mm: f64,
+    /// ... and this close afterwards.
+    pub gate_mm: f64,
+    /// Iterations of eqs. (15)-(18) at most.
+    pub max_iterations: usize,
+    /// Stop when the offset update is below this (a_th, b_th).
+    pub offset_threshold_mm: f64,
+    /// Stop when the rotation update is below this (zeta_th).
+    pub rotation_threshold_rad: f64,
+}
+
+impl Default for LocalizationConfig {
+    fn default() -> Self {
+        Self {
+            floor: FloorColor::default(),
+            morphology_iterations: 1,
+            field: FieldModel::default(),
+            goal_pos_x: ColorClass {
+                r: [0.45, 0.65],
+                g: [0.34, 0.50],
+                min_sum: 120,
+            },
+            goal_neg_x: ColorClass {
+                r: [0.0, 0.22],
+                g: [0.08, 0.32],
+                min_sum: 90,
+            },
+            min_goal_pixels: 8,
+            max_radius_frac: 0.95,
+            min_floor_pixels: 2000,
+            gate_initial_mm: 200.0,
+            gate_mm: 60.0,
+            max_iterations: 30,
+            offset_threshold_mm: 0.05,
+            rotation_threshold_rad: 1e-5,
+        }
+    }
+}
+
+/// How good a pose estimate is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalizationQuality {
+    /// Weighted RMS distance of the used boundary points to their lines, mm.
+    pub rms_residual_mm: f64,
+    /// Boundary points used in the final fit.
+    pub points: usize,
+    /// How many of the six lines had points.
+    pub lines: usize,
+    /// Iterations of eqs. (15)-(18).
+    pub iterations: usize,
+    /// Whether the goal colours decided between the two solutions (otherwise the prior did, or
+    /// nothing did).
+    pub resolved_by_goals: bool,
+}
+
+/// A pose of the robot in the field frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseEstimate {
+    /// The chosen solution.
+    pub pose: Isometry2<f64>,
+    /// The other solution of eq. (19), a half turn about the field centre away.
+    pub alternative: Isometry2<f64>,
+    /// Quality figures.
+    pub quality: LocalizationQuality,
+}
+
+/// The outcome of one attempt.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Localization {
+    /// A pose.
+    Localized(PoseEstimate),
+    /// No pose, and why.
+    NotLocalized(String),
+}
+
+impl Localization {
+    /// The estimate, if any.
+    pub fn estimate(&self) -> Option<&PoseEstimate> {
+        match self {
+            Localization::Localized(e) => Some(e),
+            Localization::NotLocalized(_) => None,
+        }
+    }
+}
+
+/// A boundary point on the floor with its fit weight.
+#[derive(Debug, Clone, Copy)]
+struct BoundaryPoint {
+    p: Point2<f64>,
+    w: f64,
+}
+
+/// Localizes a robot from images of one calibrated sensor.
+#[derive(Debug, Clone)]
+pub struct FloorLocalizer {
+    config: LocalizationConfig,
+    cal: RadialCalibration,
+    mask: Mask,
+    scratch: Vec<u8>,
+}
+
+fn wrap_pi(a: f64) -> f64 {
+    let w = a.rem_euclid(TAU);
+    if w > PI { w - TAU } else { w }
+}
+
+impl FloorLocalizer {
+    /// A localizer for images of the sensor `cal` describes.
+    pub fn new(config: LocalizationConfig, cal: &RadialCalibration) -> Result<Self, VisionError> {
+        cal.validate()?;
+        let f = &config.field;
+        if !(f.a1_mm > 0.0
+            && f.a2_mm > f.a1_mm
+            && f.b_mm > f.goal_half_width_mm
+            && f.goal_half_width_mm > 0.0)
+        {
+            return Err(VisionError::InvalidParameter {
+                name: "field (a1_mm, a2_mm, b_mm, goal_half_width_mm)",
+                value: f.a1_mm,
+                rule: "need 0 < a1 < a2 and 0 < goal_half_width < b",
+            });
+        }
+        if !(config.max_radius_frac > 0.0 && config.max_radius_frac <= 1.0) {
+            return Err(VisionError::InvalidParameter {
+                name: "max_radius_frac",
+                value: config.max_radius_frac,
+                rule: "must lie in (0, 1]",
+            });
+        }
+        Ok(Self {
+            config,
+            cal: cal.clone(),
+            mask: Mask::new(0, 0),
+            scratch: Vec::new(),
+        })
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &LocalizationConfig {
+        &self.config
+    }
+
+    /// Localizes from one image; with `prior` (a pose in the field frame, e.g. from odometry)
+    /// the solution nearer to it is taken when no goal is seen.
+    pub fn locate(
+        &mut self,
+        img: &RgbaImage,
+        prior: Option<&Isometry2<f64>>,
+    ) -> Result<Localization, VisionError> {
+        if img.width() != self.cal.width_px || img.height() != self.cal.height_px {
+            return Err(VisionError::InvalidParameter {
+                name: "image width (px)",
+                value: img.width() as f64,
+                rule: "must match the calibrated sensor's image size",
+            });
+        }
+        // Step 1, on the square around the circle where boundary points are taken.
+        let region = self.region();
+        self.mask.binarize_region(img, &self.config.floor, region);
+        self.mask
+            .clean(self.config.morphology_iterations, &mut self.scratch);
+        let floor_pixels = self.mask.data.iter().filter(|&&m| m != 0).count();
+        if floor_pixels < self.config.min_floor_pixels {
+            return Ok(Localization::NotLocalized(format!(
+                "floor region too small ({floor_pixels} pixels, need {})",
+                self.config.min_floor_pixels
+            )));
+        }
+        // Steps 2 and 4.
+        let points = self.boundary_points();
+        if points.len() < 20 {
+            return Ok(Localization::NotLocalized(format!(
+                "too few floor boundary points ({})",
+                points.len()
+            )));
+        }
+        // Step 3 (on the floor) and 5.
+        let pts: Vec<Point2<f64>> = points.iter().map(|b| b.p).collect();
+        let hull = convex_hull(&pts);
+        let m = Moments::of_polygon(&hull);
+        let f = &self.config.field;
+        let field_area = 4.0 * f.a1_mm * f.b_mm;
+        if hull.len() < 3 || m.m00 < 0.1 * field_area {
+            return Ok(Localization::NotLocalized(format!(
+                "floor region hull too small ({:.2} m^2)",
+                m.m00 * 1e-6
+            )));
+        }
+        let mut centre = m.centroid();
+        let mut psi = m.long_axis();
+        // Step 6.
+        let mut iterations = 0;
+        let mut fit = None;
+        while iterations < self.config.max_iterations {
+            let gate = if iterations < 2 {
+                self.config.gate_initial_mm
+            } else {
+                self.config.gate_mm
+            };
+            let Some((du, dv, zeta, rms, used, lines)) = self.fit_step(&points, centre, psi, gate)
+            else {
+                return Ok(Localization::NotLocalized(
+                    "boundary points do not fix the field (need a goal line or back and a \
+                     touchline)"
+                        .into(),
+                ));
+            };
+            iterations += 1;
+            // Eqs. (16)-(18): move the estimate by the fitted offset and rotation.
+            centre += Rotation2::new(psi) * Vector2::new(du, dv);
+            psi += zeta;
+            fit = Some((rms, used, lines));
+            if du.abs() < self.config.offset_threshold_mm
+                && dv.abs() < self.config.offset_threshold_mm
+                && zeta.abs() < self.config.rotation_threshold_rad
+            {
+                break;
+            }
+        }
+        let (rms, used, lines) = fit.expect("at least one iteration ran");
+        // Step 7: the robot in the field frame. The field's x axis is at psi in the robot
+        // frame, so the robot's heading in the field is -psi, and its position is the field
+        // centre's position seen from the field: -R(theta) g.
+        let pose_for = |theta: f64| {
+            let theta = wrap_pi(theta);
+            let t = -(Rotation2::new(theta) * centre.coords);
+            Isometry2::new(t, theta)
+        };
+        let a = pose_for(-psi);
+        let b = pose_for(-psi + PI);
+        let (chosen, other, by_goals) = match self.goal_vote(img, &a, &b) {
+            Some(true) => (a, b, true),
+            Some(false) => (b, a, true),
+            None => match prior {
+                Some(p) => {
+                    let d =
+                        |q: &Isometry2<f64>| (q.translation.vector - p.translation.vector).norm();
+                    if d(&a) <= d(&b) {
+                        (a, b, false)
+                    } else {
+                        (b, a, false)
+                    }
+                }
+                None => (a, b, false),
+            },
+        };
+        Ok(Localization::Localized(PoseEstimate {
+            pose: chosen,
+            alternative: other,
+            quality: LocalizationQuality {
+                rms_residual_mm: rms,
+                points: used,
+                lines,
+                iterations,
+                resolved_by_goals: by_goals,
+            },
+        }))
+    }
+
+    /// The image region `[x0, y0, x1, y1)` around the circle of usable boundary points, with
+    /// a margin for the morphology.
+    fn region(&self) -> [usize; 4] {
+        let r = self.config.max_radius_frac * self.cal.horizon_px + 3.0;
+        let [cx, cy] = self.cal.principal_point_px;
+        let (w, h) = (self.cal.width_px as f64, self.cal.height_px as f64);
+        [
+            (cx - r).floor().clamp(0.0, w) as usize,
+            (cy - r).floor().clamp(0.0, h) as usize,
+            (cx + r).ceil().clamp(0.0, w) as usize,
+            (cy + r).ceil().clamp(0.0, h) as usize,
+        ]
+    }
+
+    /// Outermost floor pixels of each row and column, converted to the floor.
+    fn boundary_points(&self) -> Vec<BoundaryPoint> {
+        let (w, h) = (self.mask.width, self.mask.height);
+        let r_max = self.config.max_radius_frac * self.cal.horizon_px;
+        let [x0, y0, _, _] = self.region();
+        // Mask pixel (u, v) is image pixel (u + x0, v + y0).
+        let cx = self.cal.principal_point_px[0] - x0 as f64;
+        let cy = self.cal.principal_point_px[1] - y0 as f64;
+        let mut out = Vec::with_capacity(2 * (w + h));
+        let mut push = |u: f64, v: f64| {
+            // (u, v) in continuous mask coordinates (pixel k spans [k, k + 1)).
+            let x = u - cx;
+            let y = cy - v;
+            let big_r = x.hypot(y);
+            if big_r > r_max {
+                return;
+            }
+            if let (Some(p), Some(slope)) = (
+                self.cal.image_to_floor(x, y),
+                self.cal.slope_mm_per_px(big_r),
+            ) {
+                out.push(BoundaryPoint {
+                    p,
+                    w: 1.0 / (slope * slope).max(1e-9),
+                });
+            }
+        };
+        for v in 1..h.saturating_sub(1) {
+            let row = &self.mask.data[v * w..(v + 1) * w];
+            if let (Some(a), Some(b)) = (
+                row.iter().position(|&m| m != 0),
+                row.iter().rposition(|&m| m != 0),
+            ) {
+                // A run touching the region's edge continues beyond it: not a boundary (and
+                // beyond the usable radius anyway, unless the region is the image's edge).
+                if a > 0 {
+                    push(a as f64, v as f64 + 0.5);
+                }
+                if b + 1 < w {
+                    push(b as f64 + 1.0, v as f64 + 0.5);
+                }
+            }
+        }
+        for u in 1..w.saturating_sub(1) {
+            let first = (0..h).find(|&v| self.mask.data[v * w + u] != 0);
+            let last = (0..h).rev().find(|&v| self.mask.data[v * w + u] != 0);
+            if let (Some(a), Some(b)) = (first, last) {
+                if a > 0 {
+                    push(u as f64 + 0.5, a as f64);
+                }
+                if b + 1 < h {
+                    push(u as f64 + 0.5, b as f64 + 1.0);
+                }
+            }
+        }
+        out
+    }
+
+    /// One step of eq. (15): assign points to lines in the current frame and solve the
+    /// linearised weighted least squares for the field's offset (du, dv) and rotation zeta.
+    #[allow(clippy::type_complexity)]
+    fn fit_step(
+        &self,
+        points: &[BoundaryPoint],
+        centre: Point2<f64>,
+        psi: f64,
+        gate: f64,
+    ) -> Option<(f64, f64, f64, f64, usize, usize)> {
+        let f = &self.config.field;
+        let (s, c) = psi.sin_cos();
+        let mut ata = Matrix3::<f64>::zeros();
+        let mut atb = Vector3::<f64>::zeros();
+        let mut seen = [false; 6];
+        let mut used = 0;
+        let mut sum_w = 0.0;
+        let mut sum_wd2 = 0.0;
+        for bp in points {
+            // Eqs. (13)-(14).
+            let dx = bp.p.x - centre.x;
+            let dy = bp.p.y - centre.y;
+            let x = dx * c + dy * s;
+            let y = -dx * s + dy * c;
+            // Candidate lines as (index, signed distance, jacobian wrt (u, v, zeta)):
+            // residual r = d0 + J . (u, v, zeta), linearised for small zeta. Each line takes
+            // points along its extent plus `ends` beyond, so that near a corner both lines are
+            // candidates and the nearer wins.
+            let g = f.goal_half_width_mm;
+            let ends = 0.5 * gate;
+            let mut best: Option<(usize, f64, Vector3<f64>)> = None;
+            let mut consider = |k: usize, d0: f64, j: Vector3<f64>| {
+                if d0.abs() <= gate && best.is_none_or(|b| d0.abs() < b.1.abs()) {
+                    best = Some((k, d0, j));
+                }
+            };
+            if y.abs() <= g + ends {
+                consider(0, x - f.a2_mm, Vector3::new(-1.0, 0.0, y));
+                consider(3, -x - f.a2_mm, Vector3::new(1.0, 0.0, -y));
+            }
+            if y.abs() >= g - ends {
+                consider(1, x - f.a1_mm, Vector3::new(-1.0, 0.0, y));
+                consider(4, -x - f.a1_mm, Vector3::new(1.0, 0.0, -y));
+            }
+            if x.abs() <= f.a1_mm + ends {
+                consider(2, y - f.b_mm, Vector3::new(0.0, -1.0, -x));
+                consider(5, -y - f.b_mm, Vector3::new(0.0, 1.0, x));
+            }
+            let Some((k, d0, j)) = best else { continue };
+            seen[k] = true;
+            used += 1;
+            ata += j * j.transpose() * bp.w;
+            atb -= j * (d0 * bp.w);
+            sum_w += bp.w;
+            sum_wd2 += bp.w * d0 * d0;
+        }
+        let lines = seen.iter().filter(|&&s| s).count();
+        let along_x = seen[0] || seen[1] || seen[3] || seen[4];
+        let along_y = seen[2] || seen[5];
+        if !(along_x && along_y) || used < 10 {
+            return None;
+        }
+        let sol = ata.lu().solve(&atb)?;
+        Some((sol.x, sol.y, sol.z, (sum_wd2 / sum_w).sqrt(), used, lines))
+    }
+
+    /// Which solution the goal colours support: `Some(true)` for `a`, `Some(false)` for `b`,
+    /// `None` when no goal is seen or the vote is even.
+    fn goal_vote(&self, img: &RgbaImage, a: &Isometry2<f64>, b: &Isometry2<f64>) -> Option<bool> {
+        let [cx, cy] = self.cal.principal_point_px;
+        let mut sums = [(0.0f64, 0.0f64, 0usize); 2];
+        // Goals stand on the floor's far edge: look between the blind centre and the mirror's
+        // edge only.
+        let r_max = self.cal.horizon_px * 1.1;
+        let (w, h) = (img.width() as i64, img.height() as i64);
+        let u0 = (cx - r_max).floor().max(0.0) as i64;
+        let u1 = ((cx + r_max).ceil() as i64).min(w);
+        let v0 = (cy - r_max).floor().max(0.0) as i64;
+        let v1 = ((cy + r_max).ceil() as i64).min(h);
+        for v in v0..v1 {
+            for u in u0..u1 {
+                let p = img.get_pixel(u as u32, v as u32);
+                let rgb = [p.0[0], p.0[1], p.0[2]];
+                let class = if self.config.goal_pos_x.contains(rgb) {
+                    0
+                } else if self.config.goal_neg_x.contains(rgb) {
+                    1
+                } else {
+                    continue;
+                };
+                let x = u as f64 + 0.5 - cx;
+                let y = cy - (v as f64 + 0.5);
+                let r = x.hypot(y);
+                if r < 1.0 {
+                    continue;
+                }
+                sums[class].0 += x / r;
+                sums[class].1 += y / r;
+                sums[class].2 += 1;
+            }
+        }
+        let a2 = self.config.field.a2_mm;
+        let mut score = 0.0;
+        for (class, goal_x) in [(0usize, a2), (1usize, -a2)] {
+            let (sx, sy, n) = sums[class];
+            if n < self.config.min_goal_pixels {
+                continue;
+            }
+            let seen = sy.atan2(sx);
+            let predicted = |pose: &Isometry2<f64>| {
+                let q = pose.inverse_transform_point(&Point2::new(goal_x, 0.0));
+                q.y.atan2(q.x)
+            };
+            let err_a = wrap_pi(seen - predicted(a)).abs();
+            let err_b = wrap_pi(seen - predicted(b)).abs();
+            score += err_b - err_a;
+        }
+        if score > 1e-9 {
+            Some(true)
+        } else if score < -1e-9 {
+            Some(false)
+        } else {
+            None
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::freespace::tests::paper_calibration;
+    use image::Rgba;
+
+    const GREEN: Rgba<u8> = Rgba([30, 130, 55, 255]);
+    const BROWN: Rgba<u8> = Rgba([120, 100, 80, 255]);
+    const YELLOW: Rgba<u8> = Rgba([235, 200, 20, 255]);
+    const BLUE: Rgba<u8> = Rgba([25, 60, 220, 255]);
+    const GREY: Rgba<u8> = Rgba([40, 40, 40, 255]);
+
+    /// A synthetic image of the field seen from `pose` (field frame) through the paper's
+    /// f(R): floor inside the outline, goal colour just beyond the goal backs, a cube.
+    fn field_image(pose: Isometry2<f64>, cube: Option<Point2<f64>>) -> RgbaImage {
+        let cal = paper_calibration();
+        let f = FieldModel::default();
+        let mut img = RgbaImage::from_pixel(cal.width_px, cal.height_px, BROWN);
+        for (u, v, px) in img.enumerate_pixels_mut() {
+            let (x, y) = cal.image_coords(u as f64, v as f64);
+            let Some(q) = cal.image_to_floor(x, y) else {
+                continue;
+            };
+            let w = pose * q;
+            let inside = (w.x.abs() <= f.a1_mm && w.y.abs() <= f.b_mm)
+                || (w.x.abs() <= f.a2_mm && w.y.abs() <= f.goal_half_width_mm);
+            if inside {
+                *px = GREEN;
+            } else if w.x.abs() <= f.a2_mm + 400.0 && w.y.abs() <= f.goal_half_width_mm + 60.0 {
+                *px = if w.x > 0.0 { YELLOW } else { BLUE };
+            }
+            if cube.is_some_and(|c| (w.x - c.x).abs() <= 65.0 && (w.y - c.y).abs() <= 65.0) {
+                *px = GREY;
+            }
+        }
+        img
+    }
+
+    fn localize(pose: Isometry2<f64>, cube: Option<Point2<f64>>) -> Localization {
+        let cal = paper_calibration();
+        let mut l = FloorLocalizer::new(LocalizationConfig::default(), &cal).unwrap();
+        l.locate(&field_image(pose, cube), None).unwrap()
+    }
+
+    #[test]
+    fn the_fit_recovers_a_known_offset_and_rotation_from_exact_boundary_points() {
+        // Boundary points sampled exactly on the six lines of a field shifted by (120, -80)
+        // and turned by 0.05 rad, started from a deliberately wrong estimate.
+        let cal = paper_calibration();
+        let l = FloorLocalizer::new(LocalizationConfig::default(), &cal).unwrap();
+        let f = FieldModel::default();
+        let truth = Isometry2::new(Vector2::new(120.0, -80.0), 0.05);
+        let mut pts = Vec::new();
+        for k in 0..=40 {
+            let t = -1.0 + 2.0 * k as f64 / 40.0;
+            for p in [
+                Point2::new(f.a2_mm, t * f.goal_half_width_mm),
+                Point2::new(-f.a2_mm, t * f.goal_half_width_mm),
+                Point2::new(t * f.a1_mm, f.b_mm),
+                Point2::new(t * f.a1_mm, -f.b_mm),
+                Point2::new(f.a1_mm, f.goal_half_width_mm + (t + 1.0) / 2.0 * 500.0),
+                Point2::new(-f.a1_mm, -f.goal_half_width_mm - (t + 1.0) / 2.0 * 500.0),
+            ] {
+                pts.push(BoundaryPoint {
+                    p: truth * p,
+                    w: 1.0,
+                });
+            }
+        }
+        let mut centre = Point2::new(60.0, -20.0);
+        let mut psi = 0.0;
+        for _ in 0..20 {
+            let (du, dv, zeta, _, _, lines) = l.fit_step(&pts, centre, psi, 200.0).unwrap();
+            assert_eq!(lines, 6);
+            centre += Rotation2::new(psi) * Vector2::new(du, dv);
+            psi += zeta;
+        }
+        assert!(
+            (centre - Point2::new(120.0, -80.0)).norm() < 1e-6,
+            "{centre}"
+        );
+        assert!((psi - 0.05).abs() < 1e-9, "{psi}");
+    }
+
+    #[test]
+    fn synthetic_field_images_give_the_pose_and_the_goals_resolve_the_half_turn() {
+        for (x, y, deg) in [
+            (-900.0, 0.0, 0.0),
+            (400.0, -400.0, 180.0),
+            (850.0, 250.0, -135.0),
+        ] {
+            let truth = Isometry2::new(Vector2::new(x, y), f64::to_radians(deg));
+            let Localization::Localized(e) = localize(truth, Some(Point2::new(250.0, 150.0)))
+            else {
+                panic!("not localized at ({x}, {y}, {deg})");
+            };
+            let d = (e.pose.translation.vector - truth.translation.vector).norm();
+            let dh = wrap_pi(e.pose.rotation.angle() - truth.rotation.angle()).abs();
+            assert!(d < 30.0, "({x}, {y}, {deg}): position off by {d}");
+            assert!(
+                dh < 1f64.to_radians(),
+                "({x}, {y}, {deg}): heading off by {dh}"
+            );
+            assert!(e.quality.resolved_by_goals);
+            // The other solution is the half turn about the field centre.
+            let alt = e.alternative.translation.vector;
+            assert!((alt + e.pose.translation.vector).norm() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn degenerate_images_are_not_localized() {
+        let cal = paper_calibration();
+        let mut l = FloorLocalizer::new(LocalizationConfig::default(), &cal).unwrap();
+        for colour in [Rgba([0, 0, 0, 255]), Rgba([255, 255, 255, 255]), GREEN] {
+            let img = RgbaImage::from_pixel(256, 220, colour);
+            let r = l.locate(&img, None).unwrap();
+            assert!(
+                matches!(r, Localization::NotLocalized(_)),
+                "{colour:?}: {r:?}"
+            );
+        }
+        // A small green patch only.
+        let mut img = RgbaImage::from_pixel(256, 220, BROWN);
+        for v in 100..120 {
+            for u in 120..140 {
+                img.put_pixel(u, v, GREEN);
+            }
+        }
+        assert!(matches!(
+            l.locate(&img, None).unwrap(),
+            Localization::NotLocalized(_)
+        ));
+        // The wrong image size is an error, not a panic.
+        assert!(l.locate(&RgbaImage::new(10, 10), None).is_err());
+    }
+}
