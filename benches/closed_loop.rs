@@ -3,10 +3,11 @@
 //!
 //!     cargo bench --bench closed_loop
 
+mod common;
+
 use omniloop::load_scenario;
 use omniloop::runner::{RunOptions, run_scenario};
 use omniloop_sim::RendererChoice;
-use std::path::Path;
 
 fn main() {
     println!(
@@ -15,12 +16,7 @@ fn main() {
     );
     for choice in [RendererChoice::Cpu, RendererChoice::Gpu] {
         for name in ["corner55_goal_direction", "corner55_velocity_aware"] {
-            let rel = Path::new("scenarios").join(format!("{name}.toml"));
-            let path = if rel.exists() {
-                rel
-            } else {
-                Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
-            };
+            let path = common::scenario_path(&format!("{name}.toml"));
             let s = load_scenario(&path).expect("scenario loads");
             let options = RunOptions {
                 renderer: choice,

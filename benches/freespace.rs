@@ -3,21 +3,17 @@
 //!
 //!     cargo bench --bench freespace
 
+mod common;
+
 use nalgebra::{Isometry2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, FreeSpaceMethod};
-use std::path::Path;
 use std::time::Instant;
 
 fn main() {
-    let rel = Path::new("scenarios/corner55_velocity_aware.toml");
-    let path = if rel.exists() {
-        rel.to_path_buf()
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
-    };
+    let path = common::scenario_path("corner55_velocity_aware.toml");
     let s = load_scenario(&path).expect("corner scenario loads");
     let spec = &s.robot.sensors[0];
     let sensor = spec.build().expect("sensor");

@@ -3,20 +3,16 @@
 //!
 //!     cargo bench --bench localization
 
+mod common;
+
 use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::FloorLocalizer;
-use std::path::Path;
 use std::time::Instant;
 
 fn main() {
-    let rel = Path::new("scenarios/selfloc_field.toml");
-    let path = if rel.exists() {
-        rel.to_path_buf()
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
-    };
+    let path = common::scenario_path("selfloc_field.toml");
     let s = load_scenario(&path).expect("E2 scenario loads");
     let spec = &s.robot.sensors[0];
     let sensor = spec.build().expect("sensor");

@@ -4,9 +4,10 @@
 //!
 //!     cargo bench --bench render
 
+mod common;
+
 use omniloop::load_scenario;
 use omniloop_sim::{Renderer, RendererChoice, Scene, World};
-use std::path::Path;
 use std::time::Instant;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -15,14 +16,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn main() {
-    // Relative to the working directory (cargo runs benches in the package root), so that the
-    // built binary also runs from a copy of the repository elsewhere.
-    let rel = Path::new("scenarios/render_hyperbolic.toml");
-    let path = if rel.exists() {
-        rel.to_path_buf()
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
-    };
+    let path = common::scenario_path("render_hyperbolic.toml");
     let s = load_scenario(&path).expect("render_hyperbolic.toml loads");
     let world = World::new(&s.world, &s.robot_bodies(), 0.002).expect("world");
     let scene = Scene::new(world.layout(), &world.robot_solids(None));

@@ -71,9 +71,9 @@ pub struct Summary {
     pub cycles: u64,
     /// Simulated time.
     pub sim_time_s: f64,
-    /// Wall-clock time the run took.
+    /// Wall-clock time the run took, set-up included.
     pub wall_time_s: f64,
-    /// Control cycles per wall-clock second.
+    /// Control cycles per wall-clock second of the cycles alone (set-up excluded).
     pub cycles_per_s: f64,
     /// How many times the robot started touching a wall, cube, pillar or robot (physics engine).
     pub wall_contacts: u32,

@@ -371,30 +371,25 @@ impl Simulation {
         let v_body = self.tracker.velocity_body_mm_s();
         let body_command =
             |v: Vector2<f64>| VelocityCommand::translate(Rotation2::new(heading) * v);
-        let command = match (&self.brain, &freespace, goal_body) {
+        let points: Vec<Vector2<f64>> = freespace.as_ref().map_or(Vec::new(), |(fs, _, _)| {
+            fs.obstacle_points.iter().map(|p| p.coords).collect()
+        });
+        let surroundings = freespace.as_ref().map(|(fs, range, _)| Surroundings {
+            direction_rad: &fs.direction_rad,
+            free_mm: &fs.free_mm,
+            range_mm: *range,
+            obstacle_points: &points,
+        });
+        let command = match (&self.brain, &surroundings, goal_body) {
             (Brain::Truth(c), _, _) => match target {
                 Some(g) => c.command(state.pose.translation.vector, g.coords),
                 None => VelocityCommand::STOP,
             },
-            (Brain::GoalDirection(c), Some((fs, range, _)), Some(goal)) => {
-                let pts: Vec<Vector2<f64>> = fs.obstacle_points.iter().map(|p| p.coords).collect();
-                let s = Surroundings {
-                    direction_rad: &fs.direction_rad,
-                    free_mm: &fs.free_mm,
-                    range_mm: *range,
-                    obstacle_points: &pts,
-                };
-                body_command(c.decide(&s, goal).v_mm_s)
+            (Brain::GoalDirection(c), Some(s), Some(goal)) => {
+                body_command(c.decide(s, goal).v_mm_s)
             }
-            (Brain::VelocityAware(c), Some((fs, range, _)), Some(goal)) => {
-                let pts: Vec<Vector2<f64>> = fs.obstacle_points.iter().map(|p| p.coords).collect();
-                let s = Surroundings {
-                    direction_rad: &fs.direction_rad,
-                    free_mm: &fs.free_mm,
-                    range_mm: *range,
-                    obstacle_points: &pts,
-                };
-                body_command(c.decide(&s, goal, v_body).v_mm_s)
+            (Brain::VelocityAware(c), Some(s), Some(goal)) => {
+                body_command(c.decide(s, goal, v_body).v_mm_s)
             }
             _ => VelocityCommand::STOP,
         };
@@ -590,6 +585,8 @@ impl Simulation {
 }
 
 /// Runs a validated scenario to its end, calling `progress(cycle, max_cycles)` after each cycle.
+/// The summary's `wall_time_s` covers the whole run, set-up included (calibration tracing,
+/// opening the renderer); its `cycles_per_s` covers the control cycles alone.
 pub fn run_scenario(
     scenario: &Scenario,
     options: &RunOptions,
@@ -604,18 +601,26 @@ pub fn run_scenario(
         })?;
     }
     let mut sim = Simulation::new(scenario, options, notice)?;
-    if scenario.experiment.is_some() {
-        let places = sim.run_places(progress)?;
-        let mut out = sim.finish(start.elapsed().as_secs_f64());
-        out.summary.places = Some(places);
-        return Ok(out);
-    }
-    let max = scenario.max_cycles();
-    while !sim.finished() {
-        sim.step()?;
-        progress(sim.cycle(), max);
-    }
-    Ok(sim.finish(start.elapsed().as_secs_f64()))
+    let loop_start = Instant::now();
+    let places = if scenario.experiment.is_some() {
+        Some(sim.run_places(progress)?)
+    } else {
+        let max = scenario.max_cycles();
+        while !sim.finished() {
+            sim.step()?;
+            progress(sim.cycle(), max);
+        }
+        None
+    };
+    let loop_s = loop_start.elapsed().as_secs_f64();
+    let mut out = sim.finish(start.elapsed().as_secs_f64());
+    out.summary.cycles_per_s = if loop_s > 0.0 {
+        out.summary.cycles as f64 / loop_s
+    } else {
+        0.0
+    };
+    out.summary.places = places;
+    Ok(out)
 }
 
 /// Renders what sensor `sensor` of the robot under test sees when the robot stands at `pose`

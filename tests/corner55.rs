@@ -1,25 +1,17 @@
 //! E1 end to end: the 55-degree corner with both controllers, on vision alone.
 
-use omniloop::replay::{CORNER55, builtin_scenario};
-use omniloop::runner::{RunOptions, run_scenario};
-use omniloop::{Summary, load_scenario};
-use omniloop_sim::RendererChoice;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn cpu() -> RunOptions {
-    RunOptions {
-        renderer: RendererChoice::Cpu,
-        ..RunOptions::default()
-    }
-}
+use common::{cpu, omniloop, scenario, scenario_path, tmp};
+use omniloop::Summary;
+use omniloop::replay::{CORNER55, builtin_scenario};
+use omniloop::runner::run_scenario;
+use std::path::Path;
 
 fn run(file: &str) -> Summary {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenarios")
-        .join(file);
-    let s = load_scenario(&path).unwrap();
-    run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary
+    run_scenario(&scenario(file), &cpu(), |_| {}, |_, _| {})
+        .unwrap()
+        .summary
 }
 
 #[test]
@@ -48,33 +40,22 @@ fn both_controllers_turn_the_corner_and_the_velocity_aware_one_turns_earlier_and
 #[test]
 fn the_built_in_replay_scenarios_are_the_files_in_scenarios() {
     for (name, text) in CORNER55 {
-        let file = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenarios")
-            .join(format!("corner55_{name}.toml"));
+        let file = scenario_path(&format!("corner55_{name}.toml"));
         assert_eq!(std::fs::read_to_string(&file).unwrap(), text);
         builtin_scenario(name, text).unwrap();
     }
 }
 
 fn replay(dir: &Path) {
-    let out = Command::new(env!("CARGO_BIN_EXE_omniloop"))
-        .args([
-            "replay",
-            "corner55",
-            "--renderer",
-            "cpu",
-            "--quiet",
-            "--out",
-        ])
-        .arg(dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = omniloop([
+        "replay".as_ref(),
+        "corner55".as_ref(),
+        "--renderer".as_ref(),
+        "cpu".as_ref(),
+        "--quiet".as_ref(),
+        "--out".as_ref(),
+        dir.as_os_str(),
+    ]);
     assert!(text.contains("velocity-aware turns earlier: yes"), "{text}");
 }
 
@@ -89,10 +70,8 @@ fn deterministic_part(path: &Path) -> serde_json::Value {
 
 #[test]
 fn the_replay_run_twice_on_the_cpu_gives_identical_results() {
-    let base = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let dirs = [base.join("corner55_a"), base.join("corner55_b")];
+    let dirs = [tmp("corner55_a"), tmp("corner55_b")];
     for d in &dirs {
-        let _ = std::fs::remove_dir_all(d);
         replay(d);
         for f in ["comparison.png", "comparison.md"] {
             assert!(d.join(f).exists(), "{f}");

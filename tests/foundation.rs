@@ -1,24 +1,15 @@
 //! End-to-end checks of the foundation: scenario files, the loop, determinism, the drive limit
 //! and contacts.
 
+mod common;
+
+use common::{bin, omniloop, scenario, scenario_path, tmp};
 use omniloop::record::write_trajectory_csv;
 use omniloop::{LoadError, load_scenario, parse_scenario, run_scenario};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn scenarios_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
-}
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_omniloop"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    scenario_path("")
 }
 
 #[test]
@@ -35,19 +26,14 @@ fn every_scenario_file_passes_check() {
             panic!("{} does not load:\n{e}", f.display());
         }
     }
-    let out = bin().arg("check").args(&files).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut args = vec![std::ffi::OsString::from("check")];
+    args.extend(files.iter().map(|f| f.as_os_str().to_owned()));
+    omniloop(args);
 }
 
 #[test]
 fn the_printed_default_scenario_is_valid_and_complete() {
-    let out = bin().args(["run", "--print-default"]).output().unwrap();
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = omniloop(["run", "--print-default"]);
     let s = parse_scenario(&text, Path::new("default.toml"), "default").unwrap();
     // Every key the schema serialises appears in the printed example.
     let full = toml::Value::try_from(&s).unwrap();
@@ -120,7 +106,7 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
 
 #[test]
 fn smoke_reaches_its_goal_without_contact_and_within_the_acceleration_limit() {
-    let s = load_scenario(&scenarios_dir().join("smoke.toml")).unwrap();
+    let s = scenario("smoke.toml");
     let out = run_scenario(&s, &Default::default(), |_| {}, |_, _| {}).unwrap();
     let m = &out.summary;
     assert!(m.reached_goal, "{m:?}");
@@ -151,17 +137,15 @@ fn same_scenario_and_seed_give_byte_identical_trajectories() {
     let mut files = Vec::new();
     for k in 0..2 {
         let dir = tmp(&format!("determinism_{k}"));
-        let out = bin()
-            .args(["run", "--quiet", "--seed", "11", "--out"])
-            .arg(&dir)
-            .arg(&f)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        omniloop([
+            "run".as_ref(),
+            "--quiet".as_ref(),
+            "--seed".as_ref(),
+            "11".as_ref(),
+            "--out".as_ref(),
+            dir.as_os_str(),
+            f.as_os_str(),
+        ]);
         files.push(std::fs::read(dir.join("trajectory.csv")).unwrap());
         let summary: serde_json::Value =
             serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();

@@ -1,13 +1,14 @@
 //! Free space on rendered frames: the detected free distance of every direction against the
 //! distance ray-cast in the world, and the labelling and counting variants of eq. (5).
 
+mod common;
+
+use common::scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
-use omniloop::load_scenario;
 use omniloop::runner::sensor_noise_seed;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::{FreeSpaceDetector, FreeSpaceMethod};
-use std::path::Path;
 
 /// Poses along and around the E1 corridor.
 const POSES: [(f64, f64, f64); 8] = [
@@ -23,8 +24,7 @@ const POSES: [(f64, f64, f64); 8] = [
 
 #[test]
 fn detected_free_distances_match_the_ray_cast_world_within_a_ring() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/corner55_velocity_aware.toml");
-    let s = load_scenario(&path).unwrap();
+    let s = scenario("corner55_velocity_aware.toml");
     let spec = &s.robot.sensors[0];
     let sensor = spec.build().unwrap();
     let cal = calibrate_sensor(spec).unwrap();

@@ -11,14 +11,10 @@ use omniloop_sim::render::SensorRays;
 use omniloop_sim::{
     FloorRect, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorSpec, Wall,
 };
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn scenario(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenarios")
-        .join(name)
-}
+use common::{omniloop, scenario_path as scenario};
+use std::path::Path;
 
 /// The paper's f(R) and its inverse.
 fn paper_f(r_px: f64) -> f64 {
@@ -112,18 +108,13 @@ fn rendered_floor_edges_lie_between_the_pixels_the_papers_f_puts_them() {
 
 #[test]
 fn calibrate_prints_the_papers_constants_within_one_percent() {
-    let out = Command::new(env!("CARGO_BIN_EXE_omniloop"))
-        .args(["calibrate", "--out"])
-        .arg(Path::new(env!("CARGO_TARGET_TMPDIR")).join("calibration_omni.json"))
-        .arg(scenario("render_hyperbolic.toml"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).unwrap();
+    let table = Path::new(env!("CARGO_TARGET_TMPDIR")).join("calibration_omni.json");
+    let text = omniloop([
+        "calibrate".as_ref(),
+        "--out".as_ref(),
+        table.as_os_str(),
+        scenario("render_hyperbolic.toml").as_os_str(),
+    ]);
     let value = |key: &str| -> f64 {
         let line = text
             .lines()

@@ -53,6 +53,12 @@ impl Solid {
     }
 }
 
+/// Rotates a world vector into the frame of a box turned by `angle_rad`.
+fn to_box_frame(angle_rad: f64, v: Vector2<f64>) -> Vector2<f64> {
+    let (s, c) = angle_rad.sin_cos();
+    Vector2::new(c * v.x + s * v.y, -s * v.x + c * v.y)
+}
+
 impl SolidShape {
     /// Signed distance from `p` to the footprint's boundary (negative inside).
     pub fn distance_mm(&self, p: Point2<f64>) -> f64 {
@@ -62,10 +68,7 @@ impl SolidShape {
                 half_extents_mm,
                 angle_rad,
             } => {
-                let (s, c) = angle_rad.sin_cos();
-                let d = p - center_mm;
-                let q = Vector2::new((c * d.x + s * d.y).abs(), (-s * d.x + c * d.y).abs())
-                    - half_extents_mm;
+                let q = to_box_frame(angle_rad, p - center_mm).abs() - half_extents_mm;
                 let outside = Vector2::new(q.x.max(0.0), q.y.max(0.0)).norm();
                 outside + q.x.max(q.y).min(0.0)
             }
@@ -88,10 +91,8 @@ impl SolidShape {
                 half_extents_mm,
                 angle_rad,
             } => {
-                let (s, c) = angle_rad.sin_cos();
-                let d = origin - center_mm;
-                let o = [c * d.x + s * d.y, -s * d.x + c * d.y];
-                let v = [c * dir.x + s * dir.y, -s * dir.x + c * dir.y];
+                let o = to_box_frame(angle_rad, origin - center_mm);
+                let v = to_box_frame(angle_rad, dir);
                 let h = [half_extents_mm.x, half_extents_mm.y];
                 let mut t0 = f64::NEG_INFINITY;
                 let mut t1 = f64::INFINITY;

@@ -101,26 +101,26 @@ impl RadialCalibration {
         self.samples.last().map_or(0.0, |s| s[0])
     }
 
-    /// `r = f(R)` by linear interpolation; `None` beyond the table.
-    pub fn floor_distance_mm(&self, r_px: f64) -> Option<f64> {
+    /// The table segment `(R, r)` to `(R, r)` holding image radius `R`; `None` beyond it.
+    fn segment(&self, r_px: f64) -> Option<([f64; 2], [f64; 2])> {
         let s = &self.samples;
         if r_px.is_nan() || r_px < s[0][0] || r_px > self.max_radius_px() {
             return None;
         }
         let k = s.partition_point(|p| p[0] <= r_px).clamp(1, s.len() - 1);
-        let (a, b) = (s[k - 1], s[k]);
+        Some((s[k - 1], s[k]))
+    }
+
+    /// `r = f(R)` by linear interpolation; `None` beyond the table.
+    pub fn floor_distance_mm(&self, r_px: f64) -> Option<f64> {
+        let (a, b) = self.segment(r_px)?;
         let u = (r_px - a[0]) / (b[0] - a[0]);
         Some(a[1] + u * (b[1] - a[1]))
     }
 
     /// `df/dR` (mm per pixel) of the table segment holding `R`.
     pub fn slope_mm_per_px(&self, r_px: f64) -> Option<f64> {
-        let s = &self.samples;
-        if r_px.is_nan() || r_px < s[0][0] || r_px > self.max_radius_px() {
-            return None;
-        }
-        let k = s.partition_point(|p| p[0] <= r_px).clamp(1, s.len() - 1);
-        let (a, b) = (s[k - 1], s[k]);
+        let (a, b) = self.segment(r_px)?;
         Some((b[1] - a[1]) / (b[0] - a[0]))
     }
 
@@ -254,7 +254,7 @@ pub fn fit_hyperbolic_form(samples: &[[f64; 2]]) -> Option<HyperbolicFit> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn paper() -> HyperbolicFit {
@@ -266,7 +266,8 @@ mod tests {
         }
     }
 
-    fn table() -> RadialCalibration {
+    /// The corner paper's f(R) as a table, 256 x 220, principal point at the centre.
+    pub(crate) fn table() -> RadialCalibration {
         let f = paper();
         let samples: Vec<[f64; 2]> = (0..=440)
             .map(|k| k as f64 * 0.25)

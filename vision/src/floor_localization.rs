@@ -561,7 +561,7 @@ impl FloorLocalizer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::freespace::tests::paper_calibration;
+    use crate::calibration::tests::table as paper_calibration;
     use image::Rgba;
 
     const GREEN: Rgba<u8> = Rgba([30, 130, 55, 255]);

@@ -512,33 +512,11 @@ impl FreeSpaceDetector {
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
-    use crate::calibration::HyperbolicFit;
     use image::Rgba;
 
-    /// The corner paper's f(R) as a table, 256 x 220, principal point at the centre.
-    pub(crate) fn paper_calibration() -> RadialCalibration {
-        let f = HyperbolicFit {
-            a: 10.12,
-            b: 2.054e-2,
-            c: 2.298e5,
-            rms_mm: 0.0,
-        };
-        RadialCalibration {
-            sensor: "omni".into(),
-            width_px: 256,
-            height_px: 220,
-            principal_point_px: [128.0, 110.0],
-            mount_mm: [0.0, 0.0],
-            samples: (0..=440)
-                .map(|k| k as f64 * 0.25)
-                .map(|r| [r, f.floor_distance_mm(r).unwrap()])
-                .collect(),
-            horizon_px: 113.9,
-            fit: None,
-        }
-    }
+    use crate::calibration::tests::table as paper_calibration;
 
     const GREEN: Rgba<u8> = Rgba([30, 130, 55, 255]);
     const GREY: Rgba<u8> = Rgba([90, 90, 90, 255]);
