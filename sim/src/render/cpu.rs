@@ -87,10 +87,14 @@ struct Item {
     prim: Prim,
 }
 
-/// Primitives binned by azimuth around the sensor axis, each bin sorted by distance.
+/// Primitives binned by azimuth around the sensor axis, each bin sorted by distance. The
+/// buffers are kept between frames.
+#[derive(Debug, Default)]
 struct Sectors {
     offsets: Vec<u32>,
     items: Vec<Item>,
+    /// (sector, item) pairs before sorting.
+    pairs: Vec<(u16, Item)>,
 }
 
 fn wrap(a: f32) -> f32 {
@@ -99,12 +103,15 @@ fn wrap(a: f32) -> f32 {
 }
 
 impl Sectors {
-    fn new(scene: &Scene, axis: [f32; 2], rho: f32) -> Self {
-        let mut bins: Vec<Vec<Item>> = vec![Vec::new(); SECTORS];
+    /// Bins the scene's primitives for a sensor axis at `axis` whose rays start up to `rho` mm
+    /// from it.
+    fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32) {
+        let pairs = &mut self.pairs;
+        pairs.clear();
         let mut add = |prim: Prim, d_min: f32, centre: f32, half: f32| {
             let item = Item { d_min, prim };
             if d_min <= 2.0 * rho + 1.0 || half >= std::f32::consts::PI {
-                bins.iter_mut().for_each(|b| b.push(item));
+                pairs.extend((0..SECTORS).map(|k| (k as u16, item)));
                 return;
             }
             let half = half + (rho / d_min).min(1.0).asin();
@@ -112,7 +119,7 @@ impl Sectors {
             let start = ((wrap(centre - half)) / width).floor() as i64;
             let n = ((2.0 * half) / width).ceil() as i64 + 1;
             for k in start..=start + n {
-                bins[k.rem_euclid(SECTORS as i64) as usize].push(item);
+                pairs.push((k.rem_euclid(SECTORS as i64) as u16, item));
             }
         };
         for (i, b) in scene.boxes.iter().enumerate() {
@@ -154,32 +161,40 @@ impl Sectors {
                 (r / dc).asin(),
             );
         }
-        let mut offsets = Vec::with_capacity(SECTORS + 1);
-        let mut items = Vec::new();
-        offsets.push(0);
-        for mut b in bins {
-            b.sort_by(|a, b| a.d_min.total_cmp(&b.d_min));
-            items.extend(b);
-            offsets.push(items.len() as u32);
+        // A stable sort keeps the scene's order among equal distances, so that exact ties
+        // (coplanar faces) resolve as when every primitive is traced.
+        self.pairs
+            .sort_by(|a, b| a.0.cmp(&b.0).then(a.1.d_min.total_cmp(&b.1.d_min)));
+        self.items.clear();
+        self.offsets.clear();
+        self.offsets.push(0);
+        let mut next = 0;
+        for k in 0..SECTORS as u16 {
+            while next < self.pairs.len() && self.pairs[next].0 == k {
+                self.items.push(self.pairs[next].1);
+                next += 1;
+            }
+            self.offsets.push(self.items.len() as u32);
         }
-        Self { offsets, items }
     }
 }
 
 /// Renders RGBA8 frames on the CPU.
 #[derive(Debug, Default)]
-pub struct CpuRenderer {}
+pub struct CpuRenderer {
+    sectors: Sectors,
+}
 
 impl CpuRenderer {
     /// A renderer.
     pub fn new() -> Self {
-        Self {}
+        Self::default()
     }
 
     /// Renders one frame: `rays` of a sensor on a robot at `pose`, into packed RGBA8 pixels
     /// (`pixels.len() == width * height`).
     pub fn render(
-        &self,
+        &mut self,
         scene: &Scene,
         rays: &SensorRays,
         pose: &Isometry2<f64>,
@@ -196,7 +211,8 @@ impl CpuRenderer {
             py + s * rays.axis[0] + c * rays.axis[1],
         ];
         let rho = rays.max_offset_mm;
-        let sectors = Sectors::new(scene, axis, rho);
+        self.sectors.rebuild(scene, axis, rho);
+        let sectors = &self.sectors;
         let theta = theta as f32;
         let scale = SECTORS as f32 / std::f32::consts::TAU;
         pixels
@@ -215,7 +231,7 @@ impl CpuRenderer {
                     ];
                     let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
                     let sector = ((wrap(r.azimuth + theta) * scale) as usize).min(SECTORS - 1);
-                    *out = trace_culled(scene, &sectors, sector, o, d, r.d_xy, rho);
+                    *out = trace_culled(scene, sectors, sector, o, d, r.d_xy, rho);
                 }
             });
         let _ = rays.height;
