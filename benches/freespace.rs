@@ -21,7 +21,7 @@ fn main() {
     let mut bodies = s.robot_bodies();
     bodies[0].start = Isometry2::new(Vector2::new(-900.0, 250.0), 0.0);
     let world = World::new(&s.world, &bodies, 0.002).expect("world");
-    let scene = Scene::new(world.layout(), &world.robot_solids(None));
+    let scene = Scene::of_world(&world);
     let mut noise = SensorNoise::new(1);
     let img = Renderer::cpu()
         .render(

@@ -25,7 +25,7 @@ fn main() {
         let mut bodies = s.robot_bodies();
         bodies[0].start = p.isometry();
         let world = World::new(&s.world, &bodies, 0.0025).expect("world");
-        let scene = Scene::new(world.layout(), &world.robot_solids(None));
+        let scene = Scene::of_world(&world);
         frames.push(
             renderer
                 .render(

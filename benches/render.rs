@@ -19,7 +19,7 @@ fn main() {
     let path = common::scenario_path("render_hyperbolic.toml");
     let s = load_scenario(&path).expect("render_hyperbolic.toml loads");
     let world = World::new(&s.world, &s.robot_bodies(), 0.002).expect("world");
-    let scene = Scene::new(world.layout(), &world.robot_solids(None));
+    let scene = Scene::of_world(&world);
     let pose = world.robot_state(0).pose;
     let small = s.robot.sensors[0].build().expect("sensor");
     let mut big_spec = s.robot.sensors[0].clone();

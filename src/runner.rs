@@ -296,7 +296,7 @@ impl Simulation {
             return Ok(Vec::new());
         };
         let pose = self.world.robot_state(0).pose;
-        let scene = Scene::new(self.world.layout(), &self.world.robot_solids(None));
+        let scene = Scene::of_world(&self.world);
         let mut frames = Vec::with_capacity(eyes.sensors.len());
         for (sensor, noise) in eyes.sensors.iter_mut() {
             frames.push(eyes.renderer.render(&scene, sensor, &pose, Some(noise))?);
@@ -660,7 +660,7 @@ pub fn render_snapshot(
     let world = World::new(&scenario.world, &bodies, scenario.run.physics_step_s)?;
     let spec = &scenario.robot.sensors[index];
     let sensor = spec.build()?;
-    let scene = Scene::new(world.layout(), &world.robot_solids(None));
+    let scene = Scene::of_world(&world);
     let mut noise_source = noise.then(|| SensorNoise::new(sensor_noise_seed(scenario.seed, index)));
     Ok(renderer.render(
         &scene,

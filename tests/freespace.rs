@@ -50,7 +50,7 @@ fn detected_free_distances_match_the_ray_cast_world_within_a_ring() {
         bodies[0].start = Isometry2::new(Vector2::new(x, y), deg.to_radians());
         let world = World::new(&s.world, &bodies, 0.002).unwrap();
         let pose = world.robot_state(0).pose;
-        let scene = Scene::new(world.layout(), &world.robot_solids(None));
+        let scene = Scene::of_world(&world);
         let img = renderer
             .render(&scene, &sensor, &pose, Some(&mut noise))
             .unwrap();

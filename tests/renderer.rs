@@ -239,7 +239,7 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
     ] {
         let s = load_scenario(&scenario(name)).unwrap();
         let world = omniloop_sim::World::new(&s.world, &s.robot_bodies(), 0.002).unwrap();
-        let scene = Scene::new(world.layout(), &world.robot_solids(None));
+        let scene = Scene::of_world(&world);
         let pose = world.robot_state(0).pose;
         for spec in &s.robot.sensors {
             let sensor = spec.build().unwrap();

@@ -6,6 +6,7 @@
 
 use crate::layout::{Layout, Rgb};
 use crate::shapes::{Solid, SolidShape};
+use crate::world::World;
 use bytemuck::{Pod, Zeroable};
 
 /// A box: footprint rectangle rotated about z, from `base` to `top` above the floor.
@@ -107,9 +108,23 @@ const SKY_RGB: Rgb = Rgb([150, 160, 175]);
 impl Scene {
     /// The scene of a layout with extra solids (robots, the observer's body).
     pub fn new(layout: &Layout, extra: &[Solid]) -> Self {
+        Self::from_solids(layout, layout.solids().iter().chain(extra))
+    }
+
+    /// The scene a world shows now: its layout, its solids and every robot.
+    pub fn of_world(world: &World) -> Self {
+        Self::from_solids(
+            world.layout(),
+            world.solids().iter().chain(&world.robot_solids(None)),
+        )
+    }
+
+    /// The scene of a layout's floor with the given solids (which must include the layout's own
+    /// walls, cubes, pillars and boards).
+    fn from_solids<'a>(layout: &Layout, solids: impl Iterator<Item = &'a Solid>) -> Self {
         let mut boxes = Vec::new();
         let mut cylinders = Vec::new();
-        for s in layout.solids().iter().chain(extra) {
+        for s in solids {
             match s.shape {
                 SolidShape::Box {
                     center_mm,
