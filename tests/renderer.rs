@@ -229,15 +229,18 @@ fn conical_omnistereo_range_follows_eqs_1_and_2() {
     }
 }
 
+/// The render examples of `scenarios/`, one per kind of optics.
+const RENDER_EXAMPLES: [&str; 4] = [
+    "render_hyperbolic",
+    "render_conical",
+    "render_spherical",
+    "render_pinhole",
+];
+
 #[test]
 fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
-    for name in [
-        "render_hyperbolic.toml",
-        "render_conical.toml",
-        "render_spherical.toml",
-        "render_pinhole.toml",
-    ] {
-        let s = load_scenario(&scenario(name)).unwrap();
+    for name in RENDER_EXAMPLES {
+        let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
         let world = omniloop_sim::World::new(&s.world, &s.robot_bodies(), 0.002).unwrap();
         let scene = Scene::of_world(&world);
         let pose = world.robot_state(0).pose;
@@ -276,13 +279,8 @@ fn gpu_and_cpu_renders_agree() {
         return;
     };
     let mut cpu = Renderer::cpu();
-    for name in [
-        "render_hyperbolic.toml",
-        "render_conical.toml",
-        "render_spherical.toml",
-        "render_pinhole.toml",
-    ] {
-        let s = load_scenario(&scenario(name)).unwrap();
+    for name in RENDER_EXAMPLES {
+        let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
         for spec in &s.robot.sensors {
             // Noise on: both draw it from the same seeded generator.
             let a = render_snapshot(&s, &mut cpu, Some(&spec.name), None, true).unwrap();
@@ -319,12 +317,7 @@ fn golden_images_of_the_render_examples() {
     let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
     let bless = std::env::var_os("OMNILOOP_BLESS").is_some();
     let mut cpu = Renderer::cpu();
-    for name in [
-        "render_hyperbolic",
-        "render_conical",
-        "render_spherical",
-        "render_pinhole",
-    ] {
+    for name in RENDER_EXAMPLES {
         let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
         let img = render_snapshot(&s, &mut cpu, None, None, false).unwrap();
         let path = golden_dir.join(format!("{name}.png"));

@@ -328,6 +328,16 @@ mod tests {
         AccelLimitedDrive::new(300.0, 10.0).unwrap()
     }
 
+    /// What vision reports with a 1000 mm template.
+    fn surroundings<'a>(dirs: &'a [f64], free: &'a [f64], pts: &'a [Vec2]) -> Surroundings<'a> {
+        Surroundings {
+            direction_rad: dirs,
+            free_mm: free,
+            range_mm: 1000.0,
+            obstacle_points: pts,
+        }
+    }
+
     /// A wall across the robot's path at x = `x_mm`, seen in 32 directions up to 1000 mm.
     fn wall_ahead(x_mm: f64) -> (Vec<f64>, Vec<f64>, Vec<Vec2>) {
         let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
@@ -359,22 +369,12 @@ mod tests {
     fn goal_direction_goes_straight_when_free_and_around_when_not() {
         let c = GoalDirection::new(AvoidanceConfig::default(), drive(), 400.0, 90.0).unwrap();
         let (dirs, free, pts) = wall_ahead(10_000.0);
-        let s = Surroundings {
-            direction_rad: &dirs,
-            free_mm: &free,
-            range_mm: 1000.0,
-            obstacle_points: &pts,
-        };
+        let s = surroundings(&dirs, &free, &pts);
         let d = c.decide(&s, Vec2::new(3000.0, 100.0));
         assert!((d.heading_rad.unwrap() - 100f64.atan2(3000.0)).abs() < 1e-12);
         assert!((d.v_mm_s.norm() - 400.0).abs() < 1e-9);
         let (dirs, free, pts) = wall_ahead(500.0);
-        let s = Surroundings {
-            direction_rad: &dirs,
-            free_mm: &free,
-            range_mm: 1000.0,
-            obstacle_points: &pts,
-        };
+        let s = surroundings(&dirs, &free, &pts);
         let d = c.decide(&s, Vec2::new(3000.0, 100.0));
         let h = d.heading_rad.unwrap();
         // The wall at 500 mm: at 56.25 degrees it is 900 mm away, at 67.5 degrees 1306 mm, and
@@ -400,12 +400,7 @@ mod tests {
         let mut max_x: f64 = f64::MIN;
         for _ in 0..200 {
             let (dirs, free, pts) = wall_ahead(600.0 - p.x);
-            let s = Surroundings {
-                direction_rad: &dirs,
-                free_mm: &free,
-                range_mm: 1000.0,
-                obstacle_points: &pts,
-            };
+            let s = surroundings(&dirs, &free, &pts);
             let goal = Vec2::new(3000.0, 50.0) - p;
             let cmd = if velocity_aware {
                 va.decide(&s, goal, v).v_mm_s
@@ -448,12 +443,7 @@ mod tests {
             .map(|a| Vec2::new(a.cos(), a.sin()) * 130.0)
             .collect();
         let free = vec![130.0; 32];
-        let s = Surroundings {
-            direction_rad: &dirs,
-            free_mm: &free,
-            range_mm: 1000.0,
-            obstacle_points: &pts,
-        };
+        let s = surroundings(&dirs, &free, &pts);
         let d = c.decide(&s, Vec2::new(1000.0, 0.0), Vec2::new(100.0, 0.0));
         assert_eq!(d.v_mm_s, Vec2::zeros());
         assert!(d.heading_rad.is_none());
