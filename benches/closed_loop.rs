@@ -6,7 +6,7 @@
 mod common;
 
 use omniloop::load_scenario;
-use omniloop::runner::{RunOptions, run_scenario};
+use omniloop::simulation::{RunOptions, run_scenario};
 use omniloop_sim::RendererChoice;
 
 fn main() {

@@ -6,6 +6,7 @@
 mod common;
 
 use omniloop::calibrate::calibrate_sensor;
+use omniloop::experiments::ExperimentSpec;
 use omniloop::load_scenario;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::FloorLocalizer;
@@ -19,7 +20,10 @@ fn main() {
     let cal = calibrate_sensor(spec).expect("calibration");
     let mut renderer = Renderer::cpu();
     let mut noise = SensorNoise::new(1);
-    let places = &s.experiment.as_ref().expect("places").places;
+    let Some(ExperimentSpec::Places(spec)) = &s.experiment else {
+        panic!("selfloc_field.toml has [experiment.places]");
+    };
+    let places = &spec.places;
     let mut frames = Vec::new();
     for p in places {
         let mut bodies = s.robot_bodies();

@@ -6,13 +6,34 @@ use omniloop_sim::optics::Optics;
 use omniloop_sim::{SensorSpec, SimError};
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::calibration::fit_hyperbolic_form;
+use std::sync::Mutex;
 
 /// Sample spacing of calibration tables, px.
 pub const CALIBRATION_STEP_PX: f64 = 0.25;
 
+/// Calibrations traced so far in this process, by sensor: validating a scenario and running
+/// it need the same table, which is traced once.
+static TRACED: Mutex<Vec<(SensorSpec, RadialCalibration)>> = Mutex::new(Vec::new());
+
 /// Traces the radial map of `spec` and, for a hyperbolic mirror, fits
-/// `f(R) = R / (A - B sqrt(C + R^2))` to the samples below 95% of the horizon radius.
+/// `f(R) = R / (A - B sqrt(C + R^2))` to the samples below 95% of the horizon radius. A sensor
+/// traced before in this process is not traced again.
 pub fn calibrate_sensor(spec: &SensorSpec) -> Result<RadialCalibration, SimError> {
+    let traced = |t: &Vec<(SensorSpec, RadialCalibration)>| {
+        t.iter().find(|(s, _)| s == spec).map(|(_, c)| c.clone())
+    };
+    if let Some(c) = traced(&TRACED.lock().unwrap_or_else(|e| e.into_inner())) {
+        return Ok(c);
+    }
+    let cal = trace(spec)?;
+    TRACED
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push((spec.clone(), cal.clone()));
+    Ok(cal)
+}
+
+fn trace(spec: &SensorSpec) -> Result<RadialCalibration, SimError> {
     let sensor = spec.build()?;
     let map = trace_radial_map(&sensor, CALIBRATION_STEP_PX)?;
     let fit = match sensor.optics {

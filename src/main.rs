@@ -5,9 +5,9 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::{Isometry2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
+use omniloop::experiments::{REPLAYS, ReplayContext, replay};
 use omniloop::output::{default_out_dir, write_run};
-use omniloop::replay::{EXPERIMENTS, corner_table, places_table, replay_corner55, replay_selfloc};
-use omniloop::runner::{RunOptions, render_snapshot};
+use omniloop::simulation::{RunOptions, render_snapshot};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice};
 use std::io::IsTerminal;
@@ -77,10 +77,14 @@ enum Command {
         #[arg(long)]
         no_noise: bool,
     },
-    /// Replay an experiment of the papers: `corner55` (E1, Fig. 7) or `selfloc` (E2, Fig. 8).
+    /// Replay an experiment of the papers (`--list` shows them).
     Replay {
         /// The experiment.
-        experiment: String,
+        #[arg(required_unless_present = "list")]
+        experiment: Option<String>,
+        /// List the experiments and exit.
+        #[arg(long)]
+        list: bool,
         /// Output folder (default: runs/<experiment>).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -207,8 +211,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             bar.finish_and_clear();
             write_run(&dir, &s, &output)?;
             let m = &output.summary;
-            if m.places.is_some() {
-                print!("{}", places_table(m));
+            if let Some(table) = s.experiment.as_ref().and_then(|e| e.table(m)) {
+                print!("{table}");
                 println!("results in {}", dir.display());
                 return Ok(());
             }
@@ -260,42 +264,48 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Replay {
             experiment,
+            list,
             out,
             seed,
             renderer,
             quiet,
         } => {
-            if !EXPERIMENTS.iter().any(|(n, _)| *n == experiment) {
-                let known: Vec<String> = EXPERIMENTS
+            let listing = || -> String {
+                REPLAYS
                     .iter()
-                    .map(|(n, d)| format!("  {n}: {d}"))
-                    .collect();
-                bail!(
-                    "unknown experiment {experiment:?}; known:\n{}",
-                    known.join("\n")
-                );
+                    .map(|r| format!("  {:<10} {}", r.name, r.title))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            };
+            if list {
+                println!("{}", listing());
+                return Ok(());
             }
-            let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(&experiment));
+            let name = experiment.expect("clap requires an experiment without --list");
+            let Some(r) = replay(&name) else {
+                bail!("unknown experiment {name:?}; known:\n{}", listing());
+            };
+            let dir = out.unwrap_or_else(|| PathBuf::from("runs").join(r.name));
             let options = RunOptions {
                 renderer,
                 ..RunOptions::default()
             };
             let bar = progress_bar(0, quiet);
-            let progress = |name: &str, k: u64, n: u64| {
+            let mut progress = |name: &str, k: u64, n: u64| {
                 bar.set_length(n);
                 bar.set_prefix(name.to_string());
                 bar.set_position(k);
             };
             let mut notice = |msg: &str| eprintln!("{msg}");
-            if experiment == "selfloc" {
-                let run = replay_selfloc(&dir, &options, seed, progress, &mut notice)?;
-                bar.finish_and_clear();
-                print!("{}", places_table(&run.output.summary));
-            } else {
-                let runs = replay_corner55(&dir, &options, seed, progress, &mut notice)?;
-                bar.finish_and_clear();
-                print!("{}", corner_table(&runs));
-            }
+            let table = (r.run)(&mut ReplayContext {
+                out: &dir,
+                options: &options,
+                seed,
+                progress: &mut progress,
+                notice: &mut notice,
+            })?;
+            bar.finish_and_clear();
+            print!("{table}");
             println!("\nwritten to {}", dir.display());
             Ok(())
         }
@@ -305,12 +315,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             out,
         } => {
             let s = load(&scenario)?;
-            let Some(spec) = s.sensor(sensor.as_deref()) else {
-                bail!(
-                    "scenario {:?} has no sensor {}",
-                    s.name,
-                    sensor.map_or("at all".to_string(), |n| format!("{n:?}"))
-                );
+            let spec = match s.sensor(sensor.as_deref()) {
+                Ok(spec) => spec,
+                Err(e) => bail!("scenario {:?}: {e}", s.name),
             };
             let cal = calibrate_sensor(spec)?;
             let out = out.unwrap_or_else(|| {

@@ -1,8 +1,9 @@
-//! Writing a run's results: `summary.json`, `trajectory.csv` and `topview.png`.
+//! Writing a run's results: `summary.json`, `trajectory.csv`, `estimates.jsonl` and
+//! `topview.png`.
 
-use crate::record::write_trajectory_csv;
-use crate::runner::RunOutput;
+use crate::record::{write_estimates_jsonl, write_trajectory_csv};
 use crate::scenario::Scenario;
+use crate::simulation::RunOutput;
 use crate::topview::{Marker, PathLayer, draw_topview};
 use anyhow::Context;
 use nalgebra::Point2;
@@ -15,7 +16,8 @@ pub fn default_out_dir(scenario: &Scenario) -> PathBuf {
     Path::new("runs").join(&scenario.name)
 }
 
-/// Writes `summary.json`, `trajectory.csv` and `topview.png` into `dir` (created if needed).
+/// Writes `summary.json`, `trajectory.csv`, `estimates.jsonl` and `topview.png` into `dir`
+/// (created if needed).
 pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let summary_path = dir.join("summary.json");
@@ -26,6 +28,10 @@ pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Re
     let f = File::create(&traj_path).with_context(|| format!("writing {}", traj_path.display()))?;
     write_trajectory_csv(&out.trajectory, BufWriter::new(f))
         .with_context(|| format!("writing {}", traj_path.display()))?;
+    let est_path = dir.join("estimates.jsonl");
+    let f = File::create(&est_path).with_context(|| format!("writing {}", est_path.display()))?;
+    write_estimates_jsonl(&out.trajectory, &out.estimates, BufWriter::new(f))
+        .with_context(|| format!("writing {}", est_path.display()))?;
     draw_run_topview(&dir.join("topview.png"), scenario, out)?;
     Ok(())
 }

@@ -1,5 +1,7 @@
 //! What a run leaves behind: the trajectory (one row a control cycle) and the summary.
 
+use nalgebra::Isometry2;
+use omniloop_robot::{Estimates, Fix, FixOutcome, Measurement};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 
@@ -91,12 +93,6 @@ pub struct Summary {
     pub path_length_mm: f64,
     /// The renderer that traced the sensors' images (adapter name or `cpu (...)`), if any.
     pub renderer: Option<String>,
-    /// E1: `(K - p).u1` where the robot starts giving up speed along the first leg.
-    #[serde(skip_serializing_if = "Option::is_none", default)]
-    pub turn_onset_mm: Option<f64>,
-    /// E1: how far past the corner point the robot centre went along the first leg.
-    #[serde(skip_serializing_if = "Option::is_none", default)]
-    pub overshoot_mm: Option<f64>,
     /// Median over the run of |detected free distance - true free distance| over all directions
     /// (truth ray-cast in the world, clipped at the template's range).
     #[serde(skip_serializing_if = "Option::is_none", default)]
@@ -111,24 +107,128 @@ pub struct Summary {
     /// With localization in the loop: how many localizations corrected the pose.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub localization_fixes: Option<usize>,
-    /// Experiment mode: the results at each place.
-    #[serde(skip_serializing_if = "Option::is_none", default)]
-    pub places: Option<Vec<PlaceResult>>,
+    /// The experiment's own metrics (`turn_onset_mm`, `overshoot_mm` of E1, `places` of E2,
+    /// ...), written as keys of the summary beside the others.
+    #[serde(flatten)]
+    pub experiment: serde_json::Map<String, serde_json::Value>,
 }
 
-/// Self-localization at one place of an experiment (E2).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct PlaceResult {
-    /// The true pose: x_mm, y_mm, theta_deg.
-    pub true_pose: [f64; 3],
-    /// RMS distance of the localized estimates from the true position.
-    pub rms_position_mm: f64,
-    /// RMS heading error of the localized estimates.
-    pub rms_heading_deg: f64,
-    /// Estimates that took the wrong one of the two half-turn solutions.
-    pub ambiguity_errors: usize,
-    /// Frames taken here.
-    pub frames: usize,
-    /// Frames that gave no estimate.
-    pub not_localized: usize,
+impl Summary {
+    /// The experiment metric `key` as a number, when it is one.
+    pub fn metric(&self, key: &str) -> Option<f64> {
+        self.experiment.get(key).and_then(serde_json::Value::as_f64)
+    }
+}
+
+/// A planar pose as written in `estimates.jsonl`.
+#[derive(Debug, Clone, Copy, Serialize)]
+struct PoseRecord {
+    x_mm: f64,
+    y_mm: f64,
+    theta_rad: f64,
+}
+
+impl PoseRecord {
+    fn of(p: &Isometry2<f64>) -> Self {
+        Self {
+            x_mm: p.translation.x,
+            y_mm: p.translation.y,
+            theta_rad: p.rotation.angle(),
+        }
+    }
+}
+
+/// A fix as written in `estimates.jsonl`: what was measured (the parts a kind has) and what
+/// the estimator did with it.
+#[derive(Debug, Serialize)]
+struct FixRecord<'a> {
+    source: &'a str,
+    kind: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    x_mm: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    y_mm: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    theta_rad: Option<f64>,
+    outcome: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    why: Option<&'a str>,
+}
+
+impl<'a> FixRecord<'a> {
+    fn of(f: &'a Fix) -> Self {
+        let (kind, x, y, t) = match &f.measurement {
+            Measurement::Pose { pose, .. } => {
+                let p = PoseRecord::of(pose);
+                ("pose", Some(p.x_mm), Some(p.y_mm), Some(p.theta_rad))
+            }
+            Measurement::Heading { heading_rad } => ("heading", None, None, Some(*heading_rad)),
+            Measurement::Position { position } => {
+                ("position", Some(position.x), Some(position.y), None)
+            }
+            Measurement::Motion { delta } => {
+                let p = PoseRecord::of(delta);
+                ("motion", Some(p.x_mm), Some(p.y_mm), Some(p.theta_rad))
+            }
+        };
+        let (outcome, why) = match &f.outcome {
+            FixOutcome::Anchored => ("anchored", None),
+            FixOutcome::Used => ("used", None),
+            FixOutcome::Rejected(why) => ("rejected", Some(why.as_str())),
+            FixOutcome::Ignored => ("ignored", None),
+        };
+        Self {
+            source: f.source,
+            kind,
+            x_mm: x,
+            y_mm: y,
+            theta_rad: t,
+            outcome,
+            why,
+        }
+    }
+}
+
+/// One line of `estimates.jsonl`: the truth of a cycle beside what the robot believed.
+#[derive(Debug, Serialize)]
+struct EstimateLine<'a> {
+    t_s: f64,
+    truth: PoseRecord,
+    estimate: Option<PoseRecord>,
+    target: Option<usize>,
+    fixes: Vec<FixRecord<'a>>,
+    not_found: Vec<(&'a str, &'a str)>,
+    free_mm: Option<&'a [f64]>,
+}
+
+/// Writes one JSON line a control cycle: time, true pose, the robot's pose estimate, the
+/// target it headed for, its fixes with their outcomes, the stages that found nothing (with
+/// why) and its free distances.
+pub fn write_estimates_jsonl(
+    rows: &[TrajectoryRow],
+    estimates: &[Estimates],
+    mut w: impl Write,
+) -> std::io::Result<()> {
+    for (r, e) in rows.iter().zip(estimates) {
+        let line = EstimateLine {
+            t_s: e.t_s,
+            truth: PoseRecord {
+                x_mm: r.x_mm,
+                y_mm: r.y_mm,
+                theta_rad: r.theta_rad,
+            },
+            estimate: e.pose.as_ref().map(PoseRecord::of),
+            target: e.target,
+            fixes: e.fixes.iter().map(FixRecord::of).collect(),
+            not_found: e
+                .not_found
+                .iter()
+                .map(|n| (n.source, n.reason.as_str()))
+                .collect(),
+            free_mm: e.freespace.as_ref().map(|f| f.free_mm.as_slice()),
+        };
+        serde_json::to_writer(&mut w, &line)?;
+        writeln!(w)?;
+    }
+    Ok(())
 }

@@ -3,12 +3,13 @@
 //! Every table rejects unknown keys. Parsing and validation errors name the file, the line
 //! and column, and the dotted path of the field ([`crate::scenario_error`]).
 
+use crate::experiments::ExperimentSpec;
+use crate::odometry::OdometrySpec;
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop_control::AvoidanceConfig;
+use omniloop_robot::{BodySpec, ControlSpec, GoalSpec, RobotConfig, VisionSpec};
 use omniloop_sim::{Layout, Rgb, SensorSpec};
-use omniloop_vision::{FreeSpaceConfig, LocalizationConfig};
+use omniloop_vision::RadialCalibration;
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
 
 /// A complete scenario: the world, the robot, what it should do and for how long.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -40,35 +41,16 @@ pub struct Scenario {
     /// Image processing.
     #[serde(default)]
     pub vision: VisionSpec,
-    /// How the robot chooses its velocity.
+    /// How the robot chooses its velocity and where its pose estimate comes from.
     #[serde(default)]
     pub control: ControlSpec,
-    /// The robot's wheel odometry.
+    /// The errors of the robot's wheel odometry.
     #[serde(default)]
     pub odometry: OdometrySpec,
-    /// Experiment metrics to compute.
-    #[serde(default)]
-    pub metrics: MetricsSpec,
-    /// Experiment mode: carry the robot to places and estimate its pose there, instead of
-    /// driving.
+    /// The experiment this scenario belongs to (`[experiment.NAME]`): its procedure and
+    /// metrics. Without one, the robot drives until the goal or the time is up.
     #[serde(default)]
     pub experiment: Option<ExperimentSpec>,
-}
-
-/// Experiment mode (E2): the robot is put at each place in turn and estimates its pose
-/// `frames_per_place` times there, with fresh sensor noise in every frame.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ExperimentSpec {
-    /// The places (field frame).
-    pub places: Vec<PoseSpec>,
-    /// Estimates at each place.
-    #[serde(default = "default_frames_per_place")]
-    pub frames_per_place: u32,
-}
-
-fn default_frames_per_place() -> u32 {
-    10
 }
 
 fn default_seed() -> u64 {
@@ -212,162 +194,6 @@ fn default_other_rgb() -> Rgb {
     Rgb([200, 40, 160])
 }
 
-/// The goal point, reached through optional waypoints.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GoalSpec {
-    /// Points to pass (within the tolerance) in order before the goal point.
-    #[serde(default)]
-    pub waypoints_mm: Vec<[f64; 2]>,
-    /// x of the goal point (world frame).
-    pub x_mm: f64,
-    /// y of the goal point (world frame).
-    pub y_mm: f64,
-    /// The goal is reached when the robot centre is this close.
-    #[serde(default = "default_goal_tolerance")]
-    pub tolerance_mm: f64,
-}
-
-fn default_goal_tolerance() -> f64 {
-    100.0
-}
-
-impl GoalSpec {
-    /// The goal point.
-    pub fn point(&self) -> Point2<f64> {
-        Point2::new(self.x_mm, self.y_mm)
-    }
-
-    /// The waypoints and then the goal point.
-    pub fn targets(&self) -> Vec<Point2<f64>> {
-        self.waypoints_mm
-            .iter()
-            .map(|w| Point2::new(w[0], w[1]))
-            .chain(std::iter::once(self.point()))
-            .collect()
-    }
-}
-
-/// Which controller drives the robot.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum ControllerKind {
-    /// Stand still.
-    Idle,
-    /// Straight to the goal on the true pose (a reference that needs no vision).
-    #[default]
-    GoToGoalTruth,
-    /// Free direction closest to the goal direction, from the image (ref. [4] of the corner
-    /// paper); goal dead-reckoned from odometry.
-    GoalDirection,
-    /// Velocity-aware avoidance of Sect. 3.2, from the image; goal dead-reckoned.
-    VelocityAware,
-}
-
-impl ControllerKind {
-    /// Whether the controller needs the free-space detection.
-    pub fn uses_vision(self) -> bool {
-        matches!(self, Self::GoalDirection | Self::VelocityAware)
-    }
-}
-
-/// How the robot chooses its velocity.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ControlSpec {
-    /// The controller.
-    pub kind: ControllerKind,
-    /// Settings of the avoidance controllers.
-    pub avoidance: AvoidanceConfig,
-    /// Where the vision controllers' pose comes from.
-    pub pose_source: PoseSource,
-    /// With `pose_source = "localization"`: how far each localization pulls the dead-reckoned
-    /// pose toward itself (0: odometry only, 1: jump to the measurement).
-    pub localization_gain: f64,
-}
-
-/// Where the vision controllers' pose estimate comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum PoseSource {
-    /// Dead reckoning from wheel odometry alone (the goal is given in the start frame).
-    #[default]
-    Odometry,
-    /// Odometry corrected by floor-region self-localization every cycle (the goal and the
-    /// start are in the field frame).
-    Localization,
-}
-
-impl Default for ControlSpec {
-    fn default() -> Self {
-        Self {
-            kind: ControllerKind::default(),
-            avoidance: AvoidanceConfig::default(),
-            pose_source: PoseSource::Odometry,
-            localization_gain: 0.3,
-        }
-    }
-}
-
-/// Image processing settings.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
-pub struct VisionSpec {
-    /// The sensor whose images vision uses (default: the robot's first).
-    pub sensor: Option<String>,
-    /// A calibration table written by `omniloop calibrate` (relative to the scenario file);
-    /// default: traced from the sensor's optics at start.
-    pub calibration_file: Option<PathBuf>,
-    /// Free-space detection (Sect. 3.1 of the corner paper).
-    pub freespace: FreeSpaceConfig,
-    /// Self-localization from the floor region (Sect. 4 of the corner paper).
-    pub localization: LocalizationConfig,
-}
-
-/// The robot's wheel odometry: the true body velocity with systematic and seeded Gaussian
-/// errors.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct OdometrySpec {
-    /// Standard deviation of the relative error of each velocity component.
-    pub speed_noise_frac: f64,
-    /// Standard deviation of the rotation-rate error.
-    pub omega_noise_rad_s: f64,
-    /// Systematic scale error of the measured speed (e.g. a wheel radius off by this fraction).
-    pub scale_bias_frac: f64,
-    /// Systematic rotation-rate error (gyro bias, wheel slip).
-    pub omega_bias_rad_s: f64,
-}
-
-impl Default for OdometrySpec {
-    fn default() -> Self {
-        Self {
-            speed_noise_frac: 0.01,
-            omega_noise_rad_s: 0.0,
-            scale_bias_frac: 0.0,
-            omega_bias_rad_s: 0.0,
-        }
-    }
-}
-
-/// Experiment metrics.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
-pub struct MetricsSpec {
-    /// The corner metrics of E1 (`turn_onset_mm`, `overshoot_mm`).
-    pub corner: Option<CornerSpec>,
-}
-
-/// The corner of E1: the corner point K and the direction of the first leg.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CornerSpec {
-    /// K, where the legs' centre lines meet.
-    pub k_mm: [f64; 2],
-    /// Direction u1 of the first leg.
-    pub leg1_heading_deg: f64,
-}
-
 impl Scenario {
     /// Parses a scenario from TOML text (no validation; see [`crate::load_scenario`]).
     pub fn from_toml(text: &str) -> Result<Self, toml::de::Error> {
@@ -397,24 +223,68 @@ impl Scenario {
         out
     }
 
-    /// The sensor called `name`, or the first one when `name` is `None`.
-    pub fn sensor(&self, name: Option<&str>) -> Option<&SensorSpec> {
+    /// The index of the robot's sensor called `name`, or of its first sensor when `name` is
+    /// `None`; the error says which sensors there are.
+    pub fn sensor_index(&self, name: Option<&str>) -> Result<usize, String> {
+        let sensors = &self.robot.sensors;
         match name {
-            Some(n) => self.robot.sensors.iter().find(|s| s.name == n),
-            None => self.robot.sensors.first(),
+            Some(n) => sensors.iter().position(|s| s.name == n).ok_or_else(|| {
+                let names: Vec<&str> = sensors.iter().map(|s| s.name.as_str()).collect();
+                if names.is_empty() {
+                    format!("the robot has no sensor {n:?} (it has none)")
+                } else {
+                    format!(
+                        "the robot has no sensor {n:?} (it has: {})",
+                        names.join(", ")
+                    )
+                }
+            }),
+            None if sensors.is_empty() => {
+                Err("the robot has no sensor (add a [[robot.sensors]] table)".into())
+            }
+            None => Ok(0),
         }
+    }
+
+    /// The sensor called `name`, or the first one when `name` is `None`.
+    pub fn sensor(&self, name: Option<&str>) -> Result<&SensorSpec, String> {
+        self.sensor_index(name).map(|i| &self.robot.sensors[i])
+    }
+
+    /// The index of the sensor vision uses (`vision.sensor`, else the first).
+    pub fn vision_sensor_index(&self) -> Result<usize, String> {
+        self.sensor_index(self.vision.sensor.as_deref())
+    }
+
+    /// The configuration of the robot's software: what it is told of its start, its body and
+    /// cameras, with the image-to-floor calibrations of the cameras vision uses.
+    pub fn robot_config(&self, calibrations: Vec<RadialCalibration>) -> RobotConfig {
+        let r = &self.robot;
+        RobotConfig {
+            start: r.start.isometry(),
+            body: BodySpec {
+                radius_mm: r.radius_mm,
+                max_speed_mm_s: r.max_speed_mm_s,
+                accel_limit_mm_s2: r.accel_limit_mm_s2,
+                angular_accel_limit_rad_s2: r.angular_accel_limit_rad_s2,
+            },
+            control_period_s: self.run.control_period_s,
+            cameras: r.sensors.iter().map(|s| s.name.clone()).collect(),
+            calibrations,
+            vision: self.vision.clone(),
+            control: self.control.clone(),
+            goal: self.goal.clone(),
+        }
+    }
+
+    /// Whether the robot's software uses a mirror camera's image-to-floor map.
+    pub fn needs_calibration(&self) -> bool {
+        self.control.kind.uses_freespace()
+            || self.control.pose_source == omniloop_robot::PoseSource::Localization
     }
 
     /// Number of control cycles the run lasts at most.
     pub fn max_cycles(&self) -> u64 {
         (self.run.duration_s / self.run.control_period_s).round() as u64
-    }
-}
-
-/// The name of a controller as written in scenario files.
-pub fn controller_name(kind: ControllerKind) -> String {
-    match toml::Value::try_from(kind) {
-        Ok(toml::Value::String(s)) => s,
-        _ => format!("{kind:?}"),
     }
 }

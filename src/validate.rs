@@ -1,8 +1,9 @@
 //! Validation of a parsed scenario: every rule a value must satisfy, checked once, each
 //! failure naming the dotted path of the field it concerns.
 
-use crate::scenario::{ControllerKind, PoseSource, PoseSpec, Scenario};
+use crate::scenario::{PoseSpec, Scenario};
 use nalgebra::Point2;
+use omniloop_robot::{ControllerKind, PoseSource};
 use omniloop_sim::{Layout, SensorSpec};
 use std::fmt;
 
@@ -64,31 +65,38 @@ pub struct Violation {
     pub message: String,
 }
 
-struct Checker {
+/// Collects the violations of a scenario (experiments check their own sections with it).
+pub(crate) struct Checker {
     out: Vec<Violation>,
 }
 
 impl Checker {
-    fn fail(&mut self, path: impl AsRef<str>, message: impl Into<String>) {
+    pub(crate) fn fail(&mut self, path: impl AsRef<str>, message: impl Into<String>) {
         self.out.push(Violation {
             path: FieldPath::parse(path.as_ref()),
             message: message.into(),
         });
     }
 
-    fn positive(&mut self, path: impl AsRef<str>, v: f64) {
+    pub(crate) fn positive(&mut self, path: impl AsRef<str>, v: f64) {
         if !(v.is_finite() && v > 0.0) {
             self.fail(path, format!("must be a finite number > 0 (got {v})"));
         }
     }
 
-    fn finite(&mut self, path: impl AsRef<str>, v: f64) {
+    pub(crate) fn finite(&mut self, path: impl AsRef<str>, v: f64) {
         if !v.is_finite() {
             self.fail(path, format!("must be a finite number (got {v})"));
         }
     }
 
-    fn pose_in_world(&mut self, path: &str, pose: &PoseSpec, radius: f64, world: &Layout) {
+    pub(crate) fn pose_in_world(
+        &mut self,
+        path: &str,
+        pose: &PoseSpec,
+        radius: f64,
+        world: &Layout,
+    ) {
         self.finite(format!("{path}.x_mm"), pose.x_mm);
         self.finite(format!("{path}.y_mm"), pose.y_mm);
         self.finite(format!("{path}.heading_deg"), pose.heading_deg);
@@ -232,6 +240,15 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         c.finite("goal.x_mm", g.x_mm);
         c.finite("goal.y_mm", g.y_mm);
         c.positive("goal.tolerance_mm", g.tolerance_mm);
+        if !(g.estimate_margin_mm >= 0.0 && g.estimate_margin_mm < g.tolerance_mm) {
+            c.fail(
+                "goal.estimate_margin_mm",
+                format!(
+                    "must lie in [0, tolerance_mm = {}) (got {})",
+                    g.tolerance_mm, g.estimate_margin_mm
+                ),
+            );
+        }
         if !in_floor(w, g.point()) {
             c.fail(
                 "goal.x_mm",
@@ -248,9 +265,22 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             "control.kind",
             format!(
                 "controller {:?} needs a [goal] table",
-                crate::scenario::controller_name(s.control.kind)
+                s.control.kind.name()
             ),
         );
+    }
+    if let Some(g) = &s.goal {
+        for (k, wp) in g.waypoints_mm.iter().enumerate() {
+            if !in_floor(w, Point2::new(wp[0], wp[1])) {
+                c.fail(
+                    format!("goal.waypoints_mm[{k}]"),
+                    format!("({}, {}) mm is outside the floor region", wp[0], wp[1]),
+                );
+            }
+        }
+    }
+    if let Some(e) = &s.experiment {
+        e.validate(s, &mut c);
     }
     c.out
 }
@@ -352,36 +382,30 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
         );
     }
     c.finite("odometry.omega_bias_rad_s", o.omega_bias_rad_s);
-    if !s.control.kind.uses_vision() {
+    if !s.needs_calibration() {
         return;
     }
-    // The controller sees through a mirror sensor: its calibration and the template must work.
+    // Vision sees through a mirror sensor: its calibration and the template must work.
     let sensors = &s.robot.sensors;
-    let index = match &s.vision.sensor {
-        Some(name) => match sensors.iter().position(|x| &x.name == name) {
-            Some(i) => i,
-            None => {
-                c.fail("vision.sensor", format!("the robot has no sensor {name:?}"));
-                return;
-            }
-        },
-        None if sensors.is_empty() => {
-            c.fail(
-                "control.kind",
-                format!(
-                    "controller {:?} sees through a camera: add a [[robot.sensors]]",
-                    crate::scenario::controller_name(s.control.kind)
-                ),
-            );
+    let index = match s.vision_sensor_index() {
+        Ok(i) => i,
+        Err(e) => {
+            let field = if s.vision.sensor.is_some() {
+                "vision.sensor"
+            } else if s.control.kind.uses_freespace() {
+                "control.kind"
+            } else {
+                "control.pose_source"
+            };
+            c.fail(field, format!("vision sees through a camera: {e}"));
             return;
         }
-        None => 0,
     };
     if sensors[index].pinhole.is_some() || sensors[index].optics_present().len() != 1 {
         c.fail(
             "vision.sensor",
             format!(
-                "free space needs a mirror sensor; {:?} is not one",
+                "free space and self-localization need a mirror sensor; {:?} is not one",
                 sensors[index].name
             ),
         );
@@ -403,7 +427,7 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
             }
         },
     };
-    if !c.out.is_empty() {
+    if !c.out.is_empty() || !s.control.kind.uses_freespace() {
         return;
     }
     if let Err(e) = omniloop_vision::freespace::PolarTemplate::new(fs, &cal) {
@@ -470,53 +494,11 @@ fn check_localization(c: &mut Checker, s: &Scenario) {
             format!("must lie in [0, 1] (got {g})"),
         );
     }
-    let localizes = s.experiment.is_some() || s.control.pose_source == PoseSource::Localization;
-    if localizes && s.world.field.is_none() {
-        c.fail(
-            if s.experiment.is_some() {
-                "experiment"
-            } else {
-                "control.pose_source"
-            },
-            "self-localization matches the floor region to the field: add [world.field]",
-        );
-    }
-    if s.control.pose_source == PoseSource::Localization && !s.control.kind.uses_vision() {
+    if s.control.pose_source == PoseSource::Localization && s.world.field.is_none() {
         c.fail(
             "control.pose_source",
-            "only the vision controllers (goal_direction, velocity_aware) use a pose estimate",
+            "self-localization matches the floor region to the field: add [world.field]",
         );
-    }
-    if let Some(e) = &s.experiment {
-        if e.places.is_empty() {
-            c.fail("experiment.places", "needs at least one place");
-        }
-        if e.frames_per_place == 0 {
-            c.fail("experiment.frames_per_place", "must be >= 1");
-        }
-        for (i, p) in e.places.iter().enumerate() {
-            c.pose_in_world(
-                &format!("experiment.places[{i}]"),
-                p,
-                s.robot.radius_mm,
-                &s.world,
-            );
-        }
-        let mirror = s
-            .vision
-            .sensor
-            .as_ref()
-            .map_or(s.robot.sensors.first(), |n| {
-                s.robot.sensors.iter().find(|x| &x.name == n)
-            })
-            .is_some_and(|x| x.pinhole.is_none() && x.optics_present().len() == 1);
-        if !mirror {
-            c.fail(
-                "experiment",
-                "localization needs a mirror sensor on the robot ([[robot.sensors]], or \
-                 vision.sensor naming one)",
-            );
-        }
     }
 }
 
@@ -623,6 +605,13 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
         let q = format!("{p}.pinhole");
         c.positive(format!("{q}.focal_px"), m.focal_px);
         c.positive(format!("{q}.height_mm"), m.height_mm);
+        c.positive(format!("{q}.pan_rate_limit_deg_s"), m.pan_rate_limit_deg_s);
+        if m.pan_deg.is_nan() || m.pan_deg.abs() > 180.0 {
+            c.fail(
+                format!("{q}.pan_deg"),
+                format!("must lie in [-180, 180] (got {})", m.pan_deg),
+            );
+        }
         if m.tilt_deg.is_nan() || m.tilt_deg.abs() > 90.0 {
             c.fail(
                 format!("{q}.tilt_deg"),

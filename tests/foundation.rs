@@ -151,6 +151,15 @@ fn same_scenario_and_seed_give_byte_identical_trajectories() {
             serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
         assert_eq!(summary["seed"], 11);
         assert!(dir.join("topview.png").exists());
+        // One line of estimates a control cycle, the truth beside what the robot believed.
+        let cycles = summary["cycles"].as_u64().unwrap() as usize;
+        let text = std::fs::read_to_string(dir.join("estimates.jsonl")).unwrap();
+        assert_eq!(text.lines().count(), cycles);
+        for line in text.lines() {
+            let v: serde_json::Value = serde_json::from_str(line).unwrap();
+            assert!(v["truth"]["x_mm"].is_number(), "{line}");
+            assert!(v["estimate"]["x_mm"].is_number(), "{line}");
+        }
     }
     assert!(files[0].len() > 1000);
     assert_eq!(files[0], files[1]);
@@ -158,7 +167,7 @@ fn same_scenario_and_seed_give_byte_identical_trajectories() {
 
 #[test]
 fn a_robot_commanded_into_a_wall_at_2000_mm_s_stays_outside_and_the_contact_is_counted() {
-    let text = "[run]\nduration_s = 3.0\n\n[world]\n[[world.walls]]\nfrom_mm = [600.0, -500.0]\nto_mm = [600.0, 500.0]\n\n[robot]\nstart = { x_mm = 0.0, y_mm = 0.0 }\nmax_speed_mm_s = 2000.0\naccel_limit_mm_s2 = 20000.0\n\n[goal]\nx_mm = 900.0\ny_mm = 0.0\n";
+    let text = "[run]\nduration_s = 3.0\n\n[world]\n[[world.walls]]\nfrom_mm = [600.0, -500.0]\nto_mm = [600.0, 500.0]\n\n[robot]\nstart = { x_mm = 0.0, y_mm = 0.0 }\nmax_speed_mm_s = 2000.0\naccel_limit_mm_s2 = 20000.0\n\n[goal]\nx_mm = 900.0\ny_mm = 0.0\n\n[control]\nkind = \"go_to_goal_truth\"\n";
     let s = match parse_scenario(text, Path::new("wall.toml"), "wall") {
         Ok(s) => s,
         Err(LoadError::Invalid { problems }) => panic!("{problems:?}"),
@@ -183,5 +192,32 @@ fn a_robot_commanded_into_a_wall_at_2000_mm_s_stays_outside_and_the_contact_is_c
         String::from_utf8(csv)
             .unwrap()
             .starts_with("t_s,x_mm,y_mm,theta_rad")
+    );
+}
+
+#[test]
+fn a_scenario_that_names_no_controller_stands_still() {
+    // Ground truth is never the default: without `control.kind` the robot is idle.
+    let s = parse_scenario(BASE, Path::new("idle.toml"), "idle").unwrap();
+    let out = run_scenario(&s, &Default::default(), |_| {}, |_, _| {}).unwrap();
+    let m = &out.summary;
+    assert_eq!(m.controller, "idle");
+    assert_eq!(m.path_length_mm, 0.0);
+    assert!(!m.reached_goal);
+    assert_eq!(m.cycles, s.max_cycles());
+}
+
+#[test]
+fn replay_lists_its_experiments_and_refuses_unknown_ones() {
+    let text = omniloop(["replay", "--list"]);
+    for name in ["corner55", "selfloc"] {
+        assert!(text.contains(name), "{text}");
+    }
+    let out = bin().args(["replay", "corner56"]).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("unknown experiment \"corner56\"") && err.contains("corner55"),
+        "{err}"
     );
 }

@@ -6,7 +6,7 @@ mod common;
 use common::scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
-use omniloop::runner::sensor_noise_seed;
+use omniloop::simulation::sensor_noise_seed;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::{FreeSpaceDetector, FreeSpaceMethod};
 

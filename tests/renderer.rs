@@ -5,7 +5,7 @@
 use nalgebra::{Isometry2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
-use omniloop::runner::render_snapshot;
+use omniloop::simulation::render_snapshot;
 use omniloop_sim::optics::HyperbolicMirror;
 use omniloop_sim::render::SensorRays;
 use omniloop_sim::{

@@ -16,9 +16,10 @@
 //!   admissible direction closest to the goal direction, or stop at the acceleration limit when
 //!   there is none and keep looking.
 
+use crate::angle::angle_diff;
 use crate::{AccelLimitedDrive, ControlError, Vec2, require_positive};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 /// What vision reports around the robot, in the robot frame.
 #[derive(Debug, Clone, Copy)]
@@ -75,11 +76,6 @@ pub struct Decision {
     pub v_mm_s: Vec2,
     /// The direction chosen, or `None` when stopping.
     pub heading_rad: Option<f64>,
-}
-
-fn angle_diff(a: f64, b: f64) -> f64 {
-    let d = (a - b).rem_euclid(TAU);
-    if d > PI { TAU - d } else { d }
 }
 
 /// Speed toward a goal `d` mm away: `min(v_max, sqrt(2 alpha d))`, so the robot can stop on it.

@@ -5,11 +5,13 @@
 //! so the same code drives the simulated robot and a real one. Nothing in this crate knows the
 //! simulator.
 
+pub mod angle;
 pub mod avoidance;
 pub mod drive;
 pub mod go_to_goal;
 pub mod odometry;
 
+pub use angle::{angle_diff, wrap_pi};
 pub use avoidance::{AvoidanceConfig, Decision, GoalDirection, Surroundings, VelocityAware};
 pub use drive::{AccelLimitedDrive, VelocityCommand};
 pub use go_to_goal::GoToGoal;

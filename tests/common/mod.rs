@@ -1,7 +1,7 @@
 //! Helpers shared by the end-to-end tests.
 #![allow(dead_code)]
 
-use omniloop::runner::RunOptions;
+use omniloop::simulation::RunOptions;
 use omniloop::{Scenario, load_scenario};
 use omniloop_sim::RendererChoice;
 use std::ffi::OsStr;

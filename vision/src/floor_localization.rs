@@ -25,7 +25,7 @@ use crate::mask::{FloorColor, Mask};
 use image::RgbaImage;
 use nalgebra::{Isometry2, Matrix3, Point2, Rotation2, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
 
 /// The floor region's outline (Fig. 6 of the corner paper).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -201,11 +201,6 @@ pub struct FloorLocalizer {
     scratch: Vec<u8>,
 }
 
-fn wrap_pi(a: f64) -> f64 {
-    let w = a.rem_euclid(TAU);
-    if w > PI { w - TAU } else { w }
-}
-
 impl FloorLocalizer {
     /// A localizer for images of the sensor `cal` describes.
     pub fn new(config: LocalizationConfig, cal: &RadialCalibration) -> Result<Self, VisionError> {
@@ -323,8 +318,8 @@ impl FloorLocalizer {
         // Step 7: the robot in the field frame. The field's x axis is at psi in the robot
         // frame, so the robot's heading in the field is -psi, and its position is the field
         // centre's position seen from the field: -R(theta) g.
+        // (The rotation takes theta modulo 2 pi; its angle() reads back in (-pi, pi].)
         let pose_for = |theta: f64| {
-            let theta = wrap_pi(theta);
             let t = -(Rotation2::new(theta) * centre.coords);
             Isometry2::new(t, theta)
         };
@@ -544,8 +539,9 @@ impl FloorLocalizer {
                 let q = pose.inverse_transform_point(&Point2::new(goal_x, 0.0));
                 q.y.atan2(q.x)
             };
-            let err_a = wrap_pi(seen - predicted(a)).abs();
-            let err_b = wrap_pi(seen - predicted(b)).abs();
+            // The rotation's angle reads back in (-pi, pi]: the angular error.
+            let err_a = Rotation2::new(seen - predicted(a)).angle().abs();
+            let err_b = Rotation2::new(seen - predicted(b)).angle().abs();
             score += err_b - err_a;
         }
         if score > 1e-9 {
@@ -655,7 +651,7 @@ mod tests {
                 panic!("not localized at ({x}, {y}, {deg})");
             };
             let d = (e.pose.translation.vector - truth.translation.vector).norm();
-            let dh = wrap_pi(e.pose.rotation.angle() - truth.rotation.angle()).abs();
+            let dh = (e.pose.rotation / truth.rotation).angle().abs();
             assert!(d < 30.0, "({x}, {y}, {deg}): position off by {d}");
             assert!(
                 dh < 1f64.to_radians(),

@@ -106,6 +106,9 @@ pub struct FreeSpace {
     pub ratio: Vec<f64>,
     /// Points on the near edge of each direction's first obstacle cell, robot frame.
     pub obstacle_points: Vec<Point2<f64>>,
+    /// How far the template reaches (its outer edge on the floor): a direction free
+    /// throughout is free this far, and nothing is known beyond.
+    pub range_mm: f64,
 }
 
 impl FreeSpace {
@@ -413,6 +416,7 @@ impl FreeSpaceDetector {
             free_mm: vec![0.0; j_n],
             ratio,
             obstacle_points: Vec::new(),
+            range_mm: self.template.edges_mm[i_n],
         };
         let [mx, my] = self.template.mount_mm;
         for j in 0..j_n {

@@ -30,7 +30,7 @@ pub struct HyperbolicMirror {
 }
 
 impl HyperbolicMirror {
-    /// The mirror reconstructed from the corner paper's calibration (`shared/EXPERIMENTS.md`):
+    /// The mirror reconstructed from the corner paper's calibration (`docs/experiments.md`):
     /// f = sqrt(C) = 479.37 px, b/c = 0.79040, c = 19.8 mm, viewpoint 205.08 mm above the floor.
     pub fn corner_paper() -> Self {
         Self {

@@ -19,6 +19,13 @@ pub struct PinholeCamera {
     /// Elevation of the optical axis (negative looks down).
     #[serde(default)]
     pub tilt_deg: f64,
+    /// Fastest the pan unit turns the camera when the robot commands a pan.
+    #[serde(default = "default_pan_rate")]
+    pub pan_rate_limit_deg_s: f64,
+}
+
+fn default_pan_rate() -> f64 {
+    60.0
 }
 
 impl PinholeCamera {
@@ -54,6 +61,7 @@ mod tests {
             height_mm: 100.0,
             pan_deg: 0.0,
             tilt_deg: -45.0,
+            pan_rate_limit_deg_s: 60.0,
         };
         let hit = cam.scene_ray(0.0, 0.0).unwrap().floor_hit().unwrap();
         assert!((hit.x - 100.0).abs() < 1e-9 && hit.y.abs() < 1e-9);

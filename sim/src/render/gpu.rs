@@ -170,16 +170,25 @@ fn entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntr
 impl GpuRenderer {
     /// Opens the first adapter wgpu offers (hardware or a software driver such as lavapipe).
     pub fn new() -> Result<Self, RenderError> {
+        Self::with_adapter(Self::adapter()?)
+    }
+
+    /// The adapter wgpu offers first, preferring high performance.
+    pub fn adapter() -> Result<wgpu::Adapter, RenderError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.flags = wgpu::InstanceFlags::empty();
         let instance = wgpu::Instance::new(desc.with_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
             compatible_surface: None,
             apply_limit_buckets: false,
         }))
-        .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
+        .map_err(|e| RenderError::NoAdapter(e.to_string()))
+    }
+
+    /// Opens `adapter`: device, shader and buffers.
+    pub fn with_adapter(adapter: wgpu::Adapter) -> Result<Self, RenderError> {
         let info = adapter.get_info();
         let adapter_name = format!("{} ({:?})", info.name, info.backend);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {

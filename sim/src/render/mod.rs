@@ -69,18 +69,29 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Opens the chosen renderer. With `Auto` and no adapter, falls back to the CPU and reports
-    /// why through `notice`.
+    /// Opens the chosen renderer. With `Auto`, the GPU when a hardware adapter opens; with no
+    /// adapter, or only a software one (a rasterizer such as Mesa's llvmpipe, which traces
+    /// these frames slower than the CPU renderer), the CPU, saying why through `notice`.
     pub fn new(choice: RendererChoice, notice: impl FnOnce(&str)) -> Result<Self, RenderError> {
         let backend = match choice {
             RendererChoice::Cpu => Backend::Cpu(CpuRenderer::new()),
             RendererChoice::Gpu => Backend::Gpu(Box::new(GpuRenderer::new()?)),
-            RendererChoice::Auto => match GpuRenderer::new() {
-                Ok(g) => Backend::Gpu(Box::new(g)),
-                Err(e) => {
-                    notice(&format!("renderer: {e}; using the CPU renderer"));
+            RendererChoice::Auto => match GpuRenderer::adapter() {
+                Ok(a) if a.get_info().device_type == wgpu::DeviceType::Cpu => {
+                    notice(&format!(
+                        "renderer: the only GPU adapter is a software one ({}); using the CPU \
+                         renderer, which is faster here (--renderer gpu uses the adapter anyway)",
+                        a.get_info().name
+                    ));
                     Backend::Cpu(CpuRenderer::new())
                 }
+                other => match other.and_then(GpuRenderer::with_adapter) {
+                    Ok(g) => Backend::Gpu(Box::new(g)),
+                    Err(e) => {
+                        notice(&format!("renderer: {e}; using the CPU renderer"));
+                        Backend::Cpu(CpuRenderer::new())
+                    }
+                },
             },
         };
         let name = match &backend {
@@ -122,8 +133,15 @@ impl Renderer {
         match &mut self.backend {
             Backend::Gpu(g) => g.render(scene, sensor, pose, &mut self.pixels)?,
             Backend::Cpu(c) => {
-                let k = match self.rays.iter().position(|(s, _)| s == sensor) {
-                    Some(k) => k,
+                // One cache entry a sensor name, traced again when the sensor changed (a camera
+                // on a pan unit).
+                let k = match self.rays.iter().position(|(s, _)| s.name == sensor.name) {
+                    Some(k) => {
+                        if self.rays[k].0 != *sensor {
+                            self.rays[k] = (sensor.clone(), SensorRays::new(sensor));
+                        }
+                        k
+                    }
                     None => {
                         self.rays.push((sensor.clone(), SensorRays::new(sensor)));
                         self.rays.len() - 1

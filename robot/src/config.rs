@@ -1,0 +1,197 @@
+//! The robot's software configuration: the `[vision]`, `[control]` and `[goal]` tables of a
+//! scenario, plus what the robot knows of its own body, cameras and start.
+
+use nalgebra::{Isometry2, Point2};
+use omniloop_control::AvoidanceConfig;
+use omniloop_vision::{FreeSpaceConfig, LocalizationConfig, RadialCalibration};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Which controller chooses the robot's command.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ControllerKind {
+    /// Stand still (the default: nothing drives unless the scenario says so).
+    #[default]
+    Idle,
+    /// Not the robot's software: the simulator drives the robot straight to its targets on the
+    /// true pose (a reference that needs no vision). The robot's own controller stays idle; its
+    /// perception and estimator still run and are recorded.
+    GoToGoalTruth,
+    /// Free direction closest to the goal direction, from the image (ref. [4] of the corner
+    /// paper).
+    GoalDirection,
+    /// Velocity-aware avoidance of Sect. 3.2 of the corner paper, from the image.
+    VelocityAware,
+}
+
+impl ControllerKind {
+    /// Whether the controller needs the free-space detection.
+    pub fn uses_freespace(self) -> bool {
+        matches!(self, Self::GoalDirection | Self::VelocityAware)
+    }
+
+    /// The name as written in scenario files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Idle => "idle",
+            Self::GoToGoalTruth => "go_to_goal_truth",
+            Self::GoalDirection => "goal_direction",
+            Self::VelocityAware => "velocity_aware",
+        }
+    }
+}
+
+/// Where the robot's pose estimate comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseSource {
+    /// Dead reckoning from wheel odometry alone, from the start pose the robot is given.
+    #[default]
+    Odometry,
+    /// Odometry corrected by floor-region self-localization (Sect. 4 of the corner paper) in
+    /// every cycle that gives a fix.
+    Localization,
+}
+
+/// How the robot chooses its velocity (`[control]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlSpec {
+    /// The controller.
+    pub kind: ControllerKind,
+    /// Settings of the avoidance controllers.
+    pub avoidance: AvoidanceConfig,
+    /// Where the pose estimate comes from.
+    pub pose_source: PoseSource,
+    /// With `pose_source = "localization"`: how far each fix pulls the dead-reckoned pose
+    /// toward itself (0: odometry only, 1: jump to the measurement).
+    pub localization_gain: f64,
+}
+
+impl Default for ControlSpec {
+    fn default() -> Self {
+        Self {
+            kind: ControllerKind::default(),
+            avoidance: AvoidanceConfig::default(),
+            pose_source: PoseSource::Odometry,
+            localization_gain: 0.3,
+        }
+    }
+}
+
+/// Image processing settings (`[vision]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct VisionSpec {
+    /// The camera whose images vision uses (default: the robot's first).
+    pub sensor: Option<String>,
+    /// A calibration table written by `omniloop calibrate` (relative to the scenario file);
+    /// default: traced from the sensor's optics at start.
+    pub calibration_file: Option<PathBuf>,
+    /// Free-space detection (Sect. 3.1 of the corner paper).
+    pub freespace: FreeSpaceConfig,
+    /// Self-localization from the floor region (Sect. 4 of the corner paper).
+    pub localization: LocalizationConfig,
+}
+
+/// The goal point, reached through optional waypoints (`[goal]`), in the world (field) frame.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GoalSpec {
+    /// Points to pass (within the tolerance) in order before the goal point.
+    #[serde(default)]
+    pub waypoints_mm: Vec<[f64; 2]>,
+    /// x of the goal point.
+    pub x_mm: f64,
+    /// y of the goal point.
+    pub y_mm: f64,
+    /// A target is reached when the robot centre is this close (judged on the truth when a
+    /// run is scored).
+    #[serde(default = "default_goal_tolerance")]
+    pub tolerance_mm: f64,
+    /// The robot moves on from a waypoint when its own estimate is within `tolerance_mm -
+    /// estimate_margin_mm` of it: room for the error of that estimate, so that the robot truly
+    /// passes within the tolerance.
+    #[serde(default)]
+    pub estimate_margin_mm: f64,
+}
+
+fn default_goal_tolerance() -> f64 {
+    100.0
+}
+
+impl GoalSpec {
+    /// The goal point.
+    pub fn point(&self) -> Point2<f64> {
+        Point2::new(self.x_mm, self.y_mm)
+    }
+
+    /// The waypoints and then the goal point.
+    pub fn targets(&self) -> Vec<Point2<f64>> {
+        self.waypoints_mm
+            .iter()
+            .map(|w| Point2::new(w[0], w[1]))
+            .chain(std::iter::once(self.point()))
+            .collect()
+    }
+}
+
+/// What the robot knows of its own body (design constants, not measurements).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodySpec {
+    /// Disc radius, mm.
+    pub radius_mm: f64,
+    /// Top speed the controllers command, mm/s.
+    pub max_speed_mm_s: f64,
+    /// Translational acceleration limit alpha of eq. (8), mm/s^2.
+    pub accel_limit_mm_s2: f64,
+    /// Rotational acceleration limit, rad/s^2.
+    pub angular_accel_limit_rad_s2: f64,
+}
+
+/// Everything the robot's software is built from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotConfig {
+    /// The pose the robot is told it starts at (world frame): the origin of its dead reckoning.
+    pub start: Isometry2<f64>,
+    /// Its body.
+    pub body: BodySpec,
+    /// Period of the control cycle, s.
+    pub control_period_s: f64,
+    /// Names of its cameras, in order (the first is vision's default).
+    pub cameras: Vec<String>,
+    /// Image-to-floor calibrations of the mirror cameras vision uses (each names its sensor).
+    pub calibrations: Vec<RadialCalibration>,
+    /// Image processing.
+    pub vision: VisionSpec,
+    /// Controller and estimator.
+    pub control: ControlSpec,
+    /// Where to go, if anywhere.
+    pub goal: Option<GoalSpec>,
+}
+
+impl RobotConfig {
+    /// The camera vision uses: `vision.sensor`, or the first camera.
+    pub fn vision_camera(&self) -> Option<&str> {
+        match &self.vision.sensor {
+            Some(name) => self.cameras.iter().find(|c| *c == name).map(String::as_str),
+            None => self.cameras.first().map(String::as_str),
+        }
+    }
+
+    /// The calibration of camera `sensor`.
+    pub fn calibration(&self, sensor: &str) -> Option<&RadialCalibration> {
+        self.calibrations.iter().find(|c| c.sensor == sensor)
+    }
+
+    /// Whether the robot runs the free-space stage.
+    pub fn detects_freespace(&self) -> bool {
+        self.control.kind.uses_freespace()
+    }
+
+    /// Whether the robot runs floor-region self-localization.
+    pub fn localizes(&self) -> bool {
+        self.control.pose_source == PoseSource::Localization
+    }
+}

@@ -1,0 +1,93 @@
+//! Controllers: from what the robot perceives and believes to a body-frame velocity command.
+
+use crate::RobotError;
+use crate::boundary::BodyCommand;
+use crate::config::{ControllerKind, RobotConfig};
+use nalgebra::Vector2;
+use omniloop_control::{AccelLimitedDrive, GoalDirection, Surroundings, VelocityAware};
+use omniloop_vision::FreeSpace;
+
+/// What a controller decides on.
+#[derive(Debug, Clone, Copy)]
+pub struct Situation<'a> {
+    /// Free space around the robot, when perceived this cycle.
+    pub freespace: Option<&'a FreeSpace>,
+    /// The target relative to the robot (body frame, by the estimate), with a mission.
+    pub target_body_mm: Option<Vector2<f64>>,
+    /// The measured body velocity.
+    pub velocity_body_mm_s: Vector2<f64>,
+}
+
+/// Chooses the command each cycle.
+pub trait Controller: Send {
+    /// The command for this cycle.
+    fn decide(&mut self, s: &Situation<'_>) -> BodyCommand;
+}
+
+/// The controller a configuration names.
+pub fn build(config: &RobotConfig) -> Result<Box<dyn Controller>, RobotError> {
+    let b = &config.body;
+    let drive = AccelLimitedDrive::new(b.accel_limit_mm_s2, b.angular_accel_limit_rad_s2)?;
+    let avoid = config.control.avoidance.clone();
+    Ok(match config.control.kind {
+        // The truth pilot is the simulator's; the robot's own controller stays idle.
+        ControllerKind::Idle | ControllerKind::GoToGoalTruth => Box::new(Idle),
+        ControllerKind::GoalDirection => Box::new(GoalDirection::new(
+            avoid,
+            drive,
+            b.max_speed_mm_s,
+            b.radius_mm,
+        )?),
+        ControllerKind::VelocityAware => Box::new(VelocityAware::new(
+            avoid,
+            drive,
+            b.max_speed_mm_s,
+            b.radius_mm,
+            config.control_period_s,
+        )?),
+    })
+}
+
+/// Stands still.
+struct Idle;
+
+impl Controller for Idle {
+    fn decide(&mut self, _: &Situation<'_>) -> BodyCommand {
+        BodyCommand::STOP
+    }
+}
+
+/// Runs `f` on the surroundings vision reported and the target, or stops without either.
+fn with_surroundings(
+    s: &Situation<'_>,
+    f: impl FnOnce(&Surroundings<'_>, Vector2<f64>) -> Vector2<f64>,
+) -> BodyCommand {
+    let (Some(fs), Some(target)) = (s.freespace, s.target_body_mm) else {
+        return BodyCommand::STOP;
+    };
+    let points: Vec<Vector2<f64>> = fs.obstacle_points.iter().map(|p| p.coords).collect();
+    let surroundings = Surroundings {
+        direction_rad: &fs.direction_rad,
+        free_mm: &fs.free_mm,
+        range_mm: fs.range_mm,
+        obstacle_points: &points,
+    };
+    BodyCommand::translate(f(&surroundings, target))
+}
+
+impl Controller for GoalDirection {
+    fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
+        with_surroundings(s, |sur, target| {
+            GoalDirection::decide(self, sur, target).v_mm_s
+        })
+    }
+}
+
+impl Controller for VelocityAware {
+    fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
+        let v = s.velocity_body_mm_s;
+        with_surroundings(s, |sur, target| {
+            VelocityAware::decide(self, sur, target, v).v_mm_s
+        })
+    }
+}

@@ -1,0 +1,372 @@
+//! The robot's pose estimate: dead reckoning of the wheel odometry, corrected by the fixes its
+//! perception stages give (a complementary filter with gating).
+//!
+//! The estimate is kept as an *anchor*, a pose and the dead-reckoned pose at the moment it was
+//! set; the estimate is the anchor moved on by the odometry since. A fix of any kind sets a new
+//! anchor between the prediction and the measurement:
+//! - full pose: the solution nearer the prediction (of the pose and its alternative) is pulled
+//!   toward by `gain`, position and heading; the first fix after the pose was unknown or given
+//!   only as the start must be unambiguous and is taken as it is;
+//! - heading only: the heading is pulled toward the measurement, the position kept;
+//! - position only: the position is pulled toward the measurement, the heading kept;
+//! - relative motion since the previous cycle: the motion the odometry measured over that cycle
+//!   is pulled toward the measured one, and the estimate of the previous cycle moved by it.
+//!
+//! Measurements farther from the prediction than the gate (400 mm, 20 degrees) are not trusted.
+
+use crate::boundary::OdometryReading;
+use crate::config::PoseSource;
+use crate::estimates::{FixOutcome, Measurement};
+use nalgebra::{Isometry2, Vector2};
+use omniloop_control::{DeadReckoning, wrap_pi};
+
+/// A measurement farther than this from the prediction is not trusted, mm.
+const GATE_MM: f64 = 400.0;
+/// ... or turned by more than this, rad (20 degrees).
+const GATE_RAD: f64 = 0.35;
+
+/// The pose the estimate was last set to, and the dead-reckoned pose at that moment (`None`:
+/// the origin of dead reckoning, i.e. the start).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Anchor {
+    pose: Isometry2<f64>,
+    odometry: Option<Isometry2<f64>>,
+}
+
+/// Tracks the robot's pose in the world frame from what its sensors give.
+#[derive(Debug, Clone)]
+pub struct PoseEstimator {
+    reckoning: DeadReckoning,
+    anchor: Option<Anchor>,
+    anchored_by_fix: bool,
+    takes_fixes: bool,
+    gain: f64,
+    /// The estimate and the dead-reckoned pose at the end of the previous cycle.
+    last_cycle: Option<(Isometry2<f64>, Isometry2<f64>)>,
+    used: usize,
+    rejected: usize,
+}
+
+impl PoseEstimator {
+    /// An estimator for a robot told it starts at `start` (world frame). With
+    /// `PoseSource::Localization` it takes fixes, each pulling the estimate by `gain`.
+    pub fn new(start: Isometry2<f64>, source: PoseSource, gain: f64) -> Self {
+        Self {
+            reckoning: DeadReckoning::new(),
+            anchor: Some(Anchor {
+                pose: start,
+                odometry: None,
+            }),
+            anchored_by_fix: false,
+            takes_fixes: source == PoseSource::Localization,
+            gain,
+            last_cycle: None,
+            used: 0,
+            rejected: 0,
+        }
+    }
+
+    /// Takes a wheel odometry reading (integrated with the trapezoidal rule).
+    pub fn odometry(&mut self, r: &OdometryReading) {
+        self.reckoning.update(r.v_body_mm_s, r.omega_rad_s, r.dt_s);
+    }
+
+    /// The measured body velocity.
+    pub fn velocity_body_mm_s(&self) -> Vector2<f64> {
+        self.reckoning.velocity_body_mm_s()
+    }
+
+    /// The pose estimate in the world frame; `None` while the pose is unknown.
+    pub fn estimate(&self) -> Option<Isometry2<f64>> {
+        let a = self.anchor?;
+        Some(match a.odometry {
+            None => a.pose * self.reckoning.pose(),
+            Some(o) => a.pose * (o.inverse() * self.reckoning.pose()),
+        })
+    }
+
+    /// The robot was carried somewhere: its pose is unknown until an unambiguous fix.
+    pub fn forget(&mut self) {
+        self.anchor = None;
+        self.anchored_by_fix = false;
+        self.last_cycle = None;
+    }
+
+    /// Marks the end of a control cycle (the reference of the next relative-motion fix).
+    pub fn end_cycle(&mut self) {
+        self.last_cycle = self.estimate().map(|e| (e, self.reckoning.pose()));
+    }
+
+    /// Fixes used and rejected (by the gate) so far.
+    pub fn fixes(&self) -> (usize, usize) {
+        (self.used, self.rejected)
+    }
+
+    /// Folds in a measurement; says what became of it.
+    pub fn fuse(&mut self, m: &Measurement) -> FixOutcome {
+        if !self.takes_fixes {
+            return FixOutcome::Ignored;
+        }
+        let outcome = match *m {
+            Measurement::Pose {
+                pose,
+                alternative,
+                unambiguous,
+            } => self.fuse_pose(pose, alternative, unambiguous),
+            Measurement::Heading { heading_rad } => self.fuse_heading(heading_rad),
+            Measurement::Position { position } => {
+                let h = self.estimate().map(|p| p.rotation.angle());
+                match h {
+                    Some(h) => self.fuse_pose_parts(Some(position.coords), h, 0.0),
+                    None => Err(
+                        "the heading is unknown: a position alone cannot set the pose".to_string(),
+                    ),
+                }
+            }
+            Measurement::Motion { delta } => self.fuse_motion(delta),
+        };
+        match outcome {
+            Ok(o) => {
+                self.used += 1;
+                o
+            }
+            Err(why) => FixOutcome::Rejected(why),
+        }
+    }
+
+    fn set(&mut self, pose: Isometry2<f64>) {
+        self.anchor = Some(Anchor {
+            pose,
+            odometry: Some(self.reckoning.pose()),
+        });
+    }
+
+    fn gate(&mut self, d_mm: f64, dh_rad: f64) -> Result<(), String> {
+        if d_mm > GATE_MM || dh_rad.abs() > GATE_RAD {
+            self.rejected += 1;
+            return Err(format!(
+                "{d_mm:.0} mm and {:.1} deg from the prediction (gate {GATE_MM} mm, {:.0} deg)",
+                dh_rad.to_degrees(),
+                GATE_RAD.to_degrees()
+            ));
+        }
+        Ok(())
+    }
+
+    fn fuse_pose(
+        &mut self,
+        pose: Isometry2<f64>,
+        alternative: Option<Isometry2<f64>>,
+        unambiguous: bool,
+    ) -> Result<FixOutcome, String> {
+        let predicted = match self.estimate() {
+            Some(p) if self.anchored_by_fix => p,
+            _ => {
+                if !unambiguous {
+                    return Err(
+                        "the image does not tell the two solutions apart and no fix has \
+                                set the estimate yet"
+                            .into(),
+                    );
+                }
+                self.set(pose);
+                self.anchored_by_fix = true;
+                return Ok(FixOutcome::Anchored);
+            }
+        };
+        let d = |q: &Isometry2<f64>| (q.translation.vector - predicted.translation.vector).norm();
+        let z = match alternative {
+            Some(alt) if d(&alt) < d(&pose) => alt,
+            _ => pose,
+        };
+        let dh = wrap_pi(z.rotation.angle() - predicted.rotation.angle());
+        self.gate(d(&z), dh)?;
+        let t = predicted.translation.vector
+            + (z.translation.vector - predicted.translation.vector) * self.gain;
+        let h = predicted.rotation.angle() + self.gain * dh;
+        self.set(Isometry2::new(t, h));
+        Ok(FixOutcome::Used)
+    }
+
+    fn fuse_heading(&mut self, heading_rad: f64) -> Result<FixOutcome, String> {
+        let Some(p) = self.estimate() else {
+            return Err("the position is unknown: a heading alone cannot set the pose".into());
+        };
+        let dh = wrap_pi(heading_rad - p.rotation.angle());
+        self.fuse_pose_parts(None, p.rotation.angle(), dh)
+    }
+
+    /// Pulls the position toward `position` (when given) and turns the heading `h` by
+    /// `gain * dh`, after gating both.
+    fn fuse_pose_parts(
+        &mut self,
+        position: Option<Vector2<f64>>,
+        h: f64,
+        dh: f64,
+    ) -> Result<FixOutcome, String> {
+        let p = self.estimate().expect("callers checked the pose is known");
+        let here = p.translation.vector;
+        let target = position.unwrap_or(here);
+        self.gate((target - here).norm(), dh)?;
+        self.set(Isometry2::new(
+            here + (target - here) * self.gain,
+            h + self.gain * dh,
+        ));
+        Ok(FixOutcome::Used)
+    }
+
+    fn fuse_motion(&mut self, delta: Isometry2<f64>) -> Result<FixOutcome, String> {
+        let Some((before, odo_before)) = self.last_cycle else {
+            return Err("no earlier cycle with a known pose to measure the motion from".into());
+        };
+        let odo_delta = odo_before.inverse() * self.reckoning.pose();
+        let dt = delta.translation.vector - odo_delta.translation.vector;
+        let dh = wrap_pi(delta.rotation.angle() - odo_delta.rotation.angle());
+        self.gate(dt.norm(), dh)?;
+        let fused = Isometry2::new(
+            odo_delta.translation.vector + dt * self.gain,
+            odo_delta.rotation.angle() + self.gain * dh,
+        );
+        self.set(before * fused);
+        Ok(FixOutcome::Used)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point2;
+    use std::f64::consts::PI;
+
+    fn pose_fix(x: f64, y: f64, h: f64, unambiguous: bool) -> Measurement {
+        Measurement::Pose {
+            pose: Isometry2::new(Vector2::new(x, y), h),
+            alternative: Some(Isometry2::new(Vector2::new(-x, -y), wrap_pi(h + PI))),
+            unambiguous,
+        }
+    }
+
+    fn drive(e: &mut PoseEstimator, vx: f64, omega: f64, seconds: f64) {
+        e.odometry(&OdometryReading {
+            v_body_mm_s: Vector2::new(vx, 0.0),
+            omega_rad_s: omega,
+            dt_s: 0.0,
+        });
+        e.odometry(&OdometryReading {
+            v_body_mm_s: Vector2::new(vx, 0.0),
+            omega_rad_s: omega,
+            dt_s: seconds,
+        });
+    }
+
+    fn x(e: &PoseEstimator) -> f64 {
+        e.estimate().unwrap().translation.x
+    }
+
+    #[test]
+    fn odometry_moves_the_estimate_and_pose_fixes_pull_it_back() {
+        let start = Isometry2::new(Vector2::new(-500.0, 0.0), 0.0);
+        let mut e = PoseEstimator::new(start, PoseSource::Localization, 0.5);
+        // An ambiguous fix cannot set the estimate.
+        assert!(matches!(
+            e.fuse(&pose_fix(-400.0, 10.0, 0.0, false)),
+            FixOutcome::Rejected(_)
+        ));
+        assert_eq!(
+            e.fuse(&pose_fix(-490.0, 0.0, 0.0, true)),
+            FixOutcome::Anchored
+        );
+        assert!((x(&e) + 490.0).abs() < 1e-9);
+        drive(&mut e, 100.0, 0.0, 1.0);
+        assert!((x(&e) + 390.0).abs() < 1e-6);
+        // 20 mm ahead: half of it is taken; its half-turn twin is the one chosen.
+        assert_eq!(e.fuse(&pose_fix(370.0, 0.0, PI, false)), FixOutcome::Used);
+        assert!((x(&e) + 380.0).abs() < 1e-6, "{:?}", e.estimate());
+        // Far off: rejected by the gate.
+        assert!(matches!(
+            e.fuse(&pose_fix(900.0, 500.0, 0.0, true)),
+            FixOutcome::Rejected(_)
+        ));
+        assert_eq!(e.fixes(), (2, 1));
+    }
+
+    #[test]
+    fn with_odometry_as_the_source_fixes_are_ignored() {
+        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Odometry, 0.5);
+        assert_eq!(
+            e.fuse(&pose_fix(100.0, 0.0, 0.0, true)),
+            FixOutcome::Ignored
+        );
+        drive(&mut e, 50.0, 0.0, 2.0);
+        assert!((x(&e) - 100.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_forgotten_pose_is_unknown_until_an_unambiguous_fix() {
+        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Localization, 0.3);
+        e.forget();
+        assert!(e.estimate().is_none());
+        assert!(matches!(
+            e.fuse(&Measurement::Heading { heading_rad: 0.1 }),
+            FixOutcome::Rejected(_)
+        ));
+        assert!(matches!(
+            e.fuse(&pose_fix(300.0, 0.0, 0.0, false)),
+            FixOutcome::Rejected(_)
+        ));
+        assert_eq!(
+            e.fuse(&pose_fix(300.0, 0.0, 0.0, true)),
+            FixOutcome::Anchored
+        );
+        assert!((x(&e) - 300.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn heading_and_position_fixes_correct_their_part_only() {
+        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Localization, 0.5);
+        assert_eq!(
+            e.fuse(&Measurement::Heading { heading_rad: 0.2 }),
+            FixOutcome::Used
+        );
+        let p = e.estimate().unwrap();
+        assert!((p.rotation.angle() - 0.1).abs() < 1e-12);
+        assert!(p.translation.vector.norm() < 1e-12);
+        let m = Measurement::Position {
+            position: Point2::new(40.0, -20.0),
+        };
+        assert_eq!(e.fuse(&m), FixOutcome::Used);
+        let p = e.estimate().unwrap();
+        assert!((p.translation.vector - Vector2::new(20.0, -10.0)).norm() < 1e-12);
+        assert!((p.rotation.angle() - 0.1).abs() < 1e-12);
+        // Across the +-pi seam the heading moves the short way.
+        let mut e = PoseEstimator::new(
+            Isometry2::new(Vector2::zeros(), PI - 0.05),
+            PoseSource::Localization,
+            0.5,
+        );
+        e.fuse(&Measurement::Heading {
+            heading_rad: -PI + 0.05,
+        });
+        let h = e.estimate().unwrap().rotation.angle();
+        assert!((h.abs() - PI).abs() < 1e-9, "{h}");
+    }
+
+    #[test]
+    fn a_motion_fix_replaces_part_of_the_odometry_increment() {
+        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Localization, 0.5);
+        // No earlier cycle yet.
+        let delta = Isometry2::new(Vector2::new(100.0, 0.0), 0.0);
+        assert!(matches!(
+            e.fuse(&Measurement::Motion { delta }),
+            FixOutcome::Rejected(_)
+        ));
+        e.end_cycle();
+        // Odometry says 80 mm forward; the camera says 100 mm and a 0.1 rad turn.
+        drive(&mut e, 80.0, 0.0, 1.0);
+        let delta = Isometry2::new(Vector2::new(100.0, 0.0), 0.1);
+        assert_eq!(e.fuse(&Measurement::Motion { delta }), FixOutcome::Used);
+        let p = e.estimate().unwrap();
+        assert!((p.translation.x - 90.0).abs() < 1e-9, "{p:?}");
+        assert!((p.rotation.angle() - 0.05).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,58 @@
+//! omniloop-robot: the robot's software, behind the boundary a real robot has.
+//!
+//! Each control cycle the [`Robot`] receives what its own sensors give and nothing else
+//! ([`Observation`]: camera frames by sensor name with their time, the state of its actuators;
+//! [`OdometryReading`]: what the wheel encoders measured over the last period), and returns a
+//! body-frame velocity command, actuator commands and what it believes ([`Outputs`],
+//! [`Estimates`]). It never sees the world it drives in: the same stack runs on a simulated
+//! robot and on recorded or live images of a real one.
+//!
+//! Inside, the stack is built from a [`RobotConfig`]:
+//! - perception stages ([`perception`]) turn frames into free space and fixes (a full pose,
+//!   a heading, a position or a relative motion);
+//! - the [`PoseEstimator`] dead-reckons the wheel odometry and fuses the fixes;
+//! - the [`Mission`] holds the targets (waypoints, then the goal) and moves on when the robot's
+//!   *own estimate* says a target is reached;
+//! - the controller ([`controller`]) chooses the command.
+
+pub mod boundary;
+pub mod config;
+pub mod controller;
+pub mod estimates;
+pub mod estimator;
+pub mod mission;
+pub mod perception;
+pub mod robot;
+
+pub use boundary::{
+    ActuatorCommand, ActuatorState, BodyCommand, Frame, Observation, OdometryReading, Outputs,
+};
+pub use config::{
+    BodySpec, ControlSpec, ControllerKind, GoalSpec, PoseSource, RobotConfig, VisionSpec,
+};
+pub use estimates::{Estimates, Fix, FixOutcome, Measurement, NotFound};
+pub use estimator::PoseEstimator;
+pub use mission::Mission;
+pub use robot::Robot;
+
+/// Why the robot's software could not be built or run a cycle.
+#[derive(Debug, thiserror::Error)]
+pub enum RobotError {
+    /// A vision stage could not be set up or failed on a frame.
+    #[error("vision: {0}")]
+    Vision(#[from] omniloop_vision::VisionError),
+    /// A controller could not be built.
+    #[error("control: {0}")]
+    Control(#[from] omniloop_control::ControlError),
+    /// The configuration names a sensor or calibration the robot does not have.
+    #[error("{0}")]
+    Config(String),
+    /// A stage needs a camera frame that the cycle did not bring.
+    #[error("no frame from sensor {sensor:?} this cycle (stage {stage})")]
+    MissingFrame {
+        /// The sensor.
+        sensor: String,
+        /// The stage that needed it.
+        stage: &'static str,
+    },
+}

@@ -1,0 +1,97 @@
+//! Perception stages: each reads the frames of its cameras and gives free space, fixes for the
+//! estimator, or the reason it found nothing.
+
+mod floor_localization;
+mod freespace;
+
+pub use floor_localization::FloorLocalizationStage;
+pub use freespace::FreeSpaceStage;
+
+use crate::RobotError;
+use crate::boundary::Observation;
+use crate::config::RobotConfig;
+use crate::estimates::{Measurement, NotFound};
+use image::RgbaImage;
+use nalgebra::Isometry2;
+use omniloop_vision::{FreeSpace, RadialCalibration};
+
+/// What the stages of one cycle found.
+#[derive(Debug, Clone, Default)]
+pub struct Percepts {
+    /// Free space around the robot.
+    pub freespace: Option<FreeSpace>,
+    /// Measurements for the estimator, with the stage that made each.
+    pub fixes: Vec<(&'static str, Measurement)>,
+    /// Stages that found nothing, and why.
+    pub not_found: Vec<NotFound>,
+}
+
+/// One perception stage.
+pub trait Stage: Send {
+    /// The stage's name in the estimates record.
+    fn name(&self) -> &'static str;
+    /// The cameras whose frames it reads.
+    fn cameras(&self) -> Vec<&str>;
+    /// Processes the cycle's frames; `prior` is the estimator's prediction, when it has one.
+    fn run(
+        &mut self,
+        obs: &Observation<'_>,
+        prior: Option<&Isometry2<f64>>,
+        out: &mut Percepts,
+    ) -> Result<(), RobotError>;
+}
+
+/// The stages a configuration asks for, in the order they run.
+pub fn build(config: &RobotConfig) -> Result<Vec<Box<dyn Stage>>, RobotError> {
+    let mut stages: Vec<Box<dyn Stage>> = Vec::new();
+    if !(config.detects_freespace() || config.localizes()) {
+        return Ok(stages);
+    }
+    let camera = config.vision_camera().ok_or_else(|| {
+        RobotError::Config(match &config.vision.sensor {
+            Some(n) => format!("vision.sensor names a camera the robot does not have: {n:?}"),
+            None => "vision needs a camera and the robot has none".into(),
+        })
+    })?;
+    let cal = calibration(config, camera)?;
+    if config.detects_freespace() {
+        stages.push(Box::new(FreeSpaceStage::new(
+            camera,
+            config.vision.freespace.clone(),
+            cal,
+        )?));
+    }
+    if config.localizes() {
+        stages.push(Box::new(FloorLocalizationStage::new(
+            camera,
+            config.vision.localization.clone(),
+            cal,
+        )?));
+    }
+    Ok(stages)
+}
+
+fn calibration<'a>(
+    config: &'a RobotConfig,
+    camera: &str,
+) -> Result<&'a RadialCalibration, RobotError> {
+    config.calibration(camera).ok_or_else(|| {
+        RobotError::Config(format!(
+            "no image-to-floor calibration for camera {camera:?}"
+        ))
+    })
+}
+
+/// The image of camera `sensor` this cycle, or the error naming the stage that needed it.
+fn image<'a>(
+    obs: &Observation<'a>,
+    sensor: &str,
+    stage: &'static str,
+) -> Result<&'a RgbaImage, RobotError> {
+    obs.frame(sensor)
+        .map(|f| f.image)
+        .ok_or_else(|| RobotError::MissingFrame {
+            sensor: sensor.to_string(),
+            stage,
+        })
+}

@@ -1,0 +1,121 @@
+//! The robot's software: perception stages, estimator, mission and controller in one cycle.
+
+use crate::RobotError;
+use crate::boundary::{Observation, OdometryReading, Outputs};
+use crate::config::RobotConfig;
+use crate::controller::{self, Controller, Situation};
+use crate::estimates::{Estimates, Fix};
+use crate::estimator::PoseEstimator;
+use crate::mission::Mission;
+use crate::perception::{self, Percepts, Stage};
+use nalgebra::Isometry2;
+
+/// The robot's software stack, built once from a [`RobotConfig`].
+pub struct Robot {
+    stages: Vec<Box<dyn Stage>>,
+    estimator: PoseEstimator,
+    controller: Box<dyn Controller>,
+    mission: Option<Mission>,
+    cameras: Vec<String>,
+}
+
+impl Robot {
+    /// Builds the stack: the perception stages the configuration asks for, the estimator from
+    /// the start pose, the mission and the controller.
+    pub fn new(config: &RobotConfig) -> Result<Self, RobotError> {
+        let stages = perception::build(config)?;
+        let mut cameras: Vec<String> = Vec::new();
+        for c in stages.iter().flat_map(|s| s.cameras()) {
+            if !cameras.iter().any(|k| k == c) {
+                cameras.push(c.to_string());
+            }
+        }
+        Ok(Self {
+            estimator: PoseEstimator::new(
+                config.start,
+                config.control.pose_source,
+                config.control.localization_gain,
+            ),
+            controller: controller::build(config)?,
+            mission: config.goal.as_ref().map(Mission::new),
+            stages,
+            cameras,
+        })
+    }
+
+    /// The cameras whose frames the stack reads each cycle.
+    pub fn cameras(&self) -> &[String] {
+        &self.cameras
+    }
+
+    /// The names of the perception stages, in the order they run.
+    pub fn stages(&self) -> Vec<&'static str> {
+        self.stages.iter().map(|s| s.name()).collect()
+    }
+
+    /// Takes a wheel odometry reading.
+    pub fn odometry(&mut self, reading: &OdometryReading) {
+        self.estimator.odometry(reading);
+    }
+
+    /// The robot was carried to a place it is not told: its pose is unknown until a fix.
+    pub fn forget_pose(&mut self) {
+        self.estimator.forget();
+    }
+
+    /// The current pose estimate (world frame).
+    pub fn estimate(&self) -> Option<Isometry2<f64>> {
+        self.estimator.estimate()
+    }
+
+    /// Fixes used and rejected so far.
+    pub fn fixes(&self) -> (usize, usize) {
+        self.estimator.fixes()
+    }
+
+    /// One control cycle: perceive, fuse, judge the mission on the estimate, decide.
+    pub fn cycle(&mut self, obs: &Observation<'_>) -> Result<Outputs, RobotError> {
+        let prior = self.estimator.estimate();
+        let mut percepts = Percepts::default();
+        for stage in &mut self.stages {
+            stage.run(obs, prior.as_ref(), &mut percepts)?;
+        }
+        let fixes: Vec<Fix> = percepts
+            .fixes
+            .into_iter()
+            .map(|(source, measurement)| Fix {
+                source,
+                outcome: self.estimator.fuse(&measurement),
+                measurement,
+            })
+            .collect();
+        let pose = self.estimator.estimate();
+        if let Some(m) = &mut self.mission {
+            m.update(pose.as_ref());
+        }
+        let target_body_mm = match (&self.mission, &pose) {
+            (Some(m), Some(p)) => Some(p.inverse_transform_point(&m.target()).coords),
+            _ => None,
+        };
+        let velocity_body_mm_s = self.estimator.velocity_body_mm_s();
+        let command = self.controller.decide(&Situation {
+            freespace: percepts.freespace.as_ref(),
+            target_body_mm,
+            velocity_body_mm_s,
+        });
+        self.estimator.end_cycle();
+        Ok(Outputs {
+            command,
+            actuators: Vec::new(),
+            estimates: Estimates {
+                t_s: obs.t_s,
+                pose,
+                velocity_body_mm_s,
+                freespace: percepts.freespace,
+                fixes,
+                not_found: percepts.not_found,
+                target: self.mission.as_ref().map(Mission::index),
+            },
+        })
+    }
+}

@@ -1,0 +1,233 @@
+//! The robot's cameras on the simulator's side: the renderer, each camera's optics and seeded
+//! noise, and the pan units of pinhole cameras, which the robot commands.
+
+use crate::scenario::Scenario;
+use crate::simulation::{RunError, sensor_noise_seed};
+use image::RgbaImage;
+use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
+use omniloop_sim::optics::Optics;
+use omniloop_sim::{Renderer, RendererChoice, Scene, Sensor, SensorNoise, World};
+use std::f64::consts::PI;
+
+/// A pan unit: turns its camera about the vertical at up to its rate limit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PanUnit {
+    pan_rad: f64,
+    limit_rad_s: f64,
+    goal: PanGoal,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum PanGoal {
+    Hold,
+    To(f64),
+    At(f64),
+}
+
+impl PanUnit {
+    /// A unit at `pan_rad` turning at most `limit_rad_s`.
+    pub fn new(pan_rad: f64, limit_rad_s: f64) -> Self {
+        Self {
+            pan_rad,
+            limit_rad_s,
+            goal: PanGoal::Hold,
+        }
+    }
+
+    /// The pan angle, rad, within [-pi, pi].
+    pub fn pan_rad(&self) -> f64 {
+        self.pan_rad
+    }
+
+    /// Turn toward `pan_rad` (clamped to [-pi, pi]; the unit turns through its front, never
+    /// across the cable stop at the back).
+    pub fn pan_to(&mut self, pan_rad: f64) {
+        self.goal = PanGoal::To(pan_rad.clamp(-PI, PI));
+    }
+
+    /// Turn at `rate_rad_s` (clipped to the limit) until the stop or told otherwise.
+    pub fn pan_at(&mut self, rate_rad_s: f64) {
+        self.goal = PanGoal::At(rate_rad_s.clamp(-self.limit_rad_s, self.limit_rad_s));
+    }
+
+    /// Moves the unit on by `dt_s`.
+    pub fn advance(&mut self, dt_s: f64) {
+        let step = self.limit_rad_s * dt_s;
+        self.pan_rad = match self.goal {
+            PanGoal::Hold => self.pan_rad,
+            PanGoal::To(t) => self.pan_rad + (t - self.pan_rad).clamp(-step, step),
+            PanGoal::At(rate) => (self.pan_rad + rate * dt_s).clamp(-PI, PI),
+        };
+    }
+}
+
+struct Camera {
+    sensor: Sensor,
+    noise: SensorNoise,
+    pan: Option<PanUnit>,
+    /// Whether it is rendered each cycle.
+    live: bool,
+}
+
+/// The robot's cameras and the renderer that traces their images.
+pub struct Cameras {
+    renderer: Renderer,
+    cameras: Vec<Camera>,
+    images: Vec<RgbaImage>,
+}
+
+impl Cameras {
+    /// The cameras of the robot under test, rendering those called in `wanted` (or all with
+    /// `all`); `None` when nothing is to be rendered.
+    pub fn open(
+        scenario: &Scenario,
+        wanted: &[String],
+        all: bool,
+        choice: RendererChoice,
+        notice: impl FnOnce(&str),
+    ) -> Result<Option<Self>, RunError> {
+        let specs = &scenario.robot.sensors;
+        if specs.is_empty() || (wanted.is_empty() && !all) {
+            return Ok(None);
+        }
+        let mut cameras = Vec::with_capacity(specs.len());
+        for (i, spec) in specs.iter().enumerate() {
+            let pan = spec
+                .pinhole
+                .as_ref()
+                .map(|p| PanUnit::new(p.pan_deg.to_radians(), p.pan_rate_limit_deg_s.to_radians()));
+            cameras.push(Camera {
+                sensor: spec.build()?,
+                noise: SensorNoise::new(sensor_noise_seed(scenario.seed, i)),
+                pan,
+                live: all || wanted.contains(&spec.name),
+            });
+        }
+        Ok(Some(Self {
+            renderer: Renderer::new(choice, notice)?,
+            cameras,
+            images: Vec::new(),
+        }))
+    }
+
+    /// The renderer's name.
+    pub fn renderer_name(&self) -> &str {
+        self.renderer.name()
+    }
+
+    /// Renders every live camera at robot 0's true pose, with its noise.
+    pub fn capture(&mut self, world: &World) -> Result<(), RunError> {
+        let pose = world.robot_state(0).pose;
+        let scene = Scene::of_world(world);
+        self.images.clear();
+        for c in self.cameras.iter_mut().filter(|c| c.live) {
+            let img = self
+                .renderer
+                .render(&scene, &c.sensor, &pose, Some(&mut c.noise))?;
+            self.images.push(img);
+        }
+        Ok(())
+    }
+
+    /// The frames of the last capture, by camera name, taken at `t_s`.
+    pub fn frames(&self, t_s: f64) -> Vec<Frame<'_>> {
+        self.cameras
+            .iter()
+            .filter(|c| c.live)
+            .zip(&self.images)
+            .map(|(c, image)| Frame {
+                sensor: &c.sensor.name,
+                t_s,
+                image,
+            })
+            .collect()
+    }
+
+    /// The state of the pan units.
+    pub fn actuator_state(&self) -> Vec<ActuatorState> {
+        self.cameras
+            .iter()
+            .filter_map(|c| {
+                c.pan.map(|p| ActuatorState::Pan {
+                    sensor: c.sensor.name.clone(),
+                    pan_rad: p.pan_rad(),
+                })
+            })
+            .collect()
+    }
+
+    /// Passes the robot's actuator commands to the pan units.
+    pub fn command(&mut self, commands: &[ActuatorCommand]) -> Result<(), RunError> {
+        for cmd in commands {
+            let (ActuatorCommand::PanTo { sensor, .. } | ActuatorCommand::PanAt { sensor, .. }) =
+                cmd;
+            let unit = self
+                .cameras
+                .iter_mut()
+                .find(|c| c.sensor.name == *sensor)
+                .and_then(|c| c.pan.as_mut())
+                .ok_or_else(|| {
+                    RunError::Actuator(format!(
+                        "the robot commanded a pan of camera {sensor:?}, which is not on a pan \
+                         unit (only pinhole cameras are)"
+                    ))
+                })?;
+            match *cmd {
+                ActuatorCommand::PanTo { pan_rad, .. } => unit.pan_to(pan_rad),
+                ActuatorCommand::PanAt { rate_rad_s, .. } => unit.pan_at(rate_rad_s),
+            }
+        }
+        Ok(())
+    }
+
+    /// Moves the pan units on by `dt_s` and turns their cameras.
+    pub fn advance(&mut self, dt_s: f64) {
+        for c in &mut self.cameras {
+            if let (Some(unit), Optics::Pinhole(cam)) = (&mut c.pan, &mut c.sensor.optics) {
+                unit.advance(dt_s);
+                cam.pan_deg = unit.pan_rad().to_degrees();
+            }
+        }
+    }
+
+    /// Writes the last capture to `dir` as `<camera>_<cycle>.png`.
+    pub fn save(&self, dir: &std::path::Path, cycle: u64) -> Result<(), RunError> {
+        for (c, img) in self.cameras.iter().filter(|c| c.live).zip(&self.images) {
+            let path = dir.join(format!("{}_{:06}.png", c.sensor.name, cycle));
+            img.save(&path)
+                .map_err(|source| RunError::Frame { path, source })?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pan_unit_turns_at_its_rate_limit_and_stops_at_its_ends() {
+        let mut u = PanUnit::new(0.0, 60f64.to_radians());
+        u.pan_to(90f64.to_radians());
+        for _ in 0..25 {
+            u.advance(0.04);
+        }
+        // One second at 60 deg/s.
+        assert!((u.pan_rad().to_degrees() - 60.0).abs() < 1e-9);
+        for _ in 0..25 {
+            u.advance(0.04);
+        }
+        assert!(
+            (u.pan_rad().to_degrees() - 90.0).abs() < 1e-9,
+            "reaches, no overshoot"
+        );
+        // Clipped to 60 deg/s: 270 degrees take 4.5 s.
+        u.pan_at(-10.0);
+        for _ in 0..120 {
+            u.advance(0.04);
+        }
+        assert!((u.pan_rad() + PI).abs() < 1e-12, "stops at -180 degrees");
+        u.pan_to(4.0);
+        assert_eq!(u.goal, PanGoal::To(PI));
+    }
+}

@@ -1,0 +1,296 @@
+//! E1, the corridor corner (Sekimori et al., Sect. 5.1, Fig. 7): the robot drives round a
+//! corner to a goal; the turn is measured along the first leg. Its replay, `corner55`, runs the
+//! 55-degree corner with both avoidance controllers.
+
+use super::{Experiment, Metrics, Replay, ReplayContext, ReplayRun, write_text};
+use crate::record::{Summary, TrajectoryRow};
+use crate::simulation::RunOutput;
+use crate::topview::{Marker, Panel, PathLayer, draw_panels};
+use crate::validate::Checker;
+use nalgebra::{Point2, Vector2};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The corner (`[experiment.corner]`): the corner point K and the direction of the first leg.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CornerSpec {
+    /// K, where the legs' centre lines meet.
+    pub k_mm: [f64; 2],
+    /// Direction u1 of the first leg.
+    pub leg1_heading_deg: f64,
+}
+
+impl CornerSpec {
+    pub(crate) fn validate(&self, c: &mut Checker) {
+        c.finite("experiment.corner.k_mm", self.k_mm[0]);
+        c.finite("experiment.corner.k_mm", self.k_mm[1]);
+        c.finite("experiment.corner.leg1_heading_deg", self.leg1_heading_deg);
+    }
+}
+
+/// The E1 metrics of a trajectory.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CornerMetrics {
+    /// `(K - p).u1` at the first cycle, after `v.u1` exceeded 200 mm/s, where `v.u1` falls below
+    /// 75% of its running maximum; `None` if that never happens.
+    pub turn_onset_mm: Option<f64>,
+    /// `max (p - K).u1` over the run.
+    pub overshoot_mm: f64,
+}
+
+/// The E1 metrics of a trajectory around the corner `k` with first-leg direction `u1` (unit).
+pub fn corner_metrics(rows: &[TrajectoryRow], k: Vector2<f64>, u1: Vector2<f64>) -> CornerMetrics {
+    let mut running_max = f64::NEG_INFINITY;
+    let mut armed = false;
+    let mut onset = None;
+    let mut overshoot = f64::NEG_INFINITY;
+    for r in rows {
+        let p = Vector2::new(r.x_mm, r.y_mm);
+        let v = Vector2::new(r.vx_mm_s, r.vy_mm_s);
+        let along = v.dot(&u1);
+        overshoot = overshoot.max((p - k).dot(&u1));
+        running_max = running_max.max(along);
+        if along > 200.0 {
+            armed = true;
+        }
+        if onset.is_none() && armed && along < 0.75 * running_max {
+            onset = Some((k - p).dot(&u1));
+        }
+    }
+    CornerMetrics {
+        turn_onset_mm: onset,
+        overshoot_mm: overshoot,
+    }
+}
+
+/// The procedure (drive to the goal) and metrics of E1.
+pub struct Corner {
+    spec: CornerSpec,
+}
+
+impl Corner {
+    /// E1 for the corner of `spec`.
+    pub fn new(spec: &CornerSpec) -> Self {
+        Self { spec: spec.clone() }
+    }
+}
+
+impl Experiment for Corner {
+    fn metrics(&self, out: &RunOutput) -> Metrics {
+        let a = self.spec.leg1_heading_deg.to_radians();
+        let m = corner_metrics(
+            &out.trajectory,
+            Vector2::from(self.spec.k_mm),
+            Vector2::new(a.cos(), a.sin()),
+        );
+        let mut keys = Metrics::new();
+        if let Some(onset) = m.turn_onset_mm {
+            keys.insert("turn_onset_mm".into(), onset.into());
+        }
+        keys.insert("overshoot_mm".into(), m.overshoot_mm.into());
+        keys
+    }
+}
+
+/// `omniloop replay corner55`.
+pub const REPLAY: Replay = Replay {
+    name: "corner55",
+    title: "E1: the 55-degree corner, goal-direction vs velocity-aware avoidance (Fig. 7)",
+    run: replay,
+};
+
+/// The E1 scenario files, built into the binary so the replay runs from anywhere.
+pub const SCENARIOS: [(&str, &str, &str); 2] = [
+    (
+        "goal_direction",
+        "scenarios/corner55_goal_direction.toml",
+        include_str!("../../scenarios/corner55_goal_direction.toml"),
+    ),
+    (
+        "velocity_aware",
+        "scenarios/corner55_velocity_aware.toml",
+        include_str!("../../scenarios/corner55_velocity_aware.toml"),
+    ),
+];
+
+/// Runs both controllers, writes each run into `out/<controller>/`, the paths side by side into
+/// `comparison.png` and the table into `comparison.md`.
+fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
+    let mut runs = Vec::new();
+    for (name, file, text) in SCENARIOS {
+        let dir = ctx.out.join(name);
+        runs.push(ctx.run(name, file, text, &dir)?);
+    }
+    draw_comparison(&ctx.out.join("comparison.png"), &runs)?;
+    let md = corner_table(&runs);
+    write_text(&ctx.out.join("comparison.md"), &md)?;
+    Ok(md)
+}
+
+/// Fig. 7 (a)/(b): each run's path over the corridor, with the robot's outline every 0.5 s.
+fn draw_comparison(file: &Path, runs: &[ReplayRun]) -> anyhow::Result<()> {
+    let paths: Vec<Vec<Point2<f64>>> = runs
+        .iter()
+        .map(|r| {
+            r.output
+                .trajectory
+                .iter()
+                .map(|t| Point2::new(t.x_mm, t.y_mm))
+                .collect()
+        })
+        .collect();
+    let panels: Vec<Panel<'_>> = runs
+        .iter()
+        .zip(&paths)
+        .enumerate()
+        .map(|(k, (r, path))| {
+            let every = (0.5 / r.scenario.run.control_period_s).round() as usize;
+            let markers = r
+                .scenario
+                .goal
+                .iter()
+                .map(|g| Marker {
+                    at: g.point(),
+                    radius_mm: g.tolerance_mm,
+                    rgb: [250, 130, 0],
+                    label: "goal".into(),
+                })
+                .collect();
+            Panel {
+                title: format!(
+                    "({}) {}",
+                    (b'a' + k as u8) as char,
+                    r.name.replace('_', "-")
+                ),
+                layout: &r.scenario.world,
+                paths: vec![PathLayer {
+                    label: format!(
+                        "robot path (outline every {:.1} s)",
+                        every as f64 * r.scenario.run.control_period_s
+                    ),
+                    rgb: [220, 30, 30],
+                    points: path,
+                    dots: false,
+                    discs: Some((every, r.scenario.robot.radius_mm)),
+                }],
+                markers,
+            }
+        })
+        .collect();
+    draw_panels(file, &panels, 900)?;
+    Ok(())
+}
+
+fn fmt_opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("-".to_string(), |x| format!("{x:.digits$}"))
+}
+
+/// The E1 metrics of the runs as a Markdown table, with the comparisons E1 asks for.
+pub fn corner_table(runs: &[ReplayRun]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# E1: the 55-degree corner\n");
+    let _ = writeln!(
+        s,
+        "Metrics as defined in docs/experiments.md (E1). Renderer: {}.\n",
+        runs.first()
+            .and_then(|r| r.output.summary.renderer.clone())
+            .unwrap_or_else(|| "-".into())
+    );
+    let _ = write!(s, "| metric |");
+    for r in runs {
+        let _ = write!(s, " {} |", r.name);
+    }
+    let _ = write!(s, "\n|---|");
+    for _ in runs {
+        let _ = write!(s, "---:|");
+    }
+    let _ = writeln!(s);
+    type Row = (&'static str, fn(&Summary) -> String);
+    let rows: [Row; 13] = [
+        ("reached_goal", |m| m.reached_goal.to_string()),
+        ("wall_contacts", |m| m.wall_contacts.to_string()),
+        ("time_to_goal_s", |m| fmt_opt(m.time_to_goal_s, 2)),
+        ("turn_onset_mm", |m| fmt_opt(m.metric("turn_onset_mm"), 1)),
+        ("overshoot_mm", |m| fmt_opt(m.metric("overshoot_mm"), 1)),
+        ("min_clearance_mm", |m| format!("{:.1}", m.min_clearance_mm)),
+        ("path_length_mm", |m| format!("{:.1}", m.path_length_mm)),
+        ("peak_speed_mm_s", |m| format!("{:.1}", m.peak_speed_mm_s)),
+        ("peak_accel_mm_s2", |m| format!("{:.2}", m.peak_accel_mm_s2)),
+        ("freespace_error_mm", |m| fmt_opt(m.freespace_error_mm, 1)),
+        ("cycles", |m| m.cycles.to_string()),
+        ("cycles_per_s", |m| format!("{:.0}", m.cycles_per_s)),
+        ("seed", |m| m.seed.to_string()),
+    ];
+    for (name, f) in rows {
+        let _ = write!(s, "| `{name}` |");
+        for r in runs {
+            let _ = write!(s, " {} |", f(&r.output.summary));
+        }
+        let _ = writeln!(s);
+    }
+    if let [gd, va] = runs {
+        let (a, b) = (&gd.output.summary, &va.output.summary);
+        let _ = writeln!(s);
+        let yes = |c: bool| if c { "yes" } else { "NO" };
+        if let (Some(x), Some(y)) = (a.metric("turn_onset_mm"), b.metric("turn_onset_mm")) {
+            let _ = writeln!(
+                s,
+                "- velocity-aware turns earlier: {} ({y:.1} vs {x:.1} mm before K)",
+                yes(y > x)
+            );
+        }
+        if let (Some(x), Some(y)) = (a.metric("overshoot_mm"), b.metric("overshoot_mm")) {
+            let _ = writeln!(
+                s,
+                "- velocity-aware overshoots less: {} ({y:.1} vs {x:.1} mm past K)",
+                yes(y < x)
+            );
+        }
+        let _ = writeln!(
+            s,
+            "- both reach the goal without wall contact: {}",
+            yes(a.reached_goal && b.reached_goal && a.wall_contacts == 0 && b.wall_contacts == 0)
+        );
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(x: f64, y: f64, vx: f64, vy: f64) -> TrajectoryRow {
+        TrajectoryRow {
+            t_s: 0.0,
+            x_mm: x,
+            y_mm: y,
+            theta_rad: 0.0,
+            vx_mm_s: vx,
+            vy_mm_s: vy,
+            cmd_vx_mm_s: 0.0,
+            cmd_vy_mm_s: 0.0,
+            est_x_mm: None,
+            est_y_mm: None,
+            est_theta_rad: None,
+        }
+    }
+
+    #[test]
+    fn onset_and_overshoot_follow_their_definitions() {
+        let rows = vec![
+            row(-2500.0, 0.0, 0.0, 0.0),
+            row(-2000.0, 0.0, 150.0, 0.0), // below 200: not armed yet
+            row(-1500.0, 0.0, 400.0, 0.0),
+            row(-1000.0, 0.0, 350.0, 50.0),  // 87.5% of the maximum
+            row(-700.0, 50.0, 290.0, 100.0), // 72.5%: onset at (K - p).u1 = 700
+            row(-300.0, 200.0, 100.0, 300.0),
+            row(120.0, 300.0, -50.0, 300.0),
+            row(60.0, 500.0, -200.0, 300.0),
+        ];
+        let m = corner_metrics(&rows, Vector2::zeros(), Vector2::new(1.0, 0.0));
+        assert_eq!(m.turn_onset_mm, Some(700.0));
+        assert_eq!(m.overshoot_mm, 120.0);
+    }
+}

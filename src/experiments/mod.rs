@@ -1,0 +1,174 @@
+//! Experiments, one module each: its scenario section (`[experiment.NAME]`), its procedure,
+//! its metrics (computed from the truth and the robot's estimates) and its replay of a
+//! paper's experiment (scenario files, figure, table).
+//!
+//! A new experiment is a module here with a spec type (a variant of [`ExperimentSpec`]), an
+//! [`Experiment`] (procedure and metrics) and, when it replays a paper, a [`Replay`] in
+//! [`REPLAYS`]; plus its scenario files, its end-to-end test and its section of
+//! `docs/experiments.md`.
+
+pub mod corner;
+pub mod places;
+
+use crate::load::parse_scenario;
+use crate::output::write_run;
+use crate::record::Summary;
+use crate::scenario::Scenario;
+use crate::simulation::{RunError, RunOptions, RunOutput, Simulation, run_scenario};
+use crate::validate::Checker;
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The metrics an experiment adds to `summary.json`, by key.
+pub type Metrics = serde_json::Map<String, serde_json::Value>;
+
+/// What an experiment does with the simulation, and what it measures.
+pub trait Experiment {
+    /// Carries out the procedure, calling `progress(cycle, total)` as it goes. The default
+    /// drives: control cycles until the goal is reached or the time is up.
+    fn run(
+        &mut self,
+        sim: &mut Simulation,
+        progress: &mut dyn FnMut(u64, u64),
+    ) -> Result<(), RunError> {
+        drive(sim, progress)
+    }
+
+    /// The experiment's own metrics of a finished run.
+    fn metrics(&self, _out: &RunOutput) -> Metrics {
+        Metrics::new()
+    }
+}
+
+/// The driving procedure: control cycles until the run is over, then the final state.
+pub fn drive(sim: &mut Simulation, progress: &mut dyn FnMut(u64, u64)) -> Result<(), RunError> {
+    let max = sim.scenario().max_cycles();
+    while !sim.finished() {
+        sim.step()?;
+        progress(sim.cycle(), max);
+    }
+    sim.record_final_state();
+    Ok(())
+}
+
+/// A scenario with no experiment: it drives, and measures what every run measures.
+struct Drive;
+
+impl Experiment for Drive {}
+
+/// The experiment a scenario belongs to (`[experiment.corner]`, `[experiment.places]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ExperimentSpec {
+    /// E1: a corridor corner, its turn metrics.
+    Corner(corner::CornerSpec),
+    /// E2: localize at places on the field.
+    Places(places::PlacesSpec),
+}
+
+impl ExperimentSpec {
+    /// Checks the section against the rest of the scenario.
+    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+        match self {
+            Self::Corner(spec) => spec.validate(c),
+            Self::Places(spec) => spec.validate(s, c),
+        }
+    }
+
+    /// The table `omniloop run` prints for a run of this experiment, if it has one.
+    pub fn table(&self, summary: &Summary) -> Option<String> {
+        match self {
+            Self::Corner(_) => None,
+            Self::Places(_) => Some(places::places_table(summary)),
+        }
+    }
+}
+
+/// The procedure and metrics of a scenario's experiment.
+pub fn procedure(s: &Scenario) -> Box<dyn Experiment> {
+    match &s.experiment {
+        None => Box::new(Drive),
+        Some(ExperimentSpec::Corner(spec)) => Box::new(corner::Corner::new(spec)),
+        Some(ExperimentSpec::Places(spec)) => Box::new(places::Places::new(spec)),
+    }
+}
+
+/// A replay of a paper's experiment: `omniloop replay NAME`.
+pub struct Replay {
+    /// The name on the command line.
+    pub name: &'static str,
+    /// One line saying what it replays.
+    pub title: &'static str,
+    /// Runs it, writes its outputs under the context's folder, returns its table (Markdown).
+    pub run: fn(&mut ReplayContext<'_>) -> anyhow::Result<String>,
+}
+
+/// Every replay, in the order `omniloop replay --list` shows them.
+pub const REPLAYS: &[Replay] = &[corner::REPLAY, places::REPLAY];
+
+/// The replay called `name`.
+pub fn replay(name: &str) -> Option<&'static Replay> {
+    REPLAYS.iter().find(|r| r.name == name)
+}
+
+/// Where a replay writes, how it renders, and how it reports.
+pub struct ReplayContext<'a> {
+    /// Output folder.
+    pub out: &'a Path,
+    /// Renderer and frame options.
+    pub options: &'a RunOptions,
+    /// Seed overriding the scenarios'.
+    pub seed: Option<u64>,
+    /// Progress: run name, cycle, total.
+    pub progress: &'a mut dyn FnMut(&str, u64, u64),
+    /// One-line notices for the user.
+    pub notice: &'a mut dyn FnMut(&str),
+}
+
+/// One run of a replay.
+pub struct ReplayRun {
+    /// Short name (`goal_direction`).
+    pub name: String,
+    /// The scenario.
+    pub scenario: Scenario,
+    /// What it produced.
+    pub output: RunOutput,
+}
+
+impl ReplayContext<'_> {
+    /// Runs the built-in scenario `text` (from `file`, named in messages) with the replay's
+    /// seed, and writes its outputs into `dir`.
+    pub fn run(
+        &mut self,
+        name: &str,
+        file: &str,
+        text: &str,
+        dir: &Path,
+    ) -> anyhow::Result<ReplayRun> {
+        let path = Path::new(file);
+        let stem = path
+            .file_stem()
+            .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+        let mut scenario = parse_scenario(text, path, &stem)?;
+        if let Some(seed) = self.seed {
+            scenario.seed = seed;
+        }
+        let progress = &mut *self.progress;
+        let output = run_scenario(&scenario, self.options, &mut *self.notice, |k, n| {
+            progress(name, k, n)
+        })
+        .with_context(|| format!("running {file}"))?;
+        write_run(dir, &scenario, &output)?;
+        Ok(ReplayRun {
+            name: name.to_string(),
+            scenario,
+            output,
+        })
+    }
+}
+
+/// Writes `text` to `file`, naming the file in the error.
+pub(crate) fn write_text(file: &Path, text: &str) -> anyhow::Result<()> {
+    std::fs::write(file, text).with_context(|| format!("writing {}", file.display()))
+}

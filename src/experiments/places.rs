@@ -1,0 +1,287 @@
+//! E2, self-localization at places (Sekimori et al., Sect. 5.2, Fig. 8): the robot is carried
+//! to each place, told nothing of where it is, and localizes itself from `frames_per_place`
+//! frames with fresh sensor noise; each place is scored by its RMS errors. Its replay,
+//! `selfloc`, runs the six places on the Small-Size field.
+
+use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
+use crate::record::Summary;
+use crate::scenario::{PoseSpec, Scenario};
+use crate::simulation::{RunError, RunOutput, Simulation};
+use crate::topview::{Marker, Panel, PathLayer, draw_panels};
+use crate::validate::Checker;
+use nalgebra::{Isometry2, Point2};
+use omniloop_control::wrap_pi;
+use omniloop_robot::{Measurement, PoseSource};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The stage whose fixes E2 scores.
+const STAGE: &str = "floor_localization";
+
+/// The places (`[experiment.places]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlacesSpec {
+    /// The places (field frame).
+    pub places: Vec<PoseSpec>,
+    /// Frames (pose estimates) at each place.
+    #[serde(default = "default_frames_per_place")]
+    pub frames_per_place: u32,
+}
+
+fn default_frames_per_place() -> u32 {
+    10
+}
+
+impl PlacesSpec {
+    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+        if self.places.is_empty() {
+            c.fail("experiment.places.places", "needs at least one place");
+        }
+        if self.frames_per_place == 0 {
+            c.fail("experiment.places.frames_per_place", "must be >= 1");
+        }
+        for (i, p) in self.places.iter().enumerate() {
+            c.pose_in_world(
+                &format!("experiment.places.places[{i}]"),
+                p,
+                s.robot.radius_mm,
+                &s.world,
+            );
+        }
+        if s.control.pose_source != PoseSource::Localization {
+            c.fail(
+                "experiment.places",
+                "the robot localizes itself at each place: set control.pose_source = \
+                 \"localization\"",
+            );
+        }
+    }
+}
+
+/// Self-localization at one place.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlaceResult {
+    /// The true pose: x_mm, y_mm, theta_deg.
+    pub true_pose: [f64; 3],
+    /// RMS distance of the localized estimates from the true position.
+    pub rms_position_mm: f64,
+    /// RMS heading error of the localized estimates.
+    pub rms_heading_deg: f64,
+    /// Estimates that took the wrong one of the two half-turn solutions.
+    pub ambiguity_errors: usize,
+    /// Frames taken here.
+    pub frames: usize,
+    /// Frames that gave no estimate.
+    pub not_localized: usize,
+}
+
+/// Sums of one place's scores.
+#[derive(Debug, Default)]
+struct Tally {
+    sq_position: f64,
+    sq_heading: f64,
+    localized: usize,
+    ambiguous: usize,
+    missing: usize,
+}
+
+impl Tally {
+    /// Scores the fix of one frame against the true pose.
+    fn add(&mut self, fix: Option<&Measurement>, truth: &Isometry2<f64>) {
+        let Some(Measurement::Pose {
+            pose, alternative, ..
+        }) = fix
+        else {
+            self.missing += 1;
+            return;
+        };
+        let err = |q: &Isometry2<f64>| (q.translation.vector - truth.translation.vector).norm();
+        if alternative.is_some_and(|a| err(&a) < err(pose)) {
+            self.ambiguous += 1;
+        }
+        let dh = wrap_pi(pose.rotation.angle() - truth.rotation.angle());
+        self.sq_position += err(pose).powi(2);
+        self.sq_heading += dh.powi(2);
+        self.localized += 1;
+    }
+
+    fn result(&self, place: &PoseSpec, frames: usize) -> PlaceResult {
+        let rms = |sq: f64| {
+            if self.localized > 0 {
+                (sq / self.localized as f64).sqrt()
+            } else {
+                f64::NAN
+            }
+        };
+        PlaceResult {
+            true_pose: [place.x_mm, place.y_mm, place.heading_deg],
+            rms_position_mm: rms(self.sq_position),
+            rms_heading_deg: rms(self.sq_heading).to_degrees(),
+            ambiguity_errors: self.ambiguous,
+            frames,
+            not_localized: self.missing,
+        }
+    }
+}
+
+/// The procedure and metrics of E2.
+pub struct Places {
+    spec: PlacesSpec,
+    results: Vec<PlaceResult>,
+}
+
+impl Places {
+    /// E2 at the places of `spec`.
+    pub fn new(spec: &PlacesSpec) -> Self {
+        Self {
+            spec: spec.clone(),
+            results: Vec::new(),
+        }
+    }
+}
+
+impl Experiment for Places {
+    /// Carries the robot to each place and has it localize itself there `frames_per_place`
+    /// times, each time from nothing: it is told it was moved and nothing else (no prior).
+    fn run(
+        &mut self,
+        sim: &mut Simulation,
+        progress: &mut dyn FnMut(u64, u64),
+    ) -> Result<(), RunError> {
+        let frames = self.spec.frames_per_place as usize;
+        let total = (self.spec.places.len() * frames) as u64;
+        for place in &self.spec.places {
+            let truth = place.isometry();
+            sim.place_robot(truth);
+            let mut tally = Tally::default();
+            for _ in 0..frames {
+                sim.robot_mut().forget_pose();
+                sim.step()?;
+                let fix = sim
+                    .last_estimates()
+                    .and_then(|e| e.pose_fix(STAGE))
+                    .map(|f| &f.measurement);
+                tally.add(fix, &truth);
+                progress(sim.cycle(), total);
+            }
+            self.results.push(tally.result(place, frames));
+        }
+        Ok(())
+    }
+
+    fn metrics(&self, _out: &RunOutput) -> Metrics {
+        let mut keys = Metrics::new();
+        keys.insert(
+            "places".into(),
+            serde_json::to_value(&self.results).unwrap_or_default(),
+        );
+        keys
+    }
+}
+
+/// The per-place results of a summary (`places`).
+pub fn place_results(m: &Summary) -> Vec<PlaceResult> {
+    m.experiment
+        .get("places")
+        .and_then(|v| serde_json::from_value(v.clone()).ok())
+        .unwrap_or_default()
+}
+
+/// `omniloop replay selfloc`.
+pub const REPLAY: Replay = Replay {
+    name: "selfloc",
+    title: "E2: floor-region self-localization at six places on the field (Fig. 8)",
+    run: replay,
+};
+
+/// The E2 scenario file, built into the binary.
+pub const SCENARIO: (&str, &str) = (
+    "scenarios/selfloc_field.toml",
+    include_str!("../../scenarios/selfloc_field.toml"),
+);
+
+/// Runs E2, writes the run into `out/`, the places with their errors (like Fig. 8) into
+/// `places.png` and the table into `places.md`.
+fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
+    let out = ctx.out.to_path_buf();
+    let run = ctx.run("selfloc_field", SCENARIO.0, SCENARIO.1, &out)?;
+    draw_places(&out.join("places.png"), &run.scenario, &run.output)?;
+    let md = places_table(&run.output.summary);
+    write_text(&out.join("places.md"), &md)?;
+    Ok(md)
+}
+
+/// Fig. 8: the field with its cubes, each place with the robot's outline, its estimates, and
+/// its RMS errors written beside it.
+fn draw_places(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
+    let estimates: Vec<Point2<f64>> = out
+        .trajectory
+        .iter()
+        .filter_map(|r| Some(Point2::new(r.est_x_mm?, r.est_y_mm?)))
+        .collect();
+    let markers = place_results(&out.summary)
+        .iter()
+        .enumerate()
+        .map(|(k, p)| Marker {
+            at: Point2::new(p.true_pose[0], p.true_pose[1]),
+            radius_mm: scenario.robot.radius_mm,
+            rgb: [20, 20, 20],
+            label: format!(
+                "{}: {:.1} mm, {:.2} deg",
+                k + 1,
+                p.rms_position_mm,
+                p.rms_heading_deg
+            ),
+        })
+        .collect();
+    let panel = Panel {
+        title: format!("{}: RMS error at each place", scenario.name),
+        layout: &scenario.world,
+        paths: vec![PathLayer {
+            label: "estimates".into(),
+            rgb: [30, 80, 230],
+            points: &estimates,
+            dots: true,
+            discs: None,
+        }],
+        markers,
+    };
+    draw_panels(file, &[panel], 1100)?;
+    Ok(())
+}
+
+/// E2 per place as a Markdown table.
+pub fn places_table(m: &Summary) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# E2: self-localization on the field\n");
+    let _ = writeln!(
+        s,
+        "Renderer: {}. Seed {}. Global mode: every frame from no prior. Paper: errors of \
+         \"dozens of mm\" at each place.\n",
+        m.renderer.clone().unwrap_or_else(|| "-".into()),
+        m.seed
+    );
+    let _ = writeln!(
+        s,
+        "| place | x_mm | y_mm | theta_deg | frames | not localized | RMS position (mm) | RMS heading (deg) | ambiguity errors |"
+    );
+    let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for (k, p) in place_results(m).iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.2} | {} |",
+            k + 1,
+            p.true_pose[0],
+            p.true_pose[1],
+            p.true_pose[2],
+            p.frames,
+            p.not_localized,
+            p.rms_position_mm,
+            p.rms_heading_deg,
+            p.ambiguity_errors
+        );
+    }
+    s
+}

@@ -1,0 +1,138 @@
+//! Scoring against the truth, on the simulator's side: which targets the robot really reached,
+//! how far its free space and pose estimates were from the world.
+
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_robot::GoalSpec;
+use omniloop_sim::World;
+use omniloop_vision::FreeSpace;
+
+/// The truth-side record of a run.
+#[derive(Debug, Clone, Default)]
+pub struct TruthScore {
+    targets: Vec<Point2<f64>>,
+    tolerance_mm: f64,
+    reached: Vec<bool>,
+    time_to_goal_s: Option<f64>,
+    freespace_errors_mm: Vec<f64>,
+    pose_errors_mm: Vec<f64>,
+}
+
+impl TruthScore {
+    /// A score for the targets of `goal`, if any.
+    pub fn new(goal: Option<&GoalSpec>) -> Self {
+        let targets = goal.map_or(Vec::new(), GoalSpec::targets);
+        Self {
+            reached: vec![false; targets.len()],
+            tolerance_mm: goal.map_or(0.0, |g| g.tolerance_mm),
+            targets,
+            ..Self::default()
+        }
+    }
+
+    /// After a cycle in which the robot headed for target `heading_for`, ending at `p` at time
+    /// `t_s`: the target counts as reached when the robot centre is within the tolerance of it.
+    /// Reaching the last target (the goal) sets the time to goal.
+    pub fn targets(&mut self, p: Point2<f64>, heading_for: Option<usize>, t_s: f64) {
+        let Some(i) = heading_for.filter(|&i| i < self.targets.len()) else {
+            return;
+        };
+        if (p - self.targets[i]).norm() <= self.tolerance_mm {
+            self.reached[i] = true;
+            if i + 1 == self.targets.len() && self.time_to_goal_s.is_none() {
+                self.time_to_goal_s = Some(t_s);
+            }
+        }
+    }
+
+    /// When the goal was reached.
+    pub fn time_to_goal_s(&self) -> Option<f64> {
+        self.time_to_goal_s
+    }
+
+    /// With waypoints: how many of the targets were reached.
+    pub fn targets_reached(&self) -> Option<usize> {
+        (self.targets.len() > 1).then(|| self.reached.iter().filter(|&&r| r).count())
+    }
+
+    /// Compares detected free distances with the world's, direction by direction, for a robot
+    /// at `pose` whose camera axis sits at `mount_mm` (truth clipped at the template's range).
+    pub fn freespace(
+        &mut self,
+        world: &World,
+        pose: &Isometry2<f64>,
+        mount_mm: [f64; 2],
+        fs: &FreeSpace,
+    ) {
+        let axis = pose * Point2::new(mount_mm[0], mount_mm[1]);
+        let heading = pose.rotation.angle();
+        for (a, free) in fs.direction_rad.iter().zip(&fs.free_mm) {
+            let dir = Vector2::new((heading + a).cos(), (heading + a).sin());
+            let truth = world
+                .ray_cast_mm(axis, dir, fs.range_mm, Some(0))
+                .unwrap_or(fs.range_mm);
+            self.freespace_errors_mm.push((free - truth).abs());
+        }
+    }
+
+    /// Records the distance of a pose estimate from the true position.
+    pub fn pose(&mut self, estimate: Point2<f64>, truth: Point2<f64>) {
+        self.pose_errors_mm
+            .push((estimate.x - truth.x).hypot(estimate.y - truth.y));
+    }
+
+    /// Median |detected - true| free distance over all directions of the run.
+    pub fn freespace_error_mm(&self) -> Option<f64> {
+        median(&self.freespace_errors_mm)
+    }
+
+    /// Median distance of the pose estimate from the truth over the run.
+    pub fn pose_error_mm(&self) -> Option<f64> {
+        median(&self.pose_errors_mm)
+    }
+}
+
+/// The median of `values` (`None` when empty).
+pub fn median(values: &[f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_target_counts_only_while_the_robot_heads_for_it() {
+        let goal = GoalSpec {
+            waypoints_mm: vec![[1000.0, 0.0]],
+            x_mm: 0.0,
+            y_mm: 500.0,
+            tolerance_mm: 100.0,
+            estimate_margin_mm: 0.0,
+        };
+        let mut s = TruthScore::new(Some(&goal));
+        // Passing the goal while heading for the waypoint does not reach the goal.
+        s.targets(Point2::new(0.0, 450.0), Some(0), 1.0);
+        assert_eq!((s.targets_reached(), s.time_to_goal_s()), (Some(0), None));
+        // The robot believed it reached the waypoint 150 mm short of it: not reached.
+        s.targets(Point2::new(850.0, 0.0), Some(0), 2.0);
+        s.targets(Point2::new(0.0, 480.0), Some(1), 3.0);
+        s.targets(Point2::new(0.0, 500.0), Some(1), 3.5);
+        assert_eq!(
+            (s.targets_reached(), s.time_to_goal_s()),
+            (Some(1), Some(3.0))
+        );
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
+        assert_eq!(median(&[]), None);
+    }
+}

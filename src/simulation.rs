@@ -1,0 +1,431 @@
+//! The closed loop on the simulator's side: render the robot's cameras, hand its software what
+//! its sensors give, apply its commands, step the world, and record the truth beside what the
+//! robot believes.
+
+use crate::calibrate::calibrate_sensor;
+use crate::cameras::Cameras;
+use crate::experiments;
+use crate::odometry::WheelOdometry;
+use crate::pilot::Pilot;
+use crate::record::{Summary, TrajectoryRow};
+use crate::scenario::Scenario;
+use crate::score::TruthScore;
+use nalgebra::{Isometry2, Point2, Rotation2};
+use omniloop_control::{AccelLimitedDrive, VelocityCommand};
+use omniloop_robot::{ControllerKind, Estimates, Observation, Robot, RobotError};
+use omniloop_sim::{RenderError, Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
+use omniloop_vision::{RadialCalibration, VisionError};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Why a run could not be carried out.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The world could not be built.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The simulator's pilot could not be built.
+    #[error("control: {0}")]
+    Control(#[from] omniloop_control::ControlError),
+    /// The renderer could not open or render.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// A calibration file could not be used.
+    #[error("vision: {0}")]
+    Vision(#[from] VisionError),
+    /// The robot's software could not be built or failed.
+    #[error("robot: {0}")]
+    Robot(#[from] RobotError),
+    /// The robot commanded an actuator it does not have.
+    #[error("actuator: {0}")]
+    Actuator(String),
+    /// A frame could not be written.
+    #[error("writing frame {path}: {source}")]
+    Frame {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: image::ImageError,
+    },
+}
+
+/// How to run a scenario (what the command line adds to the scenario file).
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Which renderer traces the cameras' images.
+    pub renderer: RendererChoice,
+    /// Save every camera's image every this many cycles (with `frames_dir`).
+    pub save_frames_every: Option<u64>,
+    /// Where saved frames go.
+    pub frames_dir: Option<PathBuf>,
+}
+
+/// The seed of sensor `index`'s noise, derived from the run's seed.
+pub fn sensor_noise_seed(seed: u64, index: usize) -> u64 {
+    seed ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
+
+/// Everything a run produced.
+#[derive(Debug, Clone)]
+pub struct RunOutput {
+    /// Metrics.
+    pub summary: Summary,
+    /// One row a control cycle (and the final state, for driving runs).
+    pub trajectory: Vec<TrajectoryRow>,
+    /// What the robot believed, one record a control cycle.
+    pub estimates: Vec<Estimates>,
+    /// The paths of the other robots, one point a control cycle.
+    pub other_paths: Vec<Vec<Point2<f64>>>,
+}
+
+/// The calibrations of the cameras the robot's vision uses: the scenario's file, or the
+/// camera's traced map.
+fn calibrations(scenario: &Scenario) -> Result<Vec<RadialCalibration>, RunError> {
+    if !scenario.needs_calibration() {
+        return Ok(Vec::new());
+    }
+    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
+    let spec = &scenario.robot.sensors[index];
+    let mut cal = match &scenario.vision.calibration_file {
+        Some(path) => RadialCalibration::load(path)?,
+        None => calibrate_sensor(spec)?,
+    };
+    // The file is this camera's calibration, whatever name it was written under.
+    cal.sensor = spec.name.clone();
+    Ok(vec![cal])
+}
+
+/// A scenario being run, one control cycle at a time.
+pub struct Simulation {
+    scenario: Scenario,
+    world: World,
+    cameras: Option<Cameras>,
+    odometry: WheelOdometry,
+    robot: Robot,
+    pilot: Option<Pilot>,
+    others: Vec<Pilot>,
+    truth: TruthScore,
+    cycle: u64,
+    trajectory: Vec<TrajectoryRow>,
+    estimates: Vec<Estimates>,
+    other_paths: Vec<Vec<Point2<f64>>>,
+    options: RunOptions,
+}
+
+impl Simulation {
+    /// Builds the world, the robot's software and the cameras of a validated scenario.
+    /// `notice` receives one-line messages for the user (e.g. the renderer's choice).
+    pub fn new(
+        scenario: &Scenario,
+        options: &RunOptions,
+        notice: impl FnOnce(&str),
+    ) -> Result<Self, RunError> {
+        let world = World::new(
+            &scenario.world,
+            &scenario.robot_bodies(),
+            scenario.run.physics_step_s,
+        )?;
+        let robot = Robot::new(&scenario.robot_config(calibrations(scenario)?))?;
+        let r = &scenario.robot;
+        let pilot = match (&scenario.goal, scenario.control.kind) {
+            (Some(g), ControllerKind::GoToGoalTruth) => Some(Pilot::new(
+                g.targets(),
+                g.tolerance_mm,
+                false,
+                r.max_speed_mm_s,
+                AccelLimitedDrive::new(r.accel_limit_mm_s2, r.angular_accel_limit_rad_s2)?,
+            )?),
+            _ => None,
+        };
+        let mut others = Vec::new();
+        for o in &scenario.other_robots {
+            let waypoints = o.waypoints_mm.iter().map(|w| Point2::new(w[0], w[1]));
+            let drive = AccelLimitedDrive::new(o.accel_limit_mm_s2, 10.0)?;
+            others.push(Pilot::new(
+                waypoints.collect(),
+                20.0,
+                o.cycle,
+                o.max_speed_mm_s,
+                drive,
+            )?);
+        }
+        let cameras = Cameras::open(
+            scenario,
+            robot.cameras(),
+            options.save_frames_every.is_some(),
+            options.renderer,
+            notice,
+        )?;
+        Ok(Self {
+            scenario: scenario.clone(),
+            world,
+            cameras,
+            odometry: WheelOdometry::new(&scenario.odometry, scenario.seed),
+            robot,
+            pilot,
+            other_paths: vec![Vec::new(); others.len()],
+            others,
+            truth: TruthScore::new(scenario.goal.as_ref()),
+            cycle: 0,
+            trajectory: Vec::new(),
+            estimates: Vec::new(),
+            options: options.clone(),
+        })
+    }
+
+    /// The world being simulated.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The scenario being run.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// The robot's software.
+    pub fn robot_mut(&mut self) -> &mut Robot {
+        &mut self.robot
+    }
+
+    /// Control cycles run so far.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    /// What the robot believed in the last cycle.
+    pub fn last_estimates(&self) -> Option<&Estimates> {
+        self.estimates.last()
+    }
+
+    /// Whether the run is over: time is up, or the goal is reached and the run stops there.
+    pub fn finished(&self) -> bool {
+        self.cycle >= self.scenario.max_cycles()
+            || (self.scenario.run.stop_at_goal && self.truth.time_to_goal_s().is_some())
+    }
+
+    /// Puts the robot under test at `pose`, at rest (an experimenter carrying it there).
+    pub fn place_robot(&mut self, pose: Isometry2<f64>) {
+        self.world.place_robot(0, pose);
+    }
+
+    /// One control cycle: the cameras see, the robot's software decides, the commands are
+    /// applied and recorded, the world advances one period, the wheels report.
+    pub fn step(&mut self) -> Result<(), RunError> {
+        let t = self.world.time_s();
+        let out = match &mut self.cameras {
+            Some(c) => {
+                c.capture(&self.world)?;
+                if let (Some(every), Some(dir)) =
+                    (self.options.save_frames_every, &self.options.frames_dir)
+                    && every > 0
+                    && self.cycle.is_multiple_of(every)
+                {
+                    c.save(dir, self.cycle)?;
+                }
+                let (frames, actuators) = (c.frames(t), c.actuator_state());
+                self.robot.cycle(&Observation {
+                    t_s: t,
+                    frames: &frames,
+                    actuators: &actuators,
+                })?
+            }
+            None => self.robot.cycle(&Observation {
+                t_s: t,
+                frames: &[],
+                actuators: &[],
+            })?,
+        };
+        let state = self.world.robot_state(0);
+        let (command, heading_for) = match &mut self.pilot {
+            Some(p) => (
+                p.command(Point2::from(state.pose.translation.vector)),
+                Some(p.index()),
+            ),
+            None => (
+                VelocityCommand {
+                    v_mm_s: Rotation2::new(state.pose.rotation.angle()) * out.command.v_mm_s,
+                    omega_rad_s: out.command.omega_rad_s,
+                },
+                out.estimates.target,
+            ),
+        };
+        self.world.set_command(0, command);
+        if let Some(c) = &mut self.cameras {
+            c.command(&out.actuators)?;
+        }
+        if let Some(fs) = &out.estimates.freespace {
+            let mount = self.vision_mount_mm();
+            self.truth.freespace(&self.world, &state.pose, mount, fs);
+        }
+        self.drive_others();
+        self.record(t, command, out.estimates);
+
+        let dt = self.scenario.run.control_period_s;
+        self.world.advance(dt);
+        if let Some(c) = &mut self.cameras {
+            c.advance(dt);
+        }
+        self.cycle += 1;
+        let after = self.world.robot_state(0);
+        self.robot.odometry(&self.odometry.read(&after, dt));
+        let p = Point2::from(after.pose.translation.vector);
+        self.truth.targets(p, heading_for, self.world.time_s());
+        Ok(())
+    }
+
+    /// Where the axis of the camera vision uses sits on the robot.
+    fn vision_mount_mm(&self) -> [f64; 2] {
+        self.scenario
+            .vision_sensor_index()
+            .map_or([0.0, 0.0], |i| self.scenario.robot.sensors[i].mount_mm)
+    }
+
+    /// The other robots drive on, each by its pilot on its true position.
+    fn drive_others(&mut self) {
+        for (k, pilot) in self.others.iter_mut().enumerate() {
+            let p = Point2::from(self.world.robot_state(k + 1).pose.translation.vector);
+            self.other_paths[k].push(p);
+            let cmd = pilot.command(p);
+            self.world.set_command(k + 1, cmd);
+        }
+    }
+
+    /// Records the cycle: the trajectory row (truth, command, estimated pose) and the robot's
+    /// estimates, and scores the pose estimate.
+    fn record(&mut self, t: f64, command: VelocityCommand, estimates: Estimates) {
+        let row = self.row(t, command, estimates.pose);
+        if let (Some(x), Some(y)) = (row.est_x_mm, row.est_y_mm) {
+            self.truth
+                .pose(Point2::new(x, y), Point2::new(row.x_mm, row.y_mm));
+        }
+        self.trajectory.push(row);
+        self.estimates.push(estimates);
+    }
+
+    /// Closes the trajectory with the final state (driving runs).
+    pub fn record_final_state(&mut self) {
+        let row = self.row(
+            self.world.time_s(),
+            self.world.command(0),
+            self.robot.estimate(),
+        );
+        self.trajectory.push(row);
+    }
+
+    /// The trajectory row of the current state with `command` and the estimate.
+    fn row(&self, t: f64, command: VelocityCommand, est: Option<Isometry2<f64>>) -> TrajectoryRow {
+        let s = self.world.robot_state(0);
+        TrajectoryRow {
+            t_s: t,
+            x_mm: s.pose.translation.x,
+            y_mm: s.pose.translation.y,
+            theta_rad: s.pose.rotation.angle(),
+            vx_mm_s: s.velocity_mm_s.x,
+            vy_mm_s: s.velocity_mm_s.y,
+            cmd_vx_mm_s: command.v_mm_s.x,
+            cmd_vy_mm_s: command.v_mm_s.y,
+            est_x_mm: est.map(|e| e.translation.x),
+            est_y_mm: est.map(|e| e.translation.y),
+            est_theta_rad: est.map(|e| e.rotation.angle()),
+        }
+    }
+
+    /// Ends the run: the summary of what the truth shows, and everything recorded.
+    pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
+        for (k, path) in self.other_paths.iter_mut().enumerate() {
+            path.push(Point2::from(
+                self.world.robot_state(k + 1).pose.translation.vector,
+            ));
+        }
+        let stats = self.world.stats(0);
+        let localizes = self.robot.stages().contains(&"floor_localization");
+        let summary = Summary {
+            scenario: self.scenario.name.clone(),
+            seed: self.scenario.seed,
+            controller: self.scenario.control.kind.name().to_string(),
+            cycles: self.cycle,
+            sim_time_s: self.world.time_s(),
+            wall_time_s,
+            cycles_per_s: 0.0,
+            wall_contacts: stats.contacts,
+            peak_speed_mm_s: stats.peak_speed_mm_s,
+            peak_accel_mm_s2: stats.peak_accel_mm_s2,
+            reached_goal: self.truth.time_to_goal_s().is_some(),
+            time_to_goal_s: self.truth.time_to_goal_s(),
+            min_clearance_mm: stats.min_clearance_mm,
+            path_length_mm: stats.path_length_mm,
+            renderer: self.cameras.as_ref().map(|c| c.renderer_name().to_string()),
+            freespace_error_mm: self.truth.freespace_error_mm(),
+            pose_error_mm: self.truth.pose_error_mm(),
+            targets_reached: self.truth.targets_reached(),
+            localization_fixes: localizes.then(|| self.robot.fixes().0),
+            experiment: serde_json::Map::new(),
+        };
+        RunOutput {
+            summary,
+            trajectory: self.trajectory,
+            estimates: self.estimates,
+            other_paths: self.other_paths,
+        }
+    }
+}
+
+/// Runs a validated scenario to its end by its experiment's procedure (driving to the goal
+/// when it names none), calling `progress(cycle, total)` along the way. The summary's
+/// `wall_time_s` covers the whole run, set-up included (calibration, opening the renderer);
+/// its `cycles_per_s` covers the control cycles alone.
+pub fn run_scenario(
+    scenario: &Scenario,
+    options: &RunOptions,
+    notice: impl FnOnce(&str),
+    mut progress: impl FnMut(u64, u64),
+) -> Result<RunOutput, RunError> {
+    let start = Instant::now();
+    if let Some(dir) = &options.frames_dir {
+        std::fs::create_dir_all(dir).map_err(|e| RunError::Frame {
+            path: dir.clone(),
+            source: image::ImageError::IoError(e),
+        })?;
+    }
+    let mut sim = Simulation::new(scenario, options, notice)?;
+    let mut experiment = experiments::procedure(scenario);
+    let loop_start = Instant::now();
+    experiment.run(&mut sim, &mut progress)?;
+    let loop_s = loop_start.elapsed().as_secs_f64();
+    let mut out = sim.finish(start.elapsed().as_secs_f64());
+    if loop_s > 0.0 {
+        out.summary.cycles_per_s = out.summary.cycles as f64 / loop_s;
+    }
+    out.summary.experiment = experiment.metrics(&out);
+    Ok(out)
+}
+
+/// Renders what sensor `sensor` of the robot under test sees when the robot stands at `pose`
+/// (the scenario's start when `None`) and every other robot at its start, with the sensor's
+/// noise drawn as the first frame of a run would be, or clean when `noise` is false.
+pub fn render_snapshot(
+    scenario: &Scenario,
+    renderer: &mut Renderer,
+    sensor: Option<&str>,
+    pose: Option<Isometry2<f64>>,
+    noise: bool,
+) -> Result<image::RgbaImage, RunError> {
+    let index = scenario
+        .sensor_index(sensor)
+        .map_err(|e| SimError::Invalid(format!("scenario {:?}: {e}", scenario.name)))?;
+    let mut bodies = scenario.robot_bodies();
+    if let Some(p) = pose {
+        bodies[0].start = p;
+    }
+    let world = World::new(&scenario.world, &bodies, scenario.run.physics_step_s)?;
+    let sensor = scenario.robot.sensors[index].build()?;
+    let scene = Scene::of_world(&world);
+    let mut noise_source = noise.then(|| SensorNoise::new(sensor_noise_seed(scenario.seed, index)));
+    Ok(renderer.render(
+        &scene,
+        &sensor,
+        &world.robot_state(0).pose,
+        noise_source.as_mut(),
+    )?)
+}
