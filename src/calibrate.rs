@@ -60,3 +60,24 @@ fn trace(spec: &SensorSpec) -> Result<RadialCalibration, SimError> {
         fit,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sensor_is_traced_once_per_process() {
+        let spec = SensorSpec::corner_paper("traced_once");
+        let a = calibrate_sensor(&spec).unwrap();
+        let b = calibrate_sensor(&spec).unwrap();
+        assert_eq!(a, b);
+        assert!(a.fit.is_some());
+        let entries = TRACED
+            .lock()
+            .unwrap()
+            .iter()
+            .filter(|(s, _)| *s == spec)
+            .count();
+        assert_eq!(entries, 1);
+    }
+}

@@ -79,8 +79,7 @@ enum Command {
     },
     /// Replay an experiment of the papers (`--list` shows them).
     Replay {
-        /// The experiment.
-        #[arg(required_unless_present = "list")]
+        /// The experiment (without one, the list).
         experiment: Option<String>,
         /// List the experiments and exit.
         #[arg(long)]
@@ -277,11 +276,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     .collect::<Vec<_>>()
                     .join("\n")
             };
-            if list {
-                println!("{}", listing());
-                return Ok(());
-            }
-            let name = experiment.expect("clap requires an experiment without --list");
+            let name = match experiment {
+                Some(name) if !list => name,
+                _ => {
+                    println!("{}", listing());
+                    return Ok(());
+                }
+            };
             let Some(r) = replay(&name) else {
                 bail!("unknown experiment {name:?}; known:\n{}", listing());
             };
@@ -350,7 +351,27 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// Mesa's Vulkan driver complains on every start when `XDG_RUNTIME_DIR` is unset (headless
+/// machines, CI): give it a private folder so the terminal shows only what matters.
+fn quiet_mesa() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return;
+    }
+    let user = std::env::var("USER").unwrap_or_else(|_| "user".into());
+    let dir = std::env::temp_dir().join(format!("omniloop-runtime-{user}"));
+    if std::fs::create_dir_all(&dir).is_ok() {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let _ = std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700));
+        }
+        // SAFETY: called first thing in main, before any other thread exists.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    }
+}
+
 fn main() -> ExitCode {
+    quiet_mesa();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -102,10 +102,15 @@ impl Checker {
         self.finite(format!("{path}.heading_deg"), pose.heading_deg);
         let p = pose.point();
         if !world.is_floor(p) {
+            let noun = if path.ends_with("start") {
+                "start"
+            } else {
+                "place"
+            };
             self.fail(
                 format!("{path}.x_mm"),
                 format!(
-                    "start ({}, {}) mm is outside the floor region",
+                    "{noun} ({}, {}) mm is outside the floor region",
                     pose.x_mm, pose.y_mm
                 ),
             );

@@ -341,3 +341,41 @@ fn golden_images_of_the_render_examples() {
         );
     }
 }
+
+#[test]
+fn auto_picks_a_hardware_gpu_and_passes_over_a_software_rasterizer() {
+    let adapter = match omniloop_sim::render::GpuRenderer::adapter() {
+        Ok(a) => a.get_info(),
+        Err(e) => {
+            if std::env::var_os("OMNILOOP_REQUIRE_GPU").is_some() {
+                panic!("OMNILOOP_REQUIRE_GPU is set but no adapter opened: {e}");
+            }
+            eprintln!("no adapter: auto falls back to the CPU ({e})");
+            let mut said = String::new();
+            let r = Renderer::new(RendererChoice::Auto, |m| said = m.to_string()).unwrap();
+            assert!(
+                !r.is_gpu() && said.contains("using the CPU renderer"),
+                "{said}"
+            );
+            return;
+        }
+    };
+    let mut said = String::new();
+    let r = Renderer::new(RendererChoice::Auto, |m| said = m.to_string()).unwrap();
+    let software = adapter.device_type == wgpu::DeviceType::Cpu;
+    eprintln!(
+        "adapter {} ({:?}): auto chose {}",
+        adapter.name,
+        adapter.device_type,
+        r.name()
+    );
+    assert_eq!(r.is_gpu(), !software, "{}", r.name());
+    if software {
+        assert!(
+            said.contains("software") && said.contains(&adapter.name),
+            "{said}"
+        );
+    } else {
+        assert!(said.is_empty(), "{said}");
+    }
+}
