@@ -96,6 +96,10 @@ pub fn parse_scenario(text: &str, file: &Path, default_name: &str) -> Result<Sce
     if scenario.name.is_empty() {
         scenario.name = default_name.to_string();
     }
+    // An experiment may build part of the world (the corner's corridor, start and goal).
+    if let Some(e) = scenario.experiment.clone() {
+        e.prepare(&mut scenario);
+    }
     // Paths in a scenario are relative to its file.
     if let Some(f) = scenario
         .vision

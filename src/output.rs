@@ -75,7 +75,7 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
         discs: None,
     });
     let mut markers = vec![Marker {
-        at: scenario.robot.start.point(),
+        at: scenario.start().point(),
         radius_mm: scenario.robot.radius_mm,
         rgb: [20, 20, 20],
         label: "start".into(),

@@ -83,7 +83,7 @@ impl Default for RunSpec {
 }
 
 /// A planar pose as written in scenario files.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PoseSpec {
     /// x position.
@@ -114,8 +114,9 @@ impl PoseSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RobotSpec {
-    /// Where it starts, at rest.
-    pub start: PoseSpec,
+    /// Where it starts, at rest (required, unless the experiment places the robot).
+    #[serde(default)]
+    pub start: Option<PoseSpec>,
     /// Disc radius.
     #[serde(default = "default_radius")]
     pub radius_mm: f64,
@@ -203,7 +204,7 @@ impl Scenario {
     /// The robot bodies of the world: the robot under test first, then the others.
     pub fn robot_bodies(&self) -> Vec<omniloop_sim::RobotBodySpec> {
         let mut out = vec![omniloop_sim::RobotBodySpec {
-            start: self.robot.start.isometry(),
+            start: self.start().isometry(),
             radius_mm: self.robot.radius_mm,
             height_mm: self.robot.height_mm,
             accel_limit_mm_s2: self.robot.accel_limit_mm_s2,
@@ -261,7 +262,7 @@ impl Scenario {
     pub fn robot_config(&self, calibrations: Vec<RadialCalibration>) -> RobotConfig {
         let r = &self.robot;
         RobotConfig {
-            start: r.start.isometry(),
+            start: self.start().isometry(),
             body: BodySpec {
                 radius_mm: r.radius_mm,
                 max_speed_mm_s: r.max_speed_mm_s,
@@ -281,6 +282,11 @@ impl Scenario {
     pub fn needs_calibration(&self) -> bool {
         self.control.kind.uses_freespace()
             || self.control.pose_source == omniloop_robot::PoseSource::Localization
+    }
+
+    /// Where the robot under test starts (validation makes sure it is given).
+    pub fn start(&self) -> PoseSpec {
+        self.robot.start.unwrap_or_default()
     }
 
     /// Number of control cycles the run lasts at most.

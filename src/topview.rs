@@ -87,6 +87,22 @@ fn rect_corners(center: Point2<f64>, half: [f64; 2], angle: f64) -> Vec<(f64, f6
         .collect()
 }
 
+/// The outline of a footprint (a circle as a 36-gon).
+fn outline(shape: &SolidShape) -> Vec<(f64, f64)> {
+    match *shape {
+        SolidShape::Box {
+            center_mm,
+            half_extents_mm,
+            angle_rad,
+        } => rect_corners(center_mm, [half_extents_mm.x, half_extents_mm.y], angle_rad),
+        SolidShape::Cylinder {
+            center_mm,
+            radius_mm,
+        } => circle_points(center_mm, radius_mm, 36),
+        SolidShape::Quad { corners_mm } => corners_mm.iter().map(|c| (c.x, c.y)).collect(),
+    }
+}
+
 /// The bounding box of everything drawn, with a margin.
 fn bounds(layout: &Layout, paths: &[PathLayer<'_>], markers: &[Marker]) -> (f64, f64, f64, f64) {
     let mut pts: Vec<(f64, f64)> = Vec::new();
@@ -98,24 +114,7 @@ fn bounds(layout: &Layout, paths: &[PathLayer<'_>], markers: &[Marker]) -> (f64,
         ));
     }
     for s in layout.solids() {
-        match s.shape {
-            SolidShape::Box {
-                center_mm,
-                half_extents_mm,
-                angle_rad,
-            } => pts.extend(rect_corners(
-                center_mm,
-                [half_extents_mm.x, half_extents_mm.y],
-                angle_rad,
-            )),
-            SolidShape::Cylinder {
-                center_mm,
-                radius_mm,
-            } => {
-                pts.push((center_mm.x - radius_mm, center_mm.y - radius_mm));
-                pts.push((center_mm.x + radius_mm, center_mm.y + radius_mm));
-            }
-        }
+        pts.extend(outline(&s.shape));
     }
     for p in paths {
         pts.extend(p.points.iter().map(|q| (q.x, q.y)));
@@ -220,28 +219,14 @@ fn draw_panel(
     for s in layout.solids() {
         let fill = rgb(s.rgb).filled();
         let edge = RGBColor(60, 60, 60).stroke_width(1);
-        match s.shape {
-            SolidShape::Box {
-                center_mm,
-                half_extents_mm,
-                angle_rad,
-            } => {
-                let pts =
-                    rect_corners(center_mm, [half_extents_mm.x, half_extents_mm.y], angle_rad);
-                plot.draw(&Polygon::new(pts.clone(), fill))
-                    .map_err(|e| err(&e))?;
-                let mut closed = pts;
-                closed.push(closed[0]);
-                plot.draw(&PathElement::new(closed, edge))
-                    .map_err(|e| err(&e))?;
-            }
-            SolidShape::Cylinder {
-                center_mm,
-                radius_mm,
-            } => {
-                plot.draw(&Polygon::new(circle_points(center_mm, radius_mm, 36), fill))
-                    .map_err(|e| err(&e))?;
-            }
+        let pts = outline(&s.shape);
+        plot.draw(&Polygon::new(pts.clone(), fill))
+            .map_err(|e| err(&e))?;
+        if !matches!(s.shape, SolidShape::Cylinder { .. }) {
+            let mut closed = pts;
+            closed.push(closed[0]);
+            plot.draw(&PathElement::new(closed, edge))
+                .map_err(|e| err(&e))?;
         }
     }
     for m in &panel.markers {

@@ -185,6 +185,27 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         c.positive(format!("world.floor_rects[{i}].size_mm"), fr.size_mm[0]);
         c.positive(format!("world.floor_rects[{i}].size_mm"), fr.size_mm[1]);
     }
+    for (i, cor) in w.corridors.iter().enumerate() {
+        let p = format!("world.corridors[{i}]");
+        c.positive(format!("{p}.width_mm"), cor.width_mm);
+        c.positive(format!("{p}.wall_thickness_mm"), cor.wall_thickness_mm);
+        c.positive(format!("{p}.wall_height_mm"), cor.wall_height_mm);
+        if cor.points_mm.len() < 2 {
+            c.fail(
+                format!("{p}.points_mm"),
+                format!("needs at least two points (got {})", cor.points_mm.len()),
+            );
+        }
+        for (k, pair) in cor.points_mm.windows(2).enumerate() {
+            let len = (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
+            if !(len.is_finite() && len > 0.0) {
+                c.fail(
+                    format!("{p}.points_mm[{}]", k + 1),
+                    "must differ from the point before it",
+                );
+            }
+        }
+    }
     for (i, wall) in w.walls.iter().enumerate() {
         let p = format!("world.walls[{i}]");
         c.positive(format!("{p}.thickness_mm"), wall.thickness_mm);
@@ -213,7 +234,13 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         "robot.angular_accel_limit_rad_s2",
         rb.angular_accel_limit_rad_s2,
     );
-    c.pose_in_world("robot.start", &rb.start, rb.radius_mm, w);
+    match &rb.start {
+        Some(start) => c.pose_in_world("robot.start", start, rb.radius_mm, w),
+        None => c.fail(
+            "robot.start",
+            "missing: where the robot starts, e.g. start = { x_mm = 0.0, y_mm = 0.0 }",
+        ),
+    }
     for (i, sensor) in rb.sensors.iter().enumerate() {
         check_sensor(&mut c, &format!("robot.sensors[{i}]"), sensor);
         if rb.sensors[..i].iter().any(|o| o.name == sensor.name) {

@@ -26,7 +26,7 @@ fn on_biased_odometry_the_robot_turns_where_its_estimate_says_the_waypoint_is() 
     let goal = s.goal.clone().unwrap();
     let waypoint = Point2::new(goal.waypoints_mm[0][0], goal.waypoints_mm[0][1]);
     let accept_mm = goal.tolerance_mm - goal.estimate_margin_mm;
-    let start = s.robot.start.point();
+    let start = s.start().point();
     let out = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
 
     // The first cycle heading for the second target: where the robot turned.

@@ -2,6 +2,7 @@
 //! pillars. Scenario files embed these types directly; [`Layout::solids`] turns them into the
 //! one list of solid shapes that both the physics world and the renderer use.
 
+use crate::corridor::Corridor;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Point2, Vector2};
 use serde::{Deserialize, Serialize};
@@ -320,6 +321,8 @@ pub struct Layout {
     pub outside_rgb: Rgb,
     /// Colour of the field's white lines.
     pub line_rgb: Rgb,
+    /// Corridors: floor and walls from a centre polyline and a width.
+    pub corridors: Vec<Corridor>,
     /// Free-standing walls.
     pub walls: Vec<Wall>,
     /// Cubes.
@@ -338,6 +341,7 @@ impl Default for Layout {
             floor_rgb: Rgb([30, 130, 55]),
             outside_rgb: Rgb([120, 100, 80]),
             line_rgb: Rgb([240, 240, 240]),
+            corridors: Vec::new(),
             walls: Vec::new(),
             cubes: Vec::new(),
             pillars: Vec::new(),
@@ -347,16 +351,17 @@ impl Default for Layout {
 }
 
 impl Layout {
-    /// Every floor-coloured rectangle: the field's and the extra ones.
+    /// Every floor-coloured rectangle: the field's, the corridors' legs and the extra ones.
     pub fn all_floor_rects(&self) -> Vec<FloorRect> {
         let mut rects: Vec<FloorRect> = self.field.iter().flat_map(|f| f.floor_rects()).collect();
+        rects.extend(self.corridors.iter().flat_map(|c| c.floor_rects()));
         rects.extend(self.floor_rects.iter().cloned());
         rects
     }
 
     /// Is the floor at `p` floor-coloured (inside the floor region)?
     pub fn is_floor(&self, p: Point2<f64>) -> bool {
-        if self.field.is_none() && self.floor_rects.is_empty() {
+        if self.field.is_none() && self.floor_rects.is_empty() && self.corridors.is_empty() {
             return true;
         }
         self.all_floor_rects().iter().any(|r| r.contains(p))
@@ -369,9 +374,10 @@ impl Layout {
         walls
     }
 
-    /// All solid obstacles as boxes and cylinders, in world coordinates.
+    /// All solid obstacles as boxes, quads (corridor walls) and cylinders, in world
+    /// coordinates.
     pub fn solids(&self) -> Vec<Solid> {
-        let mut out = Vec::new();
+        let mut out = crate::corridor::walls(&self.corridors);
         for w in self.all_walls() {
             let a = Vector2::from(w.from_mm);
             let b = Vector2::from(w.to_mm);

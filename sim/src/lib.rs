@@ -3,6 +3,7 @@
 //! omnidirectional robots.
 
 pub mod calibration;
+pub mod corridor;
 pub mod layout;
 pub mod optics;
 pub mod render;
@@ -10,6 +11,7 @@ pub mod sensor;
 pub mod shapes;
 pub mod world;
 
+pub use corridor::Corridor;
 pub use layout::{Board, Cube, FieldSpec, FloorRect, Layout, Pillar, Rgb, Wall};
 pub use render::{RenderError, Renderer, RendererChoice, Scene, SensorNoise};
 pub use sensor::{Sensor, SensorSpec};

@@ -1,5 +1,6 @@
-//! Solid obstacles in the plane (boxes and upright cylinders with a height), with the exact
-//! 2-D distance and ray-cast queries used for clearance and free-space ground truth.
+//! Solid obstacles in the plane (boxes, upright cylinders and convex quadrilaterals with a
+//! height), with the exact 2-D distance and ray-cast queries used for clearance and free-space
+//! ground truth.
 
 use crate::layout::Rgb;
 use nalgebra::{Point2, Vector2};
@@ -23,6 +24,61 @@ pub enum SolidShape {
         /// Radius.
         radius_mm: f64,
     },
+    /// A convex quadrilateral, corners counter-clockwise (a triangle repeats a corner): the
+    /// mitred pieces of corridor walls.
+    Quad {
+        /// Corners.
+        corners_mm: [Point2<f64>; 4],
+    },
+}
+
+/// The edges of a convex polygon as (start, unit direction, length), zero-length ones left out.
+fn edges(
+    corners: &[Point2<f64>; 4],
+) -> impl Iterator<Item = (Point2<f64>, Vector2<f64>, f64)> + '_ {
+    (0..4).filter_map(move |i| {
+        let a = corners[i];
+        let e = corners[(i + 1) % 4] - a;
+        let len = e.norm();
+        (len > 1e-9).then(|| (a, e / len, len))
+    })
+}
+
+/// Signed distance from `p` to a convex polygon (negative inside).
+fn polygon_distance(corners: &[Point2<f64>; 4], p: Point2<f64>) -> f64 {
+    // Outward normal of a counter-clockwise edge with direction u: (u.y, -u.x).
+    let mut inside = f64::NEG_INFINITY;
+    let mut outside = f64::INFINITY;
+    for (a, u, len) in edges(corners) {
+        let ap = p - a;
+        inside = inside.max(ap.x * u.y - ap.y * u.x);
+        let along = ap.dot(&u).clamp(0.0, len);
+        outside = outside.min((ap - u * along).norm());
+    }
+    if inside <= 0.0 { inside } else { outside }
+}
+
+/// Entry distance of a ray into a convex polygon (Cyrus-Beck), for an origin outside.
+fn polygon_ray(corners: &[Point2<f64>; 4], o: Point2<f64>, dir: Vector2<f64>) -> Option<f64> {
+    let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+    for (a, u, _) in edges(corners) {
+        let n = Vector2::new(u.y, -u.x);
+        let num = (o - a).dot(&n);
+        let den = dir.dot(&n);
+        if den.abs() < 1e-15 {
+            if num > 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let t = -num / den;
+        if den < 0.0 {
+            t0 = t0.max(t);
+        } else {
+            t1 = t1.min(t);
+        }
+    }
+    (t0 <= t1 && t1 >= 0.0).then_some(t0.max(0.0))
 }
 
 /// A solid standing on the floor: footprint, vertical extent and colour.
@@ -76,6 +132,7 @@ impl SolidShape {
                 center_mm,
                 radius_mm,
             } => (p - center_mm).norm() - radius_mm,
+            SolidShape::Quad { corners_mm } => polygon_distance(&corners_mm, p),
         }
     }
 
@@ -130,6 +187,7 @@ impl SolidShape {
                 }
                 t
             }
+            SolidShape::Quad { corners_mm } => polygon_ray(&corners_mm, origin, dir)?,
         };
         (t <= max_mm).then_some(t)
     }
@@ -156,6 +214,58 @@ mod tests {
         assert!((b.distance_mm(Point2::new(100.0, 0.0)) + 10.0).abs() < 1e-9);
         let corner = b.distance_mm(Point2::new(123.0, 14.0));
         assert!((corner - 5.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn quads_measure_distance_and_take_rays_like_a_box_of_the_same_shape() {
+        // The unit box above as a quad: 20 along x, 10 along y around (100, 0).
+        let q = SolidShape::Quad {
+            corners_mm: [
+                Point2::new(80.0, -10.0),
+                Point2::new(120.0, -10.0),
+                Point2::new(120.0, 10.0),
+                Point2::new(80.0, 10.0),
+            ],
+        };
+        let b = unit_box();
+        for p in [
+            (50.0, 0.0),
+            (100.0, 30.0),
+            (100.0, 0.0),
+            (123.0, 14.0),
+            (85.0, 7.0),
+        ] {
+            let p = Point2::new(p.0, p.1);
+            assert!((q.distance_mm(p) - b.distance_mm(p)).abs() < 1e-9, "{p}");
+        }
+        for dir in [(1.0, 0.0), (0.0, 1.0), (0.8, 0.6), (0.9, -0.1)] {
+            let d = Vector2::new(dir.0, dir.1).normalize();
+            let (a, c) = (
+                q.ray_cast_mm(Point2::origin(), d, 1e4),
+                b.ray_cast_mm(Point2::origin(), d, 1e4),
+            );
+            assert_eq!(a.is_some(), c.is_some(), "{d}");
+            if let (Some(a), Some(c)) = (a, c) {
+                assert!((a - c).abs() < 1e-9, "{d}: {a} vs {c}");
+            }
+        }
+        // A triangle (a repeated corner).
+        let t = SolidShape::Quad {
+            corners_mm: [
+                Point2::new(0.0, 0.0),
+                Point2::new(100.0, 0.0),
+                Point2::new(0.0, 100.0),
+                Point2::new(0.0, 100.0),
+            ],
+        };
+        assert!((t.distance_mm(Point2::new(100.0, 100.0)) - 50.0 * 2f64.sqrt()).abs() < 1e-9);
+        assert!((t.distance_mm(Point2::new(10.0, 20.0)) + 10.0).abs() < 1e-9);
+        let hit = t.ray_cast_mm(
+            Point2::new(100.0, 100.0),
+            Vector2::new(-1.0, -1.0).normalize(),
+            1e3,
+        );
+        assert!((hit.unwrap() - 50.0 * 2f64.sqrt()).abs() < 1e-9);
     }
 
     #[test]

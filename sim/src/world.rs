@@ -142,6 +142,12 @@ impl World {
                     center_mm,
                     radius_mm,
                 } => ColliderBuilder::ball(radius_mm as Real).translation(vec(center_mm.coords)),
+                SolidShape::Quad { corners_mm } => {
+                    let points: Vec<Vector> = corners_mm.iter().map(|c| vec(c.coords)).collect();
+                    ColliderBuilder::convex_hull(&points).ok_or_else(|| {
+                        SimError::Invalid(format!("degenerate wall piece {corners_mm:?}"))
+                    })?
+                }
             };
             let h = physics.insert_collider(collider.friction(0.0).restitution(0.0), None);
             owners.push((h, Owner::Solid(owners.len())));

@@ -1,32 +1,132 @@
 //! E1, the corridor corner (Sekimori et al., Sect. 5.1, Fig. 7): the robot drives round a
-//! corner to a goal; the turn is measured along the first leg. Its replay, `corner55`, runs the
+//! corner of any angle and width to a goal; the turn is measured along the first leg. Its replay, `corner55`, runs the
 //! 55-degree corner with both avoidance controllers.
 
 use super::{Experiment, Metrics, Replay, ReplayContext, ReplayRun, write_text};
 use crate::record::{Summary, TrajectoryRow};
+use crate::scenario::{PoseSpec, Scenario};
 use crate::simulation::RunOutput;
 use crate::topview::{Marker, Panel, PathLayer, draw_panels};
 use crate::validate::Checker;
 use nalgebra::{Point2, Vector2};
+use omniloop_robot::GoalSpec;
+use omniloop_sim::{Corridor, Rgb};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// The corner (`[experiment.corner]`): the corner point K and the direction of the first leg.
+/// The corner (`[experiment.corner]`): two straight corridor legs meeting at the corner point
+/// K = (0, 0) at `angle_deg`. Leg 1 runs along u1 = +x from the start S = (-leg1_mm, 0) to K,
+/// leg 2 from K along u2 = (cos(180 - angle), sin(180 - angle)) for `leg2_mm`; each leg's floor
+/// is `width_mm` wide, extended half the width past both ends, and walls follow the outline of
+/// their union. The robot starts at rest at S facing +x; the goal lies on leg 2's centre line
+/// `goal_mm` from K (a scenario's own `[robot] start` or `[goal]` take precedence).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct CornerSpec {
-    /// K, where the legs' centre lines meet.
-    pub k_mm: [f64; 2],
-    /// Direction u1 of the first leg.
-    pub leg1_heading_deg: f64,
+    /// Angle between the legs (the direction of travel changes by 180 minus this).
+    pub angle_deg: f64,
+    /// Width of both legs' floor.
+    pub width_mm: f64,
+    /// Length of leg 1, start to K.
+    pub leg1_mm: f64,
+    /// Length of leg 2 from K.
+    pub leg2_mm: f64,
+    /// Distance of the goal from K along leg 2.
+    pub goal_mm: f64,
+    /// Reached when the robot centre is this close to the goal.
+    pub goal_tolerance_mm: f64,
+    /// Wall thickness.
+    pub wall_thickness_mm: f64,
+    /// Wall height.
+    pub wall_height_mm: f64,
+}
+
+impl Default for CornerSpec {
+    /// E1 of the corner paper: 55 degrees, 800 mm wide, legs of 2500 and 2000 mm, the goal
+    /// 1500 mm along leg 2.
+    fn default() -> Self {
+        Self {
+            angle_deg: 55.0,
+            width_mm: 800.0,
+            leg1_mm: 2500.0,
+            leg2_mm: 2000.0,
+            goal_mm: 1500.0,
+            goal_tolerance_mm: 100.0,
+            wall_thickness_mm: 100.0,
+            wall_height_mm: 150.0,
+        }
+    }
 }
 
 impl CornerSpec {
+    /// Unit direction of leg 2.
+    pub fn u2(&self) -> Vector2<f64> {
+        let a = (180.0 - self.angle_deg).to_radians();
+        Vector2::new(a.cos(), a.sin())
+    }
+
+    /// The corridor of the two legs.
+    pub fn corridor(&self) -> Corridor {
+        let end = self.u2() * self.leg2_mm;
+        Corridor {
+            points_mm: vec![[-self.leg1_mm, 0.0], [0.0, 0.0], [end.x, end.y]],
+            width_mm: self.width_mm,
+            wall_thickness_mm: self.wall_thickness_mm,
+            wall_height_mm: self.wall_height_mm,
+            wall_rgb: Rgb([235, 235, 235]),
+        }
+    }
+
+    /// Builds the corner into the scenario: its corridor, and the start and goal unless the
+    /// scenario gives its own.
+    pub(crate) fn prepare(&self, s: &mut Scenario) {
+        s.world.corridors.push(self.corridor());
+        s.robot.start.get_or_insert(PoseSpec {
+            x_mm: -self.leg1_mm,
+            y_mm: 0.0,
+            heading_deg: 0.0,
+        });
+        if s.goal.is_none() {
+            let g = self.u2() * self.goal_mm;
+            s.goal = Some(GoalSpec {
+                waypoints_mm: Vec::new(),
+                x_mm: g.x,
+                y_mm: g.y,
+                tolerance_mm: self.goal_tolerance_mm,
+                estimate_margin_mm: 0.0,
+            });
+        }
+    }
+
     pub(crate) fn validate(&self, c: &mut Checker) {
-        c.finite("experiment.corner.k_mm", self.k_mm[0]);
-        c.finite("experiment.corner.k_mm", self.k_mm[1]);
-        c.finite("experiment.corner.leg1_heading_deg", self.leg1_heading_deg);
+        let p = "experiment.corner";
+        if !(self.angle_deg > 0.0 && self.angle_deg < 180.0) {
+            c.fail(
+                format!("{p}.angle_deg"),
+                format!("must lie in (0, 180) (got {})", self.angle_deg),
+            );
+        }
+        for (key, v) in [
+            ("width_mm", self.width_mm),
+            ("leg1_mm", self.leg1_mm),
+            ("leg2_mm", self.leg2_mm),
+            ("goal_mm", self.goal_mm),
+            ("goal_tolerance_mm", self.goal_tolerance_mm),
+            ("wall_thickness_mm", self.wall_thickness_mm),
+            ("wall_height_mm", self.wall_height_mm),
+        ] {
+            c.positive(format!("{p}.{key}"), v);
+        }
+        if self.goal_mm > self.leg2_mm {
+            c.fail(
+                format!("{p}.goal_mm"),
+                format!(
+                    "must not exceed leg2_mm = {} (got {})",
+                    self.leg2_mm, self.goal_mm
+                ),
+            );
+        }
     }
 }
 
@@ -65,26 +165,14 @@ pub fn corner_metrics(rows: &[TrajectoryRow], k: Vector2<f64>, u1: Vector2<f64>)
     }
 }
 
-/// The procedure (drive to the goal) and metrics of E1.
-pub struct Corner {
-    spec: CornerSpec,
-}
-
-impl Corner {
-    /// E1 for the corner of `spec`.
-    pub fn new(spec: &CornerSpec) -> Self {
-        Self { spec: spec.clone() }
-    }
-}
+/// The procedure (drive to the goal) and metrics of E1, in the corner's frame: K at the
+/// origin, leg 1 along +x.
+pub struct Corner;
 
 impl Experiment for Corner {
     fn metrics(&self, out: &RunOutput) -> Metrics {
-        let a = self.spec.leg1_heading_deg.to_radians();
-        let m = corner_metrics(
-            &out.trajectory,
-            Vector2::from(self.spec.k_mm),
-            Vector2::new(a.cos(), a.sin()),
-        );
+        // The metric frame: K at the origin, leg 1 along +x.
+        let m = corner_metrics(&out.trajectory, Vector2::zeros(), Vector2::x());
         let mut keys = Metrics::new();
         if let Some(onset) = m.turn_onset_mm {
             keys.insert("turn_onset_mm".into(), onset.into());

@@ -76,6 +76,14 @@ impl ExperimentSpec {
         }
     }
 
+    /// Builds what the experiment owns into the scenario, before it is validated.
+    pub(crate) fn prepare(&self, s: &mut Scenario) {
+        match self {
+            Self::Corner(spec) => spec.prepare(s),
+            Self::Places(_) => {}
+        }
+    }
+
     /// The table `omniloop run` prints for a run of this experiment, if it has one.
     pub fn table(&self, summary: &Summary) -> Option<String> {
         match self {
@@ -89,7 +97,7 @@ impl ExperimentSpec {
 pub fn procedure(s: &Scenario) -> Box<dyn Experiment> {
     match &s.experiment {
         None => Box::new(Drive),
-        Some(ExperimentSpec::Corner(spec)) => Box::new(corner::Corner::new(spec)),
+        Some(ExperimentSpec::Corner(_)) => Box::new(corner::Corner),
         Some(ExperimentSpec::Places(spec)) => Box::new(places::Places::new(spec)),
     }
 }

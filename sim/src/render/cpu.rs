@@ -78,6 +78,7 @@ const SECTORS: usize = 256;
 #[derive(Debug, Clone, Copy)]
 enum Prim {
     Box(u32),
+    Quad(u32),
     Cylinder(u32),
 }
 
@@ -100,6 +101,31 @@ struct Sectors {
 fn wrap(a: f32) -> f32 {
     let t = std::f32::consts::TAU;
     a - (a / t).floor() * t
+}
+
+/// Distance from the origin to a convex polygon given relative to it (counter-clockwise), and
+/// whether the origin lies inside.
+fn polygon_distance(corners: &[[f32; 2]]) -> (f32, bool) {
+    let n = corners.len();
+    let mut inside = true;
+    let mut best = f32::INFINITY;
+    for i in 0..n {
+        let a = corners[i];
+        let b = corners[(i + 1) % n];
+        let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = ex * ex + ey * ey;
+        if len2 < 1e-12 {
+            continue;
+        }
+        // The origin is outside when it lies right of a side: cross(e, -a) < 0.
+        if ex * -a[1] - ey * -a[0] < 0.0 {
+            inside = false;
+        }
+        let u = ((-a[0] * ex - a[1] * ey) / len2).clamp(0.0, 1.0);
+        let (px, py) = (a[0] + u * ex, a[1] + u * ey);
+        best = best.min((px * px + py * py).sqrt());
+    }
+    (best, inside)
 }
 
 impl Sectors {
@@ -144,6 +170,30 @@ impl Sectors {
                 half = half.max(da.abs());
             }
             add(Prim::Box(i as u32), d_min, centre, half);
+        }
+        for (i, q) in scene.quads.iter().enumerate() {
+            let corners: Vec<[f32; 2]> = (0..4)
+                .map(|k| {
+                    let c = q.corner(k);
+                    [c[0] - axis[0], c[1] - axis[1]]
+                })
+                .collect();
+            let (d_min, inside) = polygon_distance(&corners);
+            if inside {
+                add(Prim::Quad(i as u32), 0.0, 0.0, std::f32::consts::PI);
+                continue;
+            }
+            let (sx, sy) = corners
+                .iter()
+                .fold((0.0, 0.0), |(x, y), c| (x + c[0], y + c[1]));
+            let centre = sy.atan2(sx);
+            let mut half: f32 = 0.0;
+            for c in &corners {
+                let mut da = c[1].atan2(c[0]) - centre;
+                da -= (da / std::f32::consts::TAU).round() * std::f32::consts::TAU;
+                half = half.max(da.abs());
+            }
+            add(Prim::Quad(i as u32), d_min, centre, half);
         }
         for (i, cyl) in scene.cylinders.iter().enumerate() {
             let [cx, cy, r, _] = cyl.geom;
@@ -256,6 +306,7 @@ fn trace_culled(
         }
         let h = match item.prim {
             Prim::Box(i) => trace::hit_box(scene, &scene.boxes[i as usize], o, d, t_max),
+            Prim::Quad(i) => trace::hit_quad(&scene.quads[i as usize], o, d, t_max),
             Prim::Cylinder(i) => trace::hit_cylinder(&scene.cylinders[i as usize], o, d, t_max),
         };
         if let Some(h) = h {

@@ -5,7 +5,7 @@
 //! image needs more room and are reused otherwise.
 
 use super::RenderError;
-use super::scene::{BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, Scene};
+use super::scene::{BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene};
 use crate::optics::Optics;
 use crate::sensor::Sensor;
 use bytemuck::{Pod, Zeroable};
@@ -145,6 +145,7 @@ pub struct GpuRenderer {
     boards: Storage,
     stripes: Storage,
     rects: Storage,
+    quads: Storage,
     pixels: wgpu::Buffer,
     readback: wgpu::Buffer,
     pixel_capacity: u64,
@@ -215,6 +216,7 @@ impl GpuRenderer {
                 entry(5, ro),
                 entry(6, ro),
                 entry(7, B::Storage { read_only: false }),
+                entry(8, ro),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -248,6 +250,7 @@ impl GpuRenderer {
         let boards = Storage::new(&device, "boards", 4 * 48, STORAGE_RW);
         let stripes = Storage::new(&device, "stripes", 64 * 4, STORAGE_RW);
         let rects = Storage::new(&device, "rects", 8 * 32, STORAGE_RW);
+        let quads = Storage::new(&device, "quads", 16 * 64, STORAGE_RW);
         let (pixels, readback) = Self::pixel_buffers(&device, 256 * 256 * 4);
         Ok(Self {
             device,
@@ -262,6 +265,7 @@ impl GpuRenderer {
             boards,
             stripes,
             rects,
+            quads,
             pixels,
             readback,
             pixel_capacity: 256 * 256 * 4,
@@ -334,6 +338,9 @@ impl GpuRenderer {
             q,
             bytemuck::cast_slice::<FloorRectPrim, u8>(&scene.floor_rects),
         );
+        rebind |= self
+            .quads
+            .write(d, q, bytemuck::cast_slice::<QuadPrim, u8>(&scene.quads));
         if rebind {
             let buffers = [
                 &self.globals,
@@ -344,6 +351,7 @@ impl GpuRenderer {
                 &self.stripes.buffer,
                 &self.rects.buffer,
                 &self.pixels,
+                &self.quads.buffer,
             ];
             let entries: Vec<wgpu::BindGroupEntry> = buffers
                 .iter()

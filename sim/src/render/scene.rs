@@ -1,6 +1,6 @@
 //! The 3-D scene a sensor sees, as flat `f32` arrays laid out for the GPU: the floor (floor
 //! region rectangles, field lines), boxes (walls, cubes, boards), upright cylinders (pillars,
-//! robots, the observer's own body) and the light.
+//! robots, the observer's own body), quadrilateral prisms (mitred wall pieces) and the light.
 //!
 //! Both tracers, the WGSL one and the CPU reference, read exactly these arrays.
 
@@ -29,6 +29,33 @@ pub struct CylinderPrim {
     pub geom: [f32; 4],
     /// r, g, b (0..1), unused.
     pub color: [f32; 4],
+}
+
+/// An upright prism on a convex quadrilateral (corners counter-clockwise; a triangle repeats a
+/// corner), standing on the floor.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct QuadPrim {
+    /// Corners 0 and 1: x0, y0, x1, y1 (mm).
+    pub c01: [f32; 4],
+    /// Corners 2 and 3: x2, y2, x3, y3 (mm).
+    pub c23: [f32; 4],
+    /// Top height (mm), unused, unused, unused.
+    pub z: [f32; 4],
+    /// r, g, b (0..1), unused.
+    pub color: [f32; 4],
+}
+
+impl QuadPrim {
+    /// Corner `i` (0..4).
+    pub fn corner(&self, i: usize) -> [f32; 2] {
+        match i {
+            0 => [self.c01[0], self.c01[1]],
+            1 => [self.c01[2], self.c01[3]],
+            2 => [self.c23[0], self.c23[1]],
+            _ => [self.c23[2], self.c23[3]],
+        }
+    }
 }
 
 /// The stripes of a board: a range of `stripe_edges` and the two alternating colours.
@@ -61,7 +88,7 @@ pub struct SceneGlobals {
     pub field: [f32; 4],
     /// field present (0/1), any floor region (0/1), box count, cylinder count.
     pub flags: [u32; 4],
-    /// floor rectangle count, board count, unused, unused.
+    /// floor rectangle count, board count, quad count, unused.
     pub counts: [u32; 4],
     /// Floor region colour.
     pub floor_rgb: [f32; 4],
@@ -86,6 +113,8 @@ pub struct Scene {
     pub boxes: Vec<BoxPrim>,
     /// Cylinders.
     pub cylinders: Vec<CylinderPrim>,
+    /// Quadrilateral prisms.
+    pub quads: Vec<QuadPrim>,
     /// Boards.
     pub boards: Vec<BoardPrim>,
     /// Stripe edges of all boards, as fractions of the board length.
@@ -124,6 +153,7 @@ impl Scene {
     fn from_solids<'a>(layout: &Layout, solids: impl Iterator<Item = &'a Solid>) -> Self {
         let mut boxes = Vec::new();
         let mut cylinders = Vec::new();
+        let mut quads = Vec::new();
         for s in solids {
             match s.shape {
                 SolidShape::Box {
@@ -155,6 +185,12 @@ impl Scene {
                         radius_mm as f32,
                         s.height_mm as f32,
                     ],
+                    color: rgb4(s.rgb, 0.0),
+                }),
+                SolidShape::Quad { corners_mm: c } => quads.push(QuadPrim {
+                    c01: [c[0].x, c[0].y, c[1].x, c[1].y].map(|v| v as f32),
+                    c23: [c[2].x, c[2].y, c[3].x, c[3].y].map(|v| v as f32),
+                    z: [s.height_mm as f32, 0.0, 0.0, 0.0],
                     color: rgb4(s.rgb, 0.0),
                 }),
             }
@@ -207,7 +243,12 @@ impl Scene {
                 boxes.len() as u32,
                 cylinders.len() as u32,
             ],
-            counts: [floor_rects.len() as u32, boards.len() as u32, 0, 0],
+            counts: [
+                floor_rects.len() as u32,
+                boards.len() as u32,
+                quads.len() as u32,
+                0,
+            ],
             floor_rgb: rgb4(layout.floor_rgb, 0.0),
             outside_rgb: rgb4(layout.outside_rgb, 0.0),
             line_rgb: rgb4(layout.line_rgb, 0.0),
@@ -219,6 +260,7 @@ impl Scene {
             globals,
             boxes,
             cylinders,
+            quads,
             boards,
             stripe_edges,
             floor_rects,

@@ -1,8 +1,8 @@
 //! The scene half of the tracer in `f32`, written to match `trace.wgsl` operation for
-//! operation: floor colouring, box, cylinder and floor intersections, stripe lookup, shading
+//! operation: floor colouring, box, quad, cylinder and floor intersections, stripe lookup, shading
 //! and packing. The CPU renderer calls these; the GPU runs the WGSL twin.
 
-use super::scene::{BoxPrim, CylinderPrim, Scene};
+use super::scene::{BoxPrim, CylinderPrim, QuadPrim, Scene};
 
 /// A 3-vector in `f32`.
 pub type V3 = [f32; 3];
@@ -121,6 +121,58 @@ pub fn hit_box(s: &Scene, b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> 
     Some(Hit { t: tn, n, rgb })
 }
 
+/// Entry of the ray into a quadrilateral prism (Cyrus-Beck over its sides, then the slab from
+/// the floor to its top), if before `t_max`.
+pub fn hit_quad(q: &QuadPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
+    let mut tn = f32::NEG_INFINITY;
+    let mut tf = f32::INFINITY;
+    let mut n = [0.0, 0.0, 0.0];
+    for i in 0..4 {
+        let a = q.corner(i);
+        let b = q.corner((i + 1) % 4);
+        let ex = b[0] - a[0];
+        let ey = b[1] - a[1];
+        let len = (ex * ex + ey * ey).sqrt();
+        if len < 1e-6 {
+            continue;
+        }
+        // Outward normal of a counter-clockwise side.
+        let nx = ey / len;
+        let ny = -ex / len;
+        let num = nx * (o[0] - a[0]) + ny * (o[1] - a[1]);
+        let den = nx * d[0] + ny * d[1];
+        if den.abs() < 1e-12 {
+            if num > 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let t = -num / den;
+        if den < 0.0 {
+            if t > tn {
+                tn = t;
+                n = [nx, ny, 0.0];
+            }
+        } else if t < tf {
+            tf = t;
+        }
+    }
+    let (z0, z1) = slab(o[2], d[2], 0.0, q.z[0])?;
+    if z0 > tn {
+        tn = z0;
+        n = [0.0, 0.0, -d[2].signum()];
+    }
+    tf = tf.min(z1);
+    if tn > tf || tn <= T_EPS || tn >= t_max {
+        return None;
+    }
+    Some(Hit {
+        t: tn,
+        n,
+        rgb: [q.color[0], q.color[1], q.color[2]],
+    })
+}
+
 /// Entry of the ray into an upright cylinder (side or top), if before `t_max`.
 pub fn hit_cylinder(cy: &CylinderPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
     let [cx, cyy, r, top] = cy.geom;
@@ -200,6 +252,12 @@ pub fn trace_all(s: &Scene, o: V3, d: V3) -> u32 {
     let mut t_max = best.map_or(f32::INFINITY, |h| h.t);
     for b in &s.boxes {
         if let Some(h) = hit_box(s, b, o, d, t_max) {
+            t_max = h.t;
+            best = Some(h);
+        }
+    }
+    for q in &s.quads {
+        if let Some(h) = hit_quad(q, o, d, t_max) {
             t_max = h.t;
             best = Some(h);
         }

@@ -1,12 +1,12 @@
 // omniloop catadioptric tracer: one invocation per pixel.
 // camera ray -> mirror (hyperbolic, conical, spherical) or pinhole -> scene (floor, boxes,
-// cylinders, striped boards) -> Lambert shading -> packed RGBA8.
+// quadrilateral prisms, cylinders, striped boards) -> Lambert shading -> packed RGBA8.
 // The scene half matches sim/src/render/trace.rs operation for operation.
 
 struct Globals {
     field: vec4<f32>,       // A1, B, line width, centre circle radius
     flags: vec4<u32>,       // field present, any floor region, box count, cylinder count
-    counts: vec4<u32>,      // floor rect count, board count
+    counts: vec4<u32>,      // floor rect count, board count, quad count
     floor_rgb: vec4<f32>,
     outside_rgb: vec4<f32>,
     line_rgb: vec4<f32>,
@@ -29,6 +29,7 @@ struct BoxPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
 struct CylinderPrim { geom: vec4<f32>, color: vec4<f32> };
 struct BoardPrim { range: vec4<u32>, color_a: vec4<f32>, color_b: vec4<f32> };
 struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32> };
+struct QuadPrim { c01: vec4<f32>, c23: vec4<f32>, z: vec4<f32>, color: vec4<f32> };
 
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(0) @binding(1) var<uniform> sensor: SensorParams;
@@ -38,6 +39,7 @@ struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32> };
 @group(0) @binding(5) var<storage, read> stripe_edges: array<f32>;
 @group(0) @binding(6) var<storage, read> floor_rects: array<FloorRectPrim>;
 @group(0) @binding(7) var<storage, read_write> pixels: array<u32>;
+@group(0) @binding(8) var<storage, read> quads: array<QuadPrim>;
 
 const T_EPS: f32 = 1e-3;
 const BIG: f32 = 3.0e38;
@@ -212,6 +214,48 @@ fn hit_box(b: BoxPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
     return Hit(tn, n, rgb, true);
 }
 
+fn quad_corner(q: QuadPrim, i: u32) -> vec2<f32> {
+    if (i == 0u) { return q.c01.xy; }
+    if (i == 1u) { return q.c01.zw; }
+    if (i == 2u) { return q.c23.xy; }
+    return q.c23.zw;
+}
+
+fn hit_quad(q: QuadPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
+    var tn = -BIG;
+    var tf = BIG;
+    var n = vec3<f32>(0.0);
+    for (var i = 0u; i < 4u; i = i + 1u) {
+        let a = quad_corner(q, i);
+        let b = quad_corner(q, (i + 1u) % 4u);
+        let ex = b.x - a.x;
+        let ey = b.y - a.y;
+        let len = sqrt(ex * ex + ey * ey);
+        if (len < 1e-6) { continue; }
+        // Outward normal of a counter-clockwise side.
+        let nx = ey / len;
+        let ny = -ex / len;
+        let num = nx * (o.x - a.x) + ny * (o.y - a.y);
+        let den = nx * d.x + ny * d.y;
+        if (abs(den) < 1e-12) {
+            if (num > 0.0) { return no_hit(); }
+            continue;
+        }
+        let t = -num / den;
+        if (den < 0.0) {
+            if (t > tn) { tn = t; n = vec3<f32>(nx, ny, 0.0); }
+        } else if (t < tf) {
+            tf = t;
+        }
+    }
+    let sz = slab(o.z, d.z, 0.0, q.z.x);
+    if (sz.z < 0.0) { return no_hit(); }
+    if (sz.x > tn) { tn = sz.x; n = vec3<f32>(0.0, 0.0, -sgn(d.z)); }
+    tf = min(tf, sz.y);
+    if (tn > tf || tn <= T_EPS || tn >= t_max) { return no_hit(); }
+    return Hit(tn, n, q.color.xyz, true);
+}
+
 fn hit_cylinder(cy: CylinderPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
     let r = cy.geom.z;
     let top = cy.geom.w;
@@ -281,6 +325,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = 0u; i < g.flags.z; i = i + 1u) {
         let hb = hit_box(boxes[i], o, d, t_max);
         if (hb.ok) { best = hb; t_max = hb.t; }
+    }
+    for (var i = 0u; i < g.counts.z; i = i + 1u) {
+        let hq = hit_quad(quads[i], o, d, t_max);
+        if (hq.ok) { best = hq; t_max = hq.t; }
     }
     for (var i = 0u; i < g.flags.w; i = i + 1u) {
         let hc = hit_cylinder(cylinders[i], o, d, t_max);
