@@ -237,11 +237,29 @@ const RENDER_EXAMPLES: [&str; 4] = [
     "render_pinhole",
 ];
 
+/// The E1 corner seen from near its inner tip, where mitred wall pieces (quad prisms) stand.
+const CORNER: &str = "corner55_velocity_aware";
+const NEAR_THE_TIP: (f64, f64, f64) = (-650.0, 150.0, 40.0);
+
+/// The render examples at their start, and the corner near its tip.
+fn compared_scenes() -> Vec<(&'static str, Option<Isometry2<f64>>)> {
+    let (x, y, deg) = NEAR_THE_TIP;
+    let mut v: Vec<(&str, Option<Isometry2<f64>>)> =
+        RENDER_EXAMPLES.iter().map(|n| (*n, None)).collect();
+    v.push((CORNER, Some(Isometry2::new(Vector2::new(x, y), deg.to_radians()))));
+    v
+}
+
 #[test]
 fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
-    for name in RENDER_EXAMPLES {
+    for (name, pose) in compared_scenes() {
         let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
-        let world = omniloop_sim::World::new(&s.world, &s.robot_bodies(), 0.002).unwrap();
+        let mut bodies = s.robot_bodies();
+        if let Some(p) = pose {
+            bodies[0].start = p;
+        }
+        assert!(name != CORNER || !Scene::new(&s.world, &[]).quads.is_empty());
+        let world = omniloop_sim::World::new(&s.world, &bodies, 0.002).unwrap();
         let scene = Scene::of_world(&world);
         let pose = world.robot_state(0).pose;
         for spec in &s.robot.sensors {
@@ -279,12 +297,12 @@ fn gpu_and_cpu_renders_agree() {
         return;
     };
     let mut cpu = Renderer::cpu();
-    for name in RENDER_EXAMPLES {
+    for (name, pose) in compared_scenes() {
         let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
         for spec in &s.robot.sensors {
             // Noise on: both draw it from the same seeded generator.
-            let a = render_snapshot(&s, &mut cpu, Some(&spec.name), None, true).unwrap();
-            let b = render_snapshot(&s, &mut gpu, Some(&spec.name), None, true).unwrap();
+            let a = render_snapshot(&s, &mut cpu, Some(&spec.name), pose, true).unwrap();
+            let b = render_snapshot(&s, &mut gpu, Some(&spec.name), pose, true).unwrap();
             let total = (a.width() * a.height()) as usize;
             let close = a
                 .pixels()
