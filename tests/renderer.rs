@@ -246,7 +246,10 @@ fn compared_scenes() -> Vec<(&'static str, Option<Isometry2<f64>>)> {
     let (x, y, deg) = NEAR_THE_TIP;
     let mut v: Vec<(&str, Option<Isometry2<f64>>)> =
         RENDER_EXAMPLES.iter().map(|n| (*n, None)).collect();
-    v.push((CORNER, Some(Isometry2::new(Vector2::new(x, y), deg.to_radians()))));
+    v.push((
+        CORNER,
+        Some(Isometry2::new(Vector2::new(x, y), deg.to_radians())),
+    ));
     v
 }
 

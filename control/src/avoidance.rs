@@ -1,20 +1,14 @@
 //! Obstacle avoidance on detected free space (Sect. 3.2 of the corner paper).
 //!
 //! Both controllers see only what vision gives them ([`Surroundings`]: per direction the free
-//! distance, plus obstacle points, in the robot frame), the robot's current velocity and the
-//! goal relative to the robot.
+//! distance, obstacle points and where the known free space ends, in the robot frame), the
+//! robot's current velocity and the goal relative to the robot.
 //!
 //! - [`GoalDirection`] (the method of the paper's ref. [4], without the velocity term): command
 //!   full speed in the free direction closest to the goal direction, a direction being free when
 //!   the straight strip the robot would sweep along it (its radius plus the margin to each side)
 //!   holds no obstacle point up to the free distance.
-//! - [`VelocityAware`] (Sect. 3.2): for every candidate direction, predict with eq. (8) the path
-//!   from the current velocity toward that direction at the commanded speed until the drive gets
-//!   there and then braking to rest (and, since the next decision comes one control period
-//!   later, also the path that brakes after that period); reject candidates whose paths come
-//!   within the robot radius plus a margin of an obstacle point; head for the
-//!   admissible direction closest to the goal direction, or stop at the acceleration limit when
-//!   there is none and keep looking.
+//! - [`crate::VelocityAware`] (Sect. 3.2, and its extension to chosen speeds): see its module.
 
 use crate::angle::angle_diff;
 use crate::{AccelLimitedDrive, ControlError, Vec2, require_positive};
@@ -32,6 +26,23 @@ pub struct Surroundings<'a> {
     pub range_mm: f64,
     /// Points on obstacles, mm.
     pub obstacle_points: &'a [Vec2],
+    /// Points on the boundary of the surely free space: obstacles placed as near as they may
+    /// be, and where the unknown begins beyond the template, mm.
+    pub clear_points: &'a [Vec2],
+}
+
+/// How the velocity-aware controller sets the speed of its command.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedChoice {
+    /// The paper's Sect. 3.2: every candidate direction at the approach speed
+    /// `min(v_max, sqrt(2 alpha d))`; space beyond the template counts as free.
+    Fixed,
+    /// Candidates are direction and speed; paths must stay inside the surely free space (what
+    /// lies beyond the template is unknown, and a cell judged free may be partly occupied); the
+    /// path that brakes one control period later must be clear too.
+    #[default]
+    Chosen,
 }
 
 /// Settings of the avoidance controllers (`[control.avoidance]` in scenarios).
@@ -50,10 +61,15 @@ pub struct AvoidanceConfig {
     /// Velocity aware: time added to each predicted path beyond reaching the commanded velocity
     /// and covering the stopping distance.
     pub extra_horizon_s: f64,
-    /// Velocity aware: also require the path that brakes one control period from now to be
-    /// clear (guarantees that stopping at the next cycle is safe, at the price of stop-and-go
-    /// near walls).
+    /// Velocity aware, fixed speed: also require the path that brakes one control period from
+    /// now to be clear (guarantees that stopping at the next cycle is safe, at the price of
+    /// stop-and-go near walls; with chosen speeds it is always required).
     pub check_period_brake: bool,
+    /// Velocity aware: how the speed of the command is set.
+    pub speed: SpeedChoice,
+    /// Velocity aware, chosen speeds: the speeds tried in each direction, `v k / speeds` for
+    /// `k = speeds ... 1` of the approach speed `v`.
+    pub speeds: usize,
 }
 
 impl Default for AvoidanceConfig {
@@ -65,6 +81,8 @@ impl Default for AvoidanceConfig {
             prediction_step_s: 0.04,
             extra_horizon_s: 0.0,
             check_period_brake: false,
+            speed: SpeedChoice::Chosen,
+            speeds: 16,
         }
     }
 }
@@ -79,7 +97,7 @@ pub struct Decision {
 }
 
 /// Speed toward a goal `d` mm away: `min(v_max, sqrt(2 alpha d))`, so the robot can stop on it.
-fn approach_speed(max_speed: f64, drive: &AccelLimitedDrive, d: f64) -> f64 {
+pub(crate) fn approach_speed(max_speed: f64, drive: &AccelLimitedDrive, d: f64) -> f64 {
     max_speed.min((2.0 * drive.accel_limit_mm_s2() * d).sqrt())
 }
 
@@ -92,7 +110,7 @@ pub struct GoalDirection {
     radius_mm: f64,
 }
 
-fn check_config(c: &AvoidanceConfig) -> Result<(), ControlError> {
+pub(crate) fn check_config(c: &AvoidanceConfig) -> Result<(), ControlError> {
     if !(c.margin_mm.is_finite() && c.margin_mm >= 0.0) {
         return Err(ControlError::InvalidParameter {
             name: "margin_mm",
@@ -107,6 +125,13 @@ fn check_config(c: &AvoidanceConfig) -> Result<(), ControlError> {
             name: "candidates",
             value: c.candidates as f64,
             rule: "must be >= 4",
+        });
+    }
+    if c.speeds < 1 {
+        return Err(ControlError::InvalidParameter {
+            name: "speeds",
+            value: c.speeds as f64,
+            rule: "must be >= 1",
         });
     }
     if !(c.extra_horizon_s.is_finite() && c.extra_horizon_s >= 0.0) {
@@ -187,191 +212,30 @@ impl GoalDirection {
     }
 }
 
-/// Chooses among directions whose eq. (8) paths stay clear of the obstacles.
-#[derive(Debug, Clone)]
-pub struct VelocityAware {
-    config: AvoidanceConfig,
-    drive: AccelLimitedDrive,
-    max_speed_mm_s: f64,
-    radius_mm: f64,
-    period_s: f64,
-}
-
-impl VelocityAware {
-    /// A controller for a robot of `radius_mm` with top speed `max_speed_mm_s`, deciding every
-    /// `period_s`.
-    pub fn new(
-        config: AvoidanceConfig,
-        drive: AccelLimitedDrive,
-        max_speed_mm_s: f64,
-        radius_mm: f64,
-        period_s: f64,
-    ) -> Result<Self, ControlError> {
-        check_config(&config)?;
-        Ok(Self {
-            config,
-            drive,
-            max_speed_mm_s: require_positive("max_speed_mm_s", max_speed_mm_s)?,
-            radius_mm: require_positive("radius_mm", radius_mm)?,
-            period_s: require_positive("period_s", period_s)?,
-        })
-    }
-
-    /// Whether the paths of a command `v_b` stay clear of `obstacles` (robot frame, robot at
-    /// the origin moving at `v_now`). Two paths are predicted with eq. (8): toward `v_b` until
-    /// the drive gets there, then braking to rest; and toward `v_b` for one control period
-    /// (the time until the next decision), then braking to rest — the path the robot takes if
-    /// the next cycle finds nothing admissible and stops. Each is sampled every
-    /// `prediction_step_s`, and every obstacle must keep the robot radius plus the margin from
-    /// each segment between samples.
-    pub fn path_is_clear(&self, v_now: Vec2, v_b: Vec2, obstacles: &[Vec2]) -> bool {
-        let t_a = self.drive.settle_time_s(v_now, v_b);
-        self.phases_clear(v_now, v_b, t_a, obstacles)
-            && (!self.config.check_period_brake
-                || self.phases_clear(v_now, v_b, self.period_s, obstacles))
-    }
-
-    /// Toward `v_b` for `t1`, then toward rest until stopped (plus `extra_horizon_s`).
-    fn phases_clear(&self, v_now: Vec2, v_b: Vec2, t1: f64, obstacles: &[Vec2]) -> bool {
-        let alpha = self.drive.accel_limit_mm_s2();
-        let p1 = self.drive.displacement(v_now, v_b, t1);
-        let v1 = self.drive.velocity_at(v_now, v_b, t1);
-        let t2 = v1.norm() / alpha + self.config.extra_horizon_s;
-        let horizon = t1 + t2;
-        let dt = self.config.prediction_step_s;
-        let steps = (horizon / dt).ceil().max(1.0) as usize;
-        let clearance = self.radius_mm + self.config.margin_mm;
-        let c2 = clearance * clearance;
-        let at = |t: f64| {
-            if t <= t1 {
-                self.drive.displacement(v_now, v_b, t)
-            } else {
-                p1 + self.drive.displacement(v1, Vec2::zeros(), t - t1)
-            }
-        };
-        let mut a = Vec2::zeros();
-        for k in 1..=steps {
-            let b = at((k as f64 * dt).min(horizon));
-            let ab = b - a;
-            let len2 = ab.norm_squared();
-            for o in obstacles {
-                let u = if len2 > 0.0 {
-                    ((o - a).dot(&ab) / len2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                if (o - (a + ab * u)).norm_squared() < c2 {
-                    return false;
-                }
-            }
-            a = b;
-        }
-        true
-    }
-
-    /// The command for a robot moving at `v_now` (robot frame) with the goal at `goal`.
-    pub fn decide(&self, s: &Surroundings<'_>, goal: Vec2, v_now: Vec2) -> Decision {
-        let d_goal = goal.norm();
-        if d_goal < 1e-6 {
-            return Decision {
-                v_mm_s: Vec2::zeros(),
-                heading_rad: None,
-            };
-        }
-        let goal_rad = goal.y.atan2(goal.x);
-        let speed = approach_speed(self.max_speed_mm_s, &self.drive, d_goal);
-        // Only obstacles the robot could reach within the longest horizon matter.
-        let alpha = self.drive.accel_limit_mm_s2();
-        let top = v_now.norm().max(speed);
-        let longest = (v_now.norm() + speed) / alpha
-            + self.period_s
-            + top / alpha
-            + self.config.extra_horizon_s;
-        let reach = top * longest + self.radius_mm + self.config.margin_mm;
-        let near: Vec<Vec2> = s
-            .obstacle_points
-            .iter()
-            .copied()
-            .filter(|o| o.norm() <= reach)
-            .collect();
-        let k = self.config.candidates;
-        let mut headings: Vec<f64> = (0..k).map(|i| i as f64 * TAU / k as f64).collect();
-        headings.push(goal_rad);
-        headings.sort_by(|a, b| angle_diff(*a, goal_rad).total_cmp(&angle_diff(*b, goal_rad)));
-        // Candidates in order of closeness to the goal direction: the first admissible wins.
-        let chosen = headings.into_iter().find_map(|h| {
-            let v_b = Vec2::new(h.cos(), h.sin()) * speed;
-            self.path_is_clear(v_now, v_b, &near).then_some((h, v_b))
-        });
-        match chosen {
-            Some((h, v_b)) => Decision {
-                v_mm_s: v_b,
-                heading_rad: Some(h),
-            },
-            None => Decision {
-                v_mm_s: Vec2::zeros(),
-                heading_rad: None,
-            },
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn drive() -> AccelLimitedDrive {
-        AccelLimitedDrive::new(300.0, 10.0).unwrap()
-    }
-
-    /// What vision reports with a 1000 mm template.
-    fn surroundings<'a>(dirs: &'a [f64], free: &'a [f64], pts: &'a [Vec2]) -> Surroundings<'a> {
-        Surroundings {
-            direction_rad: dirs,
-            free_mm: free,
-            range_mm: 1000.0,
-            obstacle_points: pts,
-        }
-    }
-
-    /// A wall across the robot's path at x = `x_mm`, seen in 32 directions up to 1000 mm.
-    fn wall_ahead(x_mm: f64) -> (Vec<f64>, Vec<f64>, Vec<Vec2>) {
-        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
-        let mut free = Vec::new();
-        let mut pts = Vec::new();
-        for &a in &dirs {
-            let c = a.cos();
-            let d = if c > 1e-9 { x_mm / c } else { f64::INFINITY };
-            if d < 1000.0 {
-                free.push(d);
-                pts.push(Vec2::new(d * c, d * a.sin()));
-            } else {
-                free.push(1000.0);
-            }
-        }
-        (dirs, free, pts)
-    }
+    use crate::testing::{drive, rush_at_wall, surroundings, wall_ahead};
 
     #[test]
     fn without_the_velocity_term_the_robot_runs_into_the_wall() {
         // Sect. 3.2's point: heading for a free direction without predicting the path, the
         // acceleration limit carries the robot into the wall it is rushing at (the path here
         // ignores the wall, so the centre passes the 510 mm where its edge would touch).
-        let (max_x, _) = rush_at_wall(false, false);
+        let gd = GoalDirection::new(AvoidanceConfig::default(), drive(), 400.0, 90.0).unwrap();
+        let (max_x, _) = rush_at_wall(400.0, |s, goal, _| gd.decide(s, goal).v_mm_s);
         assert!(max_x > 600.0 - 90.0, "max x {max_x}");
     }
 
     #[test]
     fn goal_direction_goes_straight_when_free_and_around_when_not() {
         let c = GoalDirection::new(AvoidanceConfig::default(), drive(), 400.0, 90.0).unwrap();
-        let (dirs, free, pts) = wall_ahead(10_000.0);
-        let s = surroundings(&dirs, &free, &pts);
-        let d = c.decide(&s, Vec2::new(3000.0, 100.0));
+        let w = wall_ahead(10_000.0);
+        let d = c.decide(&surroundings(&w), Vec2::new(3000.0, 100.0));
         assert!((d.heading_rad.unwrap() - 100f64.atan2(3000.0)).abs() < 1e-12);
         assert!((d.v_mm_s.norm() - 400.0).abs() < 1e-9);
-        let (dirs, free, pts) = wall_ahead(500.0);
-        let s = surroundings(&dirs, &free, &pts);
-        let d = c.decide(&s, Vec2::new(3000.0, 100.0));
+        let w = wall_ahead(500.0);
+        let d = c.decide(&surroundings(&w), Vec2::new(3000.0, 100.0));
         let h = d.heading_rad.unwrap();
         // The wall at 500 mm: at 56.25 degrees it is 900 mm away, at 67.5 degrees 1306 mm, and
         // the strip swept along 67.5 degrees keeps 176 mm from the nearest wall point.
@@ -382,76 +246,8 @@ mod tests {
         );
     }
 
-    /// Closed loop against a wall at x = 600: decide every 40 ms on what the wall looks like
-    /// from where the robot is, drive with eq. (8) in 1 ms steps.
-    fn rush_at_wall(velocity_aware: bool, check_period_brake: bool) -> (f64, Vec2) {
-        let cfg = AvoidanceConfig {
-            check_period_brake,
-            ..AvoidanceConfig::default()
-        };
-        let va = VelocityAware::new(cfg.clone(), drive(), 400.0, 90.0, 0.04).unwrap();
-        let gd = GoalDirection::new(cfg, drive(), 400.0, 90.0).unwrap();
-        let mut p = Vec2::zeros();
-        let mut v = Vec2::new(400.0, 0.0);
-        let mut max_x: f64 = f64::MIN;
-        for _ in 0..200 {
-            let (dirs, free, pts) = wall_ahead(600.0 - p.x);
-            let s = surroundings(&dirs, &free, &pts);
-            let goal = Vec2::new(3000.0, 50.0) - p;
-            let cmd = if velocity_aware {
-                va.decide(&s, goal, v).v_mm_s
-            } else {
-                gd.decide(&s, goal).v_mm_s
-            };
-            for _ in 0..40 {
-                let v1 = drive().step(v, cmd, 0.001);
-                p += (v + v1) * 0.0005;
-                v = v1;
-                max_x = max_x.max(p.x);
-            }
-        }
-        (max_x, p)
-    }
-
-    #[test]
-    fn velocity_aware_never_reaches_a_wall_it_rushes_at() {
-        // With the braking path one period ahead checked too, it keeps the margin from the
-        // obstacle points: the centre stays 90 + 30 mm before the wall, up to what slips between
-        // points sampled 11.25 degrees apart (about 1 mm here).
-        let (max_x, p) = rush_at_wall(true, true);
-        assert!(max_x <= 600.0 - 120.0 + 2.0, "max x {max_x}");
-        // The goal lies beyond the wall: it ends at rest in front of it.
-        assert!(p.x > 400.0, "{p:?}");
-        // Without it, braking can start one period (16 mm at 400 mm/s) late: the margin may
-        // shrink by that much, never more, and the robot never touches.
-        let (max_x, p) = rush_at_wall(true, false);
-        assert!(max_x <= 600.0 - 120.0 + 16.0 + 2.0, "max x {max_x}");
-        assert!(max_x < 600.0 - 90.0);
-        assert!(p.x > 400.0, "{p:?}");
-    }
-
-    #[test]
-    fn velocity_aware_stops_when_boxed_in() {
-        let c = VelocityAware::new(AvoidanceConfig::default(), drive(), 400.0, 90.0, 0.04).unwrap();
-        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
-        let pts: Vec<Vec2> = dirs
-            .iter()
-            .map(|a| Vec2::new(a.cos(), a.sin()) * 130.0)
-            .collect();
-        let free = vec![130.0; 32];
-        let s = surroundings(&dirs, &free, &pts);
-        let d = c.decide(&s, Vec2::new(1000.0, 0.0), Vec2::new(100.0, 0.0));
-        assert_eq!(d.v_mm_s, Vec2::zeros());
-        assert!(d.heading_rad.is_none());
-    }
-
     #[test]
     fn bad_settings_are_refused() {
-        let bad = AvoidanceConfig {
-            candidates: 2,
-            ..AvoidanceConfig::default()
-        };
-        assert!(VelocityAware::new(bad, drive(), 400.0, 90.0, 0.04).is_err());
         let bad = AvoidanceConfig {
             margin_mm: -1.0,
             ..AvoidanceConfig::default()

@@ -10,12 +10,16 @@ pub mod avoidance;
 pub mod drive;
 pub mod go_to_goal;
 pub mod odometry;
+#[cfg(test)]
+mod testing;
+pub mod velocity_aware;
 
 pub use angle::{angle_diff, wrap_pi};
-pub use avoidance::{AvoidanceConfig, Decision, GoalDirection, Surroundings, VelocityAware};
+pub use avoidance::{AvoidanceConfig, Decision, GoalDirection, SpeedChoice, Surroundings};
 pub use drive::{AccelLimitedDrive, VelocityCommand};
 pub use go_to_goal::GoToGoal;
 pub use odometry::DeadReckoning;
+pub use velocity_aware::VelocityAware;
 
 /// A 2-D vector in millimetres (positions) or millimetres per second (velocities).
 pub type Vec2 = nalgebra::Vector2<f64>;

@@ -3,8 +3,11 @@
 use crate::RobotError;
 use crate::boundary::BodyCommand;
 use crate::config::{ControllerKind, RobotConfig};
-use nalgebra::Vector2;
-use omniloop_control::{AccelLimitedDrive, GoalDirection, Surroundings, VelocityAware};
+use crate::near_field::NearField;
+use nalgebra::{Isometry2, Vector2};
+use omniloop_control::{
+    AccelLimitedDrive, GoalDirection, SpeedChoice, Surroundings, VelocityAware,
+};
 use omniloop_vision::FreeSpace;
 
 /// What a controller decides on.
@@ -16,6 +19,10 @@ pub struct Situation<'a> {
     pub target_body_mm: Option<Vector2<f64>>,
     /// The measured body velocity.
     pub velocity_body_mm_s: Vector2<f64>,
+    /// The dead-reckoned pose in the odometry frame.
+    pub odometry_pose: Isometry2<f64>,
+    /// Time of the cycle, s.
+    pub t_s: f64,
 }
 
 /// Chooses the command each cycle.
@@ -38,13 +45,16 @@ pub fn build(config: &RobotConfig) -> Result<Box<dyn Controller>, RobotError> {
             b.max_speed_mm_s,
             b.radius_mm,
         )?),
-        ControllerKind::VelocityAware => Box::new(VelocityAware::new(
-            avoid,
-            drive,
-            b.max_speed_mm_s,
-            b.radius_mm,
-            config.control_period_s,
-        )?),
+        ControllerKind::VelocityAware => Box::new(VelocityAwareStack {
+            near: (avoid.speed == SpeedChoice::Chosen).then(|| NearField::new(b.radius_mm)),
+            controller: VelocityAware::new(
+                avoid,
+                drive,
+                b.max_speed_mm_s,
+                b.radius_mm,
+                config.control_period_s,
+            )?,
+        }),
     })
 }
 
@@ -57,37 +67,54 @@ impl Controller for Idle {
     }
 }
 
-/// Runs `f` on the surroundings vision reported and the target, or stops without either.
+/// Runs `f` on the surroundings vision reported (with `clear` as the surely free boundary, when
+/// given) and the target, or stops without either.
 fn with_surroundings(
     s: &Situation<'_>,
+    clear: Option<Vec<Vector2<f64>>>,
     f: impl FnOnce(&Surroundings<'_>, Vector2<f64>) -> Vector2<f64>,
 ) -> BodyCommand {
     let (Some(fs), Some(target)) = (s.freespace, s.target_body_mm) else {
         return BodyCommand::STOP;
     };
-    let points: Vec<Vector2<f64>> = fs.obstacle_points.iter().map(|p| p.coords).collect();
+    let coords = |pts: &[nalgebra::Point2<f64>]| -> Vec<Vector2<f64>> {
+        pts.iter().map(|p| p.coords).collect()
+    };
+    let obstacles = coords(&fs.obstacle_points);
+    let clear = clear.unwrap_or_else(|| coords(&fs.clear_points));
     let surroundings = Surroundings {
         direction_rad: &fs.direction_rad,
         free_mm: &fs.free_mm,
         range_mm: fs.range_mm,
-        obstacle_points: &points,
+        obstacle_points: &obstacles,
+        clear_points: &clear,
     };
     BodyCommand::translate(f(&surroundings, target))
 }
 
 impl Controller for GoalDirection {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        with_surroundings(s, |sur, target| {
+        with_surroundings(s, None, |sur, target| {
             GoalDirection::decide(self, sur, target).v_mm_s
         })
     }
 }
 
-impl Controller for VelocityAware {
+/// The velocity-aware controller; with chosen speeds, its near-field memory supplies where
+/// obstacles are inside the camera's blind zone.
+struct VelocityAwareStack {
+    controller: VelocityAware,
+    near: Option<NearField>,
+}
+
+impl Controller for VelocityAwareStack {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
+        let clear = match (&mut self.near, s.freespace) {
+            (Some(near), Some(fs)) => Some(near.update(fs, &s.odometry_pose, s.t_s)),
+            _ => None,
+        };
         let v = s.velocity_body_mm_s;
-        with_surroundings(s, |sur, target| {
-            VelocityAware::decide(self, sur, target, v).v_mm_s
-        })
+        let c = &self.controller;
+        with_surroundings(s, clear, |sur, target| c.decide(sur, target, v).v_mm_s)
     }
 }

@@ -71,6 +71,12 @@ impl PoseEstimator {
         self.reckoning.update(r.v_body_mm_s, r.omega_rad_s, r.dt_s);
     }
 
+    /// The dead-reckoned pose in the odometry frame (the start at the origin), which fixes do
+    /// not move: the frame of short-term memories.
+    pub fn odometry_pose(&self) -> Isometry2<f64> {
+        self.reckoning.pose()
+    }
+
     /// The measured body velocity.
     pub fn velocity_body_mm_s(&self) -> Vector2<f64> {
         self.reckoning.velocity_body_mm_s()

@@ -21,6 +21,7 @@ pub mod controller;
 pub mod estimates;
 pub mod estimator;
 pub mod mission;
+pub mod near_field;
 pub mod perception;
 pub mod robot;
 

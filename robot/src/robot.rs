@@ -102,6 +102,8 @@ impl Robot {
             freespace: percepts.freespace.as_ref(),
             target_body_mm,
             velocity_body_mm_s,
+            odometry_pose: self.estimator.odometry_pose(),
+            t_s: obs.t_s,
         });
         self.estimator.end_cycle();
         Ok(Outputs {

@@ -109,6 +109,15 @@ pub struct FreeSpace {
     /// How far the template reaches (its outer edge on the floor): a direction free
     /// throughout is free this far, and nothing is known beyond.
     pub range_mm: f64,
+    /// Per direction, how far the floor is free for certain: a cell judged free by eq. (6) may
+    /// still be up to `1 - r_th` obstacle, so an obstacle (or, past the template, the unknown)
+    /// may begin that deep inside the last free cell (computed with the obstacle filling the
+    /// cell's outer part, on the image's pixel areas). The template's inner edge where the first
+    /// ring is blocked.
+    pub clear_mm: Vec<f64>,
+    /// Points on the boundary of that surely free region, robot frame (three a direction,
+    /// like `obstacle_points`).
+    pub clear_points: Vec<Point2<f64>>,
 }
 
 impl FreeSpace {
@@ -324,6 +333,9 @@ impl PolarTemplate {
 pub struct FreeSpaceDetector {
     config: FreeSpaceConfig,
     template: PolarTemplate,
+    /// Per ring, how far it is surely free when eq. (6) judges it free (see
+    /// [`FreeSpace::clear_mm`]).
+    surely_free_mm: Vec<f64>,
     principal_point_px: [f64; 2],
     mask: Mask,
     scratch: Vec<u8>,
@@ -343,7 +355,20 @@ impl FreeSpaceDetector {
             });
         }
         let template = PolarTemplate::new(&config, cal)?;
+        let surely_free_mm = template
+            .edges_px
+            .windows(2)
+            .zip(template.edges_mm.windows(2))
+            .map(|(px, mm)| {
+                let (r0, r1) = (px[0], px[1]);
+                let r = (r1 * r1 - (1.0 - config.r_th) * (r1 * r1 - r0 * r0)).sqrt();
+                cal.floor_distance_mm(r)
+                    .unwrap_or(mm[0])
+                    .clamp(mm[0], mm[1])
+            })
+            .collect();
         Ok(Self {
+            surely_free_mm,
             counts: vec![0; config.rings * config.directions],
             config,
             template,
@@ -417,6 +442,8 @@ impl FreeSpaceDetector {
             ratio,
             obstacle_points: Vec::new(),
             range_mm: self.template.edges_mm[i_n],
+            clear_mm: vec![0.0; j_n],
+            clear_points: Vec::new(),
         };
         let [mx, my] = self.template.mount_mm;
         for j in 0..j_n {
@@ -426,12 +453,21 @@ impl FreeSpaceDetector {
             out.a[j] = a;
             let d = self.template.edges_mm[a];
             out.free_mm[j] = d;
-            if a < i_n {
-                let c = out.direction_rad[j];
-                for phi in [c - 0.5 * dir_step, c, c + 0.5 * dir_step] {
+            let c = out.direction_rad[j];
+            let clear = if a == 0 {
+                d
+            } else {
+                self.surely_free_mm[a - 1]
+            };
+            out.clear_mm[j] = clear;
+            for phi in [c - 0.5 * dir_step, c, c + 0.5 * dir_step] {
+                let u = (phi.cos(), phi.sin());
+                if a < i_n {
                     out.obstacle_points
-                        .push(Point2::new(mx + d * phi.cos(), my + d * phi.sin()));
+                        .push(Point2::new(mx + d * u.0, my + d * u.1));
                 }
+                out.clear_points
+                    .push(Point2::new(mx + clear * u.0, my + clear * u.1));
             }
         }
         Ok(out)

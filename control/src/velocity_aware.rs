@@ -1,0 +1,421 @@
+//! Velocity-aware avoidance (Sect. 3.2 of the corner paper) and its extension to chosen speeds.
+//!
+//! For a candidate command `v_b`, eq. (8) predicts the path from the current velocity: toward
+//! `v_b` until the drive gets there, then braking to rest at alpha. A candidate is admissible
+//! when that path keeps the robot radius plus a margin from every obstacle point.
+//!
+//! - [`SpeedChoice::Fixed`], the paper's: every candidate direction (64 evenly spaced, plus the
+//!   goal direction) at the approach speed `min(v_max, sqrt(2 alpha d))`; the admissible
+//!   direction closest to the goal direction wins; none admissible: brake.
+//! - [`SpeedChoice::Chosen`], ours: a candidate is a direction *and* a speed, judged against
+//!   the boundary of the *surely* free space rather than the obstacle points: space beyond the
+//!   template's outer edge is unknown, not free, and a cell eq. (6) judges free may still be
+//!   partly occupied, so the robot never commits to a speed whose stopping distance exceeds what
+//!   it has seen to be free; an obstacle already within the clearance need only get no nearer.
+//!   And the next decision comes one control period later, so the path that holds `v_b`
+//!   for that period and then brakes must be clear too: whatever the next cycle sees, braking
+//!   stays safe. In each direction the fastest admissible of `speeds` speeds is found (by
+//!   bisection: a path that brakes from a lower speed is shorter); the command maximises
+//!   `v ((1 + cos(delta)) / 2 + 0.5 (1 + cos(gamma)) / 2)`, with `delta` the angle to the goal
+//!   direction and `gamma` the angle to the present course: the speed made good toward the goal,
+//!   so it would rather go round an obstacle briskly than creep at it, and some commitment to
+//!   the course, so it follows a wall round to a goal behind it rather than dithering where both
+//!   ways along the wall look alike. The approach speed caps every speed, so the robot arrives at
+//!   a target at a speed from which it can stop there.
+
+use crate::angle::angle_diff;
+use crate::avoidance::{
+    AvoidanceConfig, Decision, SpeedChoice, Surroundings, approach_speed, check_config,
+};
+use crate::{AccelLimitedDrive, ControlError, Vec2, require_positive};
+use std::f64::consts::TAU;
+
+/// Chooses among commands whose eq. (8) paths stay clear of the obstacles.
+#[derive(Debug, Clone)]
+pub struct VelocityAware {
+    config: AvoidanceConfig,
+    drive: AccelLimitedDrive,
+    max_speed_mm_s: f64,
+    radius_mm: f64,
+    period_s: f64,
+}
+
+/// Chosen speeds: the weight of keeping the present course, against 1 for heading straight
+/// at the goal.
+const COURSE_WEIGHT: f64 = 0.5;
+/// Below this speed the robot has no course to keep.
+const COURSE_MIN_SPEED_MM_S: f64 = 50.0;
+
+/// An obstacle point and the squared distance every predicted path must keep from it.
+#[derive(Debug, Clone, Copy)]
+struct Obstacle {
+    p: Vec2,
+    c2: f64,
+}
+
+const STOP: Decision = Decision {
+    v_mm_s: Vec2::new(0.0, 0.0),
+    heading_rad: None,
+};
+
+impl VelocityAware {
+    /// A controller for a robot of `radius_mm` with top speed `max_speed_mm_s`, deciding every
+    /// `period_s`.
+    pub fn new(
+        config: AvoidanceConfig,
+        drive: AccelLimitedDrive,
+        max_speed_mm_s: f64,
+        radius_mm: f64,
+        period_s: f64,
+    ) -> Result<Self, ControlError> {
+        check_config(&config)?;
+        Ok(Self {
+            config,
+            drive,
+            max_speed_mm_s: require_positive("max_speed_mm_s", max_speed_mm_s)?,
+            radius_mm: require_positive("radius_mm", radius_mm)?,
+            period_s: require_positive("period_s", period_s)?,
+        })
+    }
+
+    /// Whether the paths of a command `v_b` stay clear of `obstacles` (robot frame, robot at
+    /// the origin moving at `v_now`) by the robot radius plus the margin: toward `v_b` until the
+    /// drive gets there, then braking to rest; with `check_period_brake` (always, with chosen
+    /// speeds) also toward `v_b` for one control period, then braking to rest — the path the
+    /// robot takes if the next cycle finds nothing admissible. Each is sampled every
+    /// `prediction_step_s`, and every obstacle must keep the clearance from each segment between
+    /// samples.
+    pub fn path_is_clear(&self, v_now: Vec2, v_b: Vec2, obstacles: &[Vec2]) -> bool {
+        let c = self.radius_mm + self.config.margin_mm;
+        let obstacles: Vec<Obstacle> = obstacles
+            .iter()
+            .map(|&p| Obstacle { p, c2: c * c })
+            .collect();
+        self.clear_among(v_now, v_b, &obstacles)
+    }
+
+    fn clear_among(&self, v_now: Vec2, v_b: Vec2, obstacles: &[Obstacle]) -> bool {
+        let t_a = self.drive.settle_time_s(v_now, v_b);
+        let period_brake =
+            self.config.check_period_brake || self.config.speed == SpeedChoice::Chosen;
+        self.phases_clear(v_now, v_b, t_a, obstacles)
+            && (!period_brake || self.phases_clear(v_now, v_b, self.period_s, obstacles))
+    }
+
+    /// Toward `v_b` for `t1`, then toward rest until stopped (plus `extra_horizon_s`).
+    fn phases_clear(&self, v_now: Vec2, v_b: Vec2, t1: f64, obstacles: &[Obstacle]) -> bool {
+        let alpha = self.drive.accel_limit_mm_s2();
+        let p1 = self.drive.displacement(v_now, v_b, t1);
+        let v1 = self.drive.velocity_at(v_now, v_b, t1);
+        let t2 = v1.norm() / alpha + self.config.extra_horizon_s;
+        let horizon = t1 + t2;
+        let dt = self.config.prediction_step_s;
+        let steps = (horizon / dt).ceil().max(1.0) as usize;
+        let at = |t: f64| {
+            if t <= t1 {
+                self.drive.displacement(v_now, v_b, t)
+            } else {
+                p1 + self.drive.displacement(v1, Vec2::zeros(), t - t1)
+            }
+        };
+        let path: Vec<Vec2> = (0..=steps)
+            .map(|k| at((k as f64 * dt).min(horizon)))
+            .collect();
+        // Only obstacles within reach of the path's bounding box can come too near.
+        let (mut lo, mut hi) = (path[0], path[0]);
+        for p in &path {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        for o in obstacles {
+            let c = o.c2.sqrt();
+            if o.p.x < lo.x - c || o.p.x > hi.x + c || o.p.y < lo.y - c || o.p.y > hi.y + c {
+                continue;
+            }
+            for w in path.windows(2) {
+                let (a, ab) = (w[0], w[1] - w[0]);
+                let len2 = ab.norm_squared();
+                let u = if len2 > 0.0 {
+                    ((o.p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                if (o.p - (a + ab * u)).norm_squared() < o.c2 {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// The obstacles the robot could reach moving at `v_now` or `speed` (those within the
+    /// longest path any candidate can take), each to be kept `clearance` away; with
+    /// `hold_nearer`, one already nearer than that need only get no nearer.
+    fn reachable(
+        &self,
+        points: &[&[Vec2]],
+        v_now: Vec2,
+        speed: f64,
+        clearance: f64,
+        hold_nearer: bool,
+    ) -> Vec<Obstacle> {
+        let alpha = self.drive.accel_limit_mm_s2();
+        let top = v_now.norm().max(speed);
+        let longest = (v_now.norm() + speed) / alpha
+            + self.period_s
+            + top / alpha
+            + self.config.extra_horizon_s;
+        let reach = top * longest + clearance;
+        let c2 = clearance * clearance;
+        points
+            .iter()
+            .flat_map(|p| p.iter())
+            .filter(|o| o.norm() <= reach)
+            .map(|&p| Obstacle {
+                p,
+                c2: if hold_nearer {
+                    c2.min(p.norm_squared())
+                } else {
+                    c2
+                },
+            })
+            .collect()
+    }
+
+    /// Candidate directions, the goal direction among them, nearest the goal direction first.
+    fn headings(&self, goal_rad: f64) -> Vec<f64> {
+        let k = self.config.candidates;
+        let mut headings: Vec<f64> = (0..k).map(|i| i as f64 * TAU / k as f64).collect();
+        headings.push(goal_rad);
+        headings.sort_by(|a, b| angle_diff(*a, goal_rad).total_cmp(&angle_diff(*b, goal_rad)));
+        headings
+    }
+
+    /// The command for a robot moving at `v_now` (robot frame) with the goal at `goal`.
+    pub fn decide(&self, s: &Surroundings<'_>, goal: Vec2, v_now: Vec2) -> Decision {
+        let d_goal = goal.norm();
+        if d_goal < 1e-6 {
+            return STOP;
+        }
+        let goal_rad = goal.y.atan2(goal.x);
+        let speed = approach_speed(self.max_speed_mm_s, &self.drive, d_goal);
+        match self.config.speed {
+            SpeedChoice::Fixed => self.decide_fixed(s, goal_rad, speed, v_now),
+            SpeedChoice::Chosen => self.decide_chosen(s, goal_rad, speed, v_now),
+        }
+    }
+
+    /// The paper's: the admissible direction nearest the goal direction at `speed`.
+    fn decide_fixed(
+        &self,
+        s: &Surroundings<'_>,
+        goal_rad: f64,
+        speed: f64,
+        v_now: Vec2,
+    ) -> Decision {
+        let clearance = self.radius_mm + self.config.margin_mm;
+        let near = self.reachable(&[s.obstacle_points], v_now, speed, clearance, false);
+        self.headings(goal_rad)
+            .into_iter()
+            .find_map(|h| {
+                let v_b = Vec2::new(h.cos(), h.sin()) * speed;
+                self.clear_among(v_now, v_b, &near).then_some(Decision {
+                    v_mm_s: v_b,
+                    heading_rad: Some(h),
+                })
+            })
+            .unwrap_or(STOP)
+    }
+
+    /// Ours: the admissible direction and speed with the most speed made good toward the goal,
+    /// the horizon counting as an obstacle.
+    fn decide_chosen(
+        &self,
+        s: &Surroundings<'_>,
+        goal_rad: f64,
+        speed: f64,
+        v_now: Vec2,
+    ) -> Decision {
+        // An obstacle already nearer than the clearance (the robot was pushed, or vision put it
+        // at the robot's edge for want of knowing better) need only get no nearer, so the robot
+        // can always move away.
+        let clearance = self.radius_mm + self.config.margin_mm;
+        let points = [s.clear_points];
+        let near = self.reachable(&points, v_now, speed, clearance, true);
+        // Moving, the robot keeps to its course unless another serves the goal clearly better,
+        // so that it follows a wall round to a goal behind it instead of dithering where the
+        // goal direction is blocked and both ways along the wall look alike.
+        let course = (v_now.norm() > COURSE_MIN_SPEED_MM_S).then(|| v_now.y.atan2(v_now.x));
+        let mut best: Option<(f64, Decision)> = None;
+        for h in self.headings(goal_rad) {
+            let toward_goal = 0.5 * (1.0 + angle_diff(h, goal_rad).cos());
+            let floor = best.map_or(0.0, |(score, _)| score);
+            // Headings come nearest the goal first: none after this can do better.
+            let bound = toward_goal + course.map_or(0.0, |_| COURSE_WEIGHT);
+            if speed * bound <= floor {
+                break;
+            }
+            let weight = toward_goal
+                + course.map_or(0.0, |c| {
+                    COURSE_WEIGHT * 0.5 * (1.0 + angle_diff(h, c).cos())
+                });
+            let u = Vec2::new(h.cos(), h.sin());
+            if let Some(v) = self.fastest(v_now, u, speed, floor / weight, &near) {
+                best = Some((
+                    v * weight,
+                    Decision {
+                        v_mm_s: u * v,
+                        heading_rad: Some(h),
+                    },
+                ));
+            }
+        }
+        best.map_or(STOP, |(_, d)| d)
+    }
+
+    /// The fastest admissible of the speeds `speed k / n` (k = n ... 1) along `u` that is faster
+    /// than `slowest`, by bisection.
+    fn fastest(
+        &self,
+        v_now: Vec2,
+        u: Vec2,
+        speed: f64,
+        slowest: f64,
+        near: &[Obstacle],
+    ) -> Option<f64> {
+        let n = self.config.speeds;
+        let at = |k: usize| speed * k as f64 / n as f64;
+        let ok = |k: usize| self.clear_among(v_now, u * at(k), near);
+        if ok(n) {
+            return Some(speed);
+        }
+        // The largest k with ok(k), in (lo, hi): ok(hi) is false, and every k <= lo is too slow.
+        let mut lo = (0..n).take_while(|&k| at(k) <= slowest).last().unwrap_or(0);
+        let mut hi = n;
+        let mut found = None;
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if ok(mid) {
+                found = Some(mid);
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        found.map(at)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::{drive, rush_at_wall, surroundings, wall_ahead};
+
+    fn controller(speed: SpeedChoice, check_period_brake: bool, v_max: f64) -> VelocityAware {
+        let cfg = AvoidanceConfig {
+            speed,
+            check_period_brake,
+            ..AvoidanceConfig::default()
+        };
+        VelocityAware::new(cfg, drive(), v_max, 90.0, 0.04).unwrap()
+    }
+
+    #[test]
+    fn the_papers_controller_never_reaches_a_wall_it_rushes_at() {
+        // With the braking path one period ahead checked too, it keeps the margin from the
+        // obstacle points: the centre stays 90 + 30 mm before the wall, up to what slips between
+        // points sampled 11.25 degrees apart (about 1 mm here).
+        let c = controller(SpeedChoice::Fixed, true, 400.0);
+        let (max_x, p) = rush_at_wall(400.0, |s, g, v| c.decide(s, g, v).v_mm_s);
+        assert!(max_x <= 600.0 - 120.0 + 2.0, "max x {max_x}");
+        // The goal lies beyond the wall: it ends at rest in front of it.
+        assert!(p.x > 400.0, "{p:?}");
+        // Without it, braking can start one period (16 mm at 400 mm/s) late: the margin may
+        // shrink by that much, never more, and the robot never touches.
+        let c = controller(SpeedChoice::Fixed, false, 400.0);
+        let (max_x, p) = rush_at_wall(400.0, |s, g, v| c.decide(s, g, v).v_mm_s);
+        assert!(max_x <= 600.0 - 120.0 + 16.0 + 2.0, "max x {max_x}");
+        assert!(max_x < 600.0 - 90.0);
+        assert!(p.x > 400.0, "{p:?}");
+    }
+
+    #[test]
+    fn at_fixed_speed_a_fast_robot_hits_the_wall_and_with_chosen_speeds_it_stops_in_time() {
+        // 1200 mm/s at alpha 300: 2400 mm to stop, more than the 1000 mm the template sees.
+        let fixed = controller(SpeedChoice::Fixed, false, 1200.0);
+        let (max_x, _) = rush_at_wall(1200.0, |s, g, v| fixed.decide(s, g, v).v_mm_s);
+        assert!(max_x > 600.0 - 90.0, "max x {max_x}");
+        // Chosen speeds, from rest: it never goes faster than it can stop within what it sees,
+        // and keeps the margin; the goal lies beyond the wall, so it ends up going along it,
+        // looking for a way round.
+        let chosen = controller(SpeedChoice::Chosen, false, 1200.0);
+        let (max_x, p) = rush_at_wall(0.0, |s, g, v| chosen.decide(s, g, v).v_mm_s);
+        assert!(max_x <= 600.0 - 120.0 + 2.0, "max x {max_x}");
+        assert!(p.x > 350.0 && p.y.abs() > 100.0, "{p:?}");
+    }
+
+    #[test]
+    fn chosen_speeds_never_leave_the_known_free_space() {
+        // Open floor all round: the fastest admissible command must stop within the template
+        // (1000 mm) less the clearance, and the top speed is not admissible.
+        let c = controller(SpeedChoice::Chosen, false, 2000.0);
+        let open = wall_ahead(1e6);
+        let d = c.decide(
+            &surroundings(&open),
+            Vec2::new(10_000.0, 0.0),
+            Vec2::zeros(),
+        );
+        let v = d.v_mm_s.norm();
+        let stop = drive().stopping_distance_mm(v) + v * 0.04;
+        assert!(v > 300.0 && v < 2000.0, "{v}");
+        assert!(stop <= 1000.0 - 120.0, "{v} mm/s stops in {stop} mm");
+        // The paper's controller commands the approach speed regardless.
+        let f = controller(SpeedChoice::Fixed, false, 2000.0);
+        let d = f.decide(
+            &surroundings(&open),
+            Vec2::new(10_000.0, 0.0),
+            Vec2::zeros(),
+        );
+        assert!((d.v_mm_s.norm() - 2000.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn velocity_aware_stops_when_boxed_in() {
+        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
+        let pts: Vec<Vec2> = dirs
+            .iter()
+            .map(|a| Vec2::new(a.cos(), a.sin()) * 130.0)
+            .collect();
+        let free = vec![130.0; 32];
+        let s = Surroundings {
+            direction_rad: &dirs,
+            free_mm: &free,
+            range_mm: 1000.0,
+            obstacle_points: &pts,
+            clear_points: &pts,
+        };
+        for speed in [SpeedChoice::Fixed, SpeedChoice::Chosen] {
+            let d = controller(speed, false, 400.0).decide(
+                &s,
+                Vec2::new(1000.0, 0.0),
+                Vec2::new(100.0, 0.0),
+            );
+            assert_eq!(d.v_mm_s, Vec2::zeros());
+            assert!(d.heading_rad.is_none());
+        }
+    }
+
+    #[test]
+    fn bad_settings_are_refused() {
+        let bad = AvoidanceConfig {
+            candidates: 2,
+            ..AvoidanceConfig::default()
+        };
+        assert!(VelocityAware::new(bad, drive(), 400.0, 90.0, 0.04).is_err());
+        let bad = AvoidanceConfig {
+            speeds: 0,
+            ..AvoidanceConfig::default()
+        };
+        assert!(VelocityAware::new(bad, drive(), 400.0, 90.0, 0.04).is_err());
+    }
+}

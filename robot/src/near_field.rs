@@ -1,0 +1,158 @@
+//! Near-field memory: where obstacles are when they are too near for the camera to see.
+//!
+//! The robot's own body hides the floor within the template's inner edge, so an obstacle nearer
+//! than that only shows as a blocked first ring: vision knows it is there, not how near. A robot
+//! that takes such an obstacle to be at the inner edge creeps into it a little every cycle. It
+//! saw the obstacle, though, while it approached: this memory keeps the surely-free boundary
+//! points of near obstacles in the odometry frame for a few seconds and, in a direction whose
+//! first ring is blocked, hands the controller the remembered points there (moved by the
+//! odometry since), or a point at the body's edge when it remembers none (something is there:
+//! the robot may move along it or away from it, never toward it).
+
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_vision::FreeSpace;
+use std::f64::consts::TAU;
+
+/// Obstacle points farther than this are not remembered (fresh vision covers them), mm.
+const NEAR_MM: f64 = 450.0;
+/// How long a point is remembered, s.
+const KEEP_S: f64 = 2.0;
+/// Points closer than this to a remembered one refresh it instead of adding another, mm.
+const MERGE_MM: f64 = 12.0;
+
+/// Remembered obstacle points near the robot.
+#[derive(Debug, Clone)]
+pub struct NearField {
+    /// Points in the odometry frame, with the time they were last seen.
+    points: Vec<(Point2<f64>, f64)>,
+    radius_mm: f64,
+}
+
+impl NearField {
+    /// A memory for a robot of radius `radius_mm`.
+    pub fn new(radius_mm: f64) -> Self {
+        Self {
+            points: Vec::new(),
+            radius_mm,
+        }
+    }
+
+    /// Takes this cycle's free space, seen at odometry pose `odo` at time `t_s`, and returns
+    /// the boundary of the surely free space (robot frame): fresh where the first ring is clear,
+    /// remembered (or at the body's edge) where it is blocked.
+    pub fn update(&mut self, fs: &FreeSpace, odo: &Isometry2<f64>, t_s: f64) -> Vec<Vector2<f64>> {
+        let here = Point2::from(odo.translation.vector);
+        self.points
+            .retain(|&(p, t)| t_s - t <= KEEP_S && (p - here).norm() <= 2.0 * NEAR_MM);
+        let n = fs.direction_rad.len();
+        let half = 0.5 * TAU / n as f64;
+        let mut out = Vec::with_capacity(3 * n);
+        for j in 0..n {
+            let fresh = &fs.clear_points[3 * j..3 * j + 3];
+            if fs.a[j] > 0 {
+                out.extend(fresh.iter().map(|p| p.coords));
+                // An obstacle, not the template's edge, and near: its point on the direction's
+                // centre line is remembered (the points at the sector's edges stand in for the
+                // whole cell and, at a wall seen at a grazing angle, lie well inside the floor).
+                if fs.free_mm[j] < fs.range_mm && fs.clear_mm[j] <= NEAR_MM {
+                    self.remember(odo * fresh[1], t_s);
+                }
+                continue;
+            }
+            // The first ring is blocked: the obstacle may be nearer than vision can tell.
+            let c = fs.direction_rad[j];
+            let before = out.len();
+            for (p, _) in &self.points {
+                let q = odo.inverse_transform_point(p).coords;
+                let off = (q.y.atan2(q.x) - c + TAU / 2.0).rem_euclid(TAU) - TAU / 2.0;
+                if off.abs() <= half {
+                    out.push(q);
+                }
+            }
+            if out.len() == before {
+                for phi in [c - half, c, c + half] {
+                    out.push(Vector2::new(phi.cos(), phi.sin()) * self.radius_mm);
+                }
+            }
+        }
+        out
+    }
+
+    fn remember(&mut self, p: Point2<f64>, t_s: f64) {
+        match self
+            .points
+            .iter_mut()
+            .find(|(q, _)| (q - p).norm() < MERGE_MM)
+        {
+            Some(entry) => *entry = (p, t_s),
+            None => self.points.push((p, t_s)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Point2;
+
+    /// Free space of 8 directions with a wall at x = `wall` seen as vision would: the first
+    /// ring blocked when the wall is within 200 mm, else surely free to the wall.
+    fn seen(wall: f64) -> FreeSpace {
+        let n = 8;
+        let dirs: Vec<f64> = (0..n).map(|j| j as f64 * TAU / n as f64).collect();
+        let mut fs = FreeSpace {
+            direction_rad: dirs.clone(),
+            range_mm: 1000.0,
+            ..FreeSpace::default()
+        };
+        for &c in &dirs {
+            let d = if c.cos() > 0.1 {
+                wall / c.cos()
+            } else {
+                1000.0
+            };
+            let (a, free, clear) = if d < 200.0 {
+                (0, 200.0, 200.0)
+            } else if d < 1000.0 {
+                (3, d, d)
+            } else {
+                (6, 1000.0, 900.0)
+            };
+            fs.a.push(a);
+            fs.free_mm.push(free);
+            fs.clear_mm.push(clear);
+            let half = 0.5 * TAU / n as f64;
+            for phi in [c - half, c, c + half] {
+                fs.clear_points
+                    .push(Point2::new(clear * phi.cos(), clear * phi.sin()));
+            }
+        }
+        fs
+    }
+
+    #[test]
+    fn a_wall_that_comes_into_the_blind_zone_stays_where_it_was_seen() {
+        let mut m = NearField::new(90.0);
+        // At 300 mm the wall is seen where it is.
+        let ahead = |pts: &[Vector2<f64>]| {
+            pts.iter()
+                .filter(|p| p.y.abs() < 1.0 && p.x > 0.0)
+                .map(|p| p.x)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let out = m.update(&seen(300.0), &Isometry2::identity(), 0.0);
+        assert!((ahead(&out) - 300.0).abs() < 1e-9);
+        // The robot moves 150 mm toward it: vision only says "blocked within 200 mm"; the
+        // memory puts the wall at 150 mm, where it is.
+        let odo = Isometry2::new(Vector2::new(150.0, 0.0), 0.0);
+        let out = m.update(&seen(150.0), &odo, 0.5);
+        assert!((ahead(&out) - 150.0).abs() < 1e-9, "{}", ahead(&out));
+        // Without a memory of it, a blocked first ring means the body's edge.
+        let mut fresh = NearField::new(90.0);
+        let out = fresh.update(&seen(150.0), &odo, 0.5);
+        assert!((ahead(&out) - 90.0).abs() < 1e-9);
+        // Forgotten after a while.
+        let out = m.update(&seen(150.0), &odo, 3.0);
+        assert!((ahead(&out) - 90.0).abs() < 1e-9);
+    }
+}
