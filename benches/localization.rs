@@ -1,15 +1,17 @@
-//! Self-localization stage benchmark: median time of steps 1-7 of Sect. 4 (floor extraction,
-//! boundary, hull, moments, least squares, goal colours) on 256x220 frames of the E2 field.
+//! Self-localization benchmark: median time of one localization at 256x220, on frames of the
+//! E2 field from the six E2 places and from four places near its walls and corners: the
+//! paper's method, and ours in global and tracking mode (prior 100 mm and 5 degrees off).
 //!
 //!     cargo bench --bench localization
 
 mod common;
 
+use nalgebra::{Isometry2, Vector2};
 use omniloop::calibrate::calibrate_sensor;
 use omniloop::experiments::ExperimentSpec;
 use omniloop::load_scenario;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
-use omniloop_vision::FloorLocalizer;
+use omniloop_vision::{FloorLocalizer, LocalizationConfig, LocalizationMethod};
 use std::time::Instant;
 
 fn main() {
@@ -20,43 +22,66 @@ fn main() {
     let cal = calibrate_sensor(spec).expect("calibration");
     let mut renderer = Renderer::cpu();
     let mut noise = SensorNoise::new(1);
-    let Some(ExperimentSpec::Places(spec)) = &s.experiment else {
+    let Some(ExperimentSpec::Places(places)) = &s.experiment else {
         panic!("selfloc_field.toml has [experiment.places]");
     };
-    let places = &spec.places;
+    let mut poses: Vec<Isometry2<f64>> = places.places.iter().map(|p| p.isometry()).collect();
+    for (x, y, deg) in [
+        (-1250.0, -650.0, 0.0),
+        (1200.0, -600.0, -45.0),
+        (-700.0, -600.0, 135.0),
+        (1410.0, 150.0, 90.0),
+    ] {
+        poses.push(Isometry2::new(Vector2::new(x, y), f64::to_radians(deg)));
+    }
     let mut frames = Vec::new();
-    for p in places {
+    for pose in &poses {
         let mut bodies = s.robot_bodies();
-        bodies[0].start = p.isometry();
+        bodies[0].start = *pose;
         let world = World::new(&s.world, &bodies, 0.0025).expect("world");
         let scene = Scene::of_world(&world);
-        frames.push(
-            renderer
-                .render(
-                    &scene,
-                    &sensor,
-                    &world.robot_state(0).pose,
-                    Some(&mut noise),
-                )
-                .expect("render"),
+        let img = renderer
+            .render(&scene, &sensor, pose, Some(&mut noise))
+            .expect("render");
+        let prior = Isometry2::new(
+            pose.translation.vector + Vector2::new(70.7, 70.7),
+            pose.rotation.angle() + 5f64.to_radians(),
+        );
+        frames.push((img, prior));
+    }
+    println!(
+        "{:<44} {:>10} {:>10}",
+        "self-localization (256x220, 10 places)", "median ms", "p90 ms"
+    );
+    for (name, method, tracking) in [
+        ("paper's method (global)", LocalizationMethod::Paper, false),
+        ("robust, global", LocalizationMethod::Robust, false),
+        ("robust, tracking", LocalizationMethod::Robust, true),
+    ] {
+        let config = LocalizationConfig {
+            method,
+            ..s.vision.localization.clone()
+        };
+        let mut loc = FloorLocalizer::new(config, &cal).expect("localizer");
+        let mut t: Vec<f64> = (0..400)
+            .map(|k| {
+                let (img, prior) = &frames[k % frames.len()];
+                let t0 = Instant::now();
+                let r = if tracking {
+                    loc.track(img, prior)
+                } else {
+                    loc.locate(img, None)
+                };
+                std::hint::black_box(r.expect("locate"));
+                t0.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        t.sort_by(f64::total_cmp);
+        println!(
+            "{:<44} {:>10.4} {:>10.4}",
+            name,
+            t[t.len() / 2],
+            t[t.len() * 9 / 10]
         );
     }
-    let mut loc = FloorLocalizer::new(s.vision.localization.clone(), &cal).expect("localizer");
-    for f in &frames {
-        loc.locate(f, None).expect("locate");
-    }
-    let mut t: Vec<f64> = (0..600)
-        .map(|k| {
-            let f = &frames[k % frames.len()];
-            let t0 = Instant::now();
-            std::hint::black_box(loc.locate(f, None).expect("locate"));
-            t0.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    println!(
-        "self-localization (256x220, six E2 places): median {:.4} ms, p90 {:.4} ms",
-        t[t.len() / 2],
-        t[t.len() * 9 / 10]
-    );
 }

@@ -103,6 +103,11 @@ impl PoseEstimator {
         self.last_cycle = self.estimate().map(|e| (e, self.reckoning.pose()));
     }
 
+    /// Whether a fix has set the estimate since the start (or since it was forgotten).
+    pub fn has_fix(&self) -> bool {
+        self.anchored_by_fix
+    }
+
     /// Fixes used and rejected (by the gate) so far.
     pub fn fixes(&self) -> (usize, usize) {
         (self.used, self.rejected)

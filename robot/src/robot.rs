@@ -7,7 +7,7 @@ use crate::controller::{self, Controller, Situation};
 use crate::estimates::{Estimates, Fix};
 use crate::estimator::PoseEstimator;
 use crate::mission::Mission;
-use crate::perception::{self, Percepts, Stage};
+use crate::perception::{self, Belief, Percepts, Stage};
 use nalgebra::Isometry2;
 
 /// The robot's software stack, built once from a [`RobotConfig`].
@@ -75,10 +75,13 @@ impl Robot {
 
     /// One control cycle: perceive, fuse, judge the mission on the estimate, decide.
     pub fn cycle(&mut self, obs: &Observation<'_>) -> Result<Outputs, RobotError> {
-        let prior = self.estimator.estimate();
+        let belief = Belief {
+            pose: self.estimator.estimate(),
+            fixed: self.estimator.has_fix(),
+        };
         let mut percepts = Percepts::default();
         for stage in &mut self.stages {
-            stage.run(obs, prior.as_ref(), &mut percepts)?;
+            stage.run(obs, &belief, &mut percepts)?;
         }
         let fixes: Vec<Fix> = percepts
             .fixes

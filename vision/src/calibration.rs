@@ -124,6 +124,13 @@ impl RadialCalibration {
         Some((b[1] - a[1]) / (b[0] - a[0]))
     }
 
+    /// `f(R)` and `df/dR` at once (one table lookup).
+    pub fn floor_distance_and_slope(&self, r_px: f64) -> Option<(f64, f64)> {
+        let (a, b) = self.segment(r_px)?;
+        let slope = (b[1] - a[1]) / (b[0] - a[0]);
+        Some((a[1] + (r_px - a[0]) * slope, slope))
+    }
+
     /// `R = f^-1(r)`; `None` beyond the table.
     pub fn image_radius_px(&self, r_mm: f64) -> Option<f64> {
         let s = &self.samples;

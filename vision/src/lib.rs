@@ -11,7 +11,8 @@ pub mod mask;
 
 pub use calibration::{HyperbolicFit, RadialCalibration};
 pub use floor_localization::{
-    ColorClass, FieldModel, FloorLocalizer, Localization, LocalizationConfig, PoseEstimate,
+    ColorClass, FieldModel, FloorLocalizer, Localization, LocalizationConfig, LocalizationMethod,
+    LocalizationMode, LocalizationQuality, PoseEstimate,
 };
 pub use freespace::{FreeSpace, FreeSpaceConfig, FreeSpaceDetector, FreeSpaceMethod};
 pub use mask::{FloorColor, Mask};

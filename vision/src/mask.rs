@@ -24,6 +24,13 @@ impl Default for FloorColor {
     }
 }
 
+impl FloorColor {
+    /// Whether a pixel is floor-coloured.
+    pub fn contains(&self, p: [u8; 3]) -> bool {
+        (0..3).all(|k| p[k] >= self.rgb_min[k] && p[k] <= self.rgb_max[k])
+    }
+}
+
 /// A binary image, one byte a pixel (0 or 1), row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mask {
@@ -81,41 +88,67 @@ impl Mask {
         }
     }
 
+    /// The first and last set row of every column (`None` for an empty column), in one pass
+    /// over the rows.
+    pub fn column_extents(&self) -> Vec<Option<(usize, usize)>> {
+        let mut ext: Vec<Option<(usize, usize)>> = vec![None; self.width];
+        for (v, row) in self.data.chunks_exact(self.width.max(1)).enumerate() {
+            for (e, &m) in ext.iter_mut().zip(row) {
+                if m != 0 {
+                    *e = Some(e.map_or((v, v), |(a, _)| (a, v)));
+                }
+            }
+        }
+        ext
+    }
+
     /// Value at `(x, y)`.
     pub fn get(&self, x: usize, y: usize) -> u8 {
         self.data[y * self.width + x]
     }
 
     /// 3x3 erosion (min) or dilation (max), separably, with `scratch` as the intermediate.
-    /// Pixels beyond the border count as the operation's neutral value.
+    /// Pixels beyond the border count as the operation's neutral value. Written as whole-row
+    /// slice operations so that the compiler vectorises them.
     fn filter3(&mut self, scratch: &mut Vec<u8>, dilate: bool) {
+        if dilate {
+            self.filter3_with(scratch, |a, b| a | b);
+        } else {
+            self.filter3_with(scratch, |a, b| a & b);
+        }
+    }
+
+    fn filter3_with(&mut self, scratch: &mut Vec<u8>, op: impl Fn(u8, u8) -> u8 + Copy) {
         let (w, h) = (self.width, self.height);
         scratch.resize(w * h, 0);
-        let op = |a: u8, b: u8| if dilate { a | b } else { a & b };
-        for y in 0..h {
-            let row = &self.data[y * w..(y + 1) * w];
-            let out = &mut scratch[y * w..(y + 1) * w];
-            for x in 0..w {
-                let mut v = row[x];
-                if x > 0 {
-                    v = op(v, row[x - 1]);
+        if w == 0 || h == 0 {
+            return;
+        }
+        // Along rows.
+        for (row, out) in self.data.chunks_exact(w).zip(scratch.chunks_exact_mut(w)) {
+            out.copy_from_slice(row);
+            if w > 1 {
+                for (o, &r) in out[..w - 1].iter_mut().zip(&row[1..]) {
+                    *o = op(*o, r);
                 }
-                if x + 1 < w {
-                    v = op(v, row[x + 1]);
+                for (o, &l) in out[1..].iter_mut().zip(&row[..w - 1]) {
+                    *o = op(*o, l);
                 }
-                out[x] = v;
             }
         }
+        // Along columns.
+        self.data.copy_from_slice(scratch);
         for y in 0..h {
-            for x in 0..w {
-                let mut v = scratch[y * w + x];
-                if y > 0 {
-                    v = op(v, scratch[(y - 1) * w + x]);
+            let out = &mut self.data[y * w..(y + 1) * w];
+            if y > 0 {
+                for (o, &u) in out.iter_mut().zip(&scratch[(y - 1) * w..y * w]) {
+                    *o = op(*o, u);
                 }
-                if y + 1 < h {
-                    v = op(v, scratch[(y + 1) * w + x]);
+            }
+            if y + 1 < h {
+                for (o, &d) in out.iter_mut().zip(&scratch[(y + 1) * w..(y + 2) * w]) {
+                    *o = op(*o, d);
                 }
-                self.data[y * w + x] = v;
             }
         }
     }

@@ -1,11 +1,13 @@
-//! Self-localization from the shape of the floor region (Sect. 4 of the corner paper,
-//! steps 1-7): a full-pose fix, with its half-turn twin when the goals do not tell them apart.
+//! Self-localization from the shape of the floor region (Sect. 4 of the corner paper): a
+//! full-pose fix, with its half-turn twin. Once a fix has set the estimate the stage tracks
+//! (the prediction is the first guess and settles the twin when no goal is seen) and falls
+//! back to the global search when tracking fails; before, it searches globally, the
+//! prediction (the start pose moved by odometry) only choosing between the twins.
 
-use super::{Percepts, Stage, image};
+use super::{Belief, Percepts, Stage, image};
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::estimates::{Measurement, NotFound};
-use nalgebra::Isometry2;
 use omniloop_vision::{FloorLocalizer, Localization, LocalizationConfig, RadialCalibration};
 
 /// Localizes the robot in every frame of one mirror camera.
@@ -40,11 +42,25 @@ impl Stage for FloorLocalizationStage {
     fn run(
         &mut self,
         obs: &Observation<'_>,
-        prior: Option<&Isometry2<f64>>,
+        belief: &Belief,
         out: &mut Percepts,
     ) -> Result<(), RobotError> {
         let img = image(obs, &self.camera, self.name())?;
-        match self.localizer.locate(img, prior)? {
+        let result = match (belief.fixed, &belief.pose) {
+            (true, Some(prior)) => match self.localizer.track(img, prior)? {
+                Localization::NotLocalized(tracking) => {
+                    match self.localizer.locate(img, Some(prior))? {
+                        Localization::NotLocalized(global) => Localization::NotLocalized(format!(
+                            "tracking: {tracking}; global: {global}"
+                        )),
+                        found => found,
+                    }
+                }
+                found => found,
+            },
+            _ => self.localizer.locate(img, belief.pose.as_ref())?,
+        };
+        match result {
             Localization::Localized(e) => out.fixes.push((
                 self.name(),
                 Measurement::Pose {

@@ -1,10 +1,9 @@
 //! Free space in the floor region (Sect. 3.1 of the corner paper): the polar template on the
 //! floor-colour mask, eqs. (5)-(7).
 
-use super::{Percepts, Stage, image};
+use super::{Belief, Percepts, Stage, image};
 use crate::RobotError;
 use crate::boundary::Observation;
-use nalgebra::Isometry2;
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, RadialCalibration};
 
 /// Detects free space in every frame of one mirror camera.
@@ -39,7 +38,7 @@ impl Stage for FreeSpaceStage {
     fn run(
         &mut self,
         obs: &Observation<'_>,
-        _prior: Option<&Isometry2<f64>>,
+        _belief: &Belief,
         out: &mut Percepts,
     ) -> Result<(), RobotError> {
         let img = image(obs, &self.camera, self.name())?;

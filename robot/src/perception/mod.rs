@@ -26,17 +26,26 @@ pub struct Percepts {
     pub not_found: Vec<NotFound>,
 }
 
+/// What the estimator believes at the start of a cycle, as the stages may use it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Belief {
+    /// The predicted pose (world frame), if the robot has one.
+    pub pose: Option<Isometry2<f64>>,
+    /// Whether a fix has set it (not only the start pose and odometry).
+    pub fixed: bool,
+}
+
 /// One perception stage.
 pub trait Stage: Send {
     /// The stage's name in the estimates record.
     fn name(&self) -> &'static str;
     /// The cameras whose frames it reads.
     fn cameras(&self) -> Vec<&str>;
-    /// Processes the cycle's frames; `prior` is the estimator's prediction, when it has one.
+    /// Processes the cycle's frames, knowing what the estimator predicts.
     fn run(
         &mut self,
         obs: &Observation<'_>,
-        prior: Option<&Isometry2<f64>>,
+        belief: &Belief,
         out: &mut Percepts,
     ) -> Result<(), RobotError>;
 }

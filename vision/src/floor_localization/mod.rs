@@ -1,5 +1,7 @@
-//! Self-localization from the shape of the floor region (Sect. 4 of the corner paper).
+//! Self-localization from the shape of the floor region (Sect. 4 of the corner paper), as the
+//! paper publishes it and made to hold anywhere on the field.
 //!
+//! The paper's method ([`LocalizationMethod::Paper`], module `paper`):
 //! 1. Extract the floor by colour and clean it with dilation/erosion.
 //! 2. Boundary points: the outermost floor pixels of every image row (`X_min`, `X_max`) and, so
 //!    that the near-horizontal parts of the boundary are sampled too, of every column.
@@ -17,13 +19,34 @@
 //!    (16)-(18)) and the step repeated until the update is below its thresholds.
 //! 7. The robot's pose in the field frame (eqs. (19)-(21)) has two solutions a half turn apart;
 //!    the blue and yellow goals seen in the image choose between them.
+//!
+//! Near a wall the robot's own body hides the floor up to the wall, so the outermost floor
+//! pixels of many rows are the edge of the body's shadow, not the field's boundary; near a
+//! corner the moments of what is left are a poor first guess, and the fit settles on a wrong
+//! pose it reports with confidence. Ours ([`LocalizationMethod::Robust`], module `robust`)
+//! keeps eq. (15) and its weights, and changes what goes in and what comes out:
+//! - a boundary point is kept only where the floor meets a wall or a goal (the colour just
+//!   beyond the outermost floor pixel), never where it meets an obstacle (a cube, a robot, the
+//!   robot's own body: their silhouettes) or the edge of the analysed image (the useful radius);
+//! - the field model has twelve segments, the paper's six lines with their extents and the goal
+//!   pockets' side walls, and the floor colour ends inside the painted boundary line;
+//! - the first guess is, in tracking mode, the prior pose from the robot's estimator, and in
+//!   global mode the best of several: the field's orientation from the directions of the
+//!   boundary (the rotation that makes the boundary points' coordinates most concentrated) and
+//!   offsets that put a wall the robot sees on each wall of the model, each refined by eq. (15)
+//!   and the one that explains most boundary points kept;
+//! - every estimate carries its quality ([`LocalizationQuality`]), and a decision rule turns a
+//!   pose the boundary cannot support into "not localized" with the reason (see
+//!   [`FloorLocalizer::track`]).
+
+mod paper;
+mod robust;
 
 use crate::VisionError;
 use crate::calibration::RadialCalibration;
-use crate::geometry::{Moments, convex_hull};
 use crate::mask::{FloorColor, Mask};
 use image::RgbaImage;
-use nalgebra::{Isometry2, Matrix3, Point2, Rotation2, Vector2, Vector3};
+use nalgebra::{Isometry2, Point2, Rotation2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -39,6 +62,10 @@ pub struct FieldModel {
     pub b_mm: f64,
     /// Half the width of the goal mouth.
     pub goal_half_width_mm: f64,
+    /// Width of the white line painted along the boundary inside the field: the floor colour
+    /// ends this far inside the goal lines and touchlines (robust method; the paper's model has
+    /// none).
+    pub boundary_line_mm: f64,
 }
 
 impl Default for FieldModel {
@@ -48,6 +75,7 @@ impl Default for FieldModel {
             a2_mm: 1550.0,
             b_mm: 762.5,
             goal_half_width_mm: 250.0,
+            boundary_line_mm: 10.0,
         }
     }
 }
@@ -79,10 +107,25 @@ impl ColorClass {
     }
 }
 
+/// Which localization method runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LocalizationMethod {
+    /// Steps 1-7 of Sect. 4 as published: every outermost floor pixel, the six lines, the
+    /// moments as first guess, no decision rule beyond the steps' own.
+    Paper,
+    /// This project's: boundary points only where the floor meets a wall or a goal, twelve
+    /// segments, a tracking mode and a global search, and a decision rule.
+    #[default]
+    Robust,
+}
+
 /// Settings of the self-localization (`[vision.localization]` in scenarios).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LocalizationConfig {
+    /// The method.
+    pub method: LocalizationMethod,
     /// Floor colour.
     pub floor: FloorColor,
     /// Dilation/erosion passes cleaning the floor mask.
@@ -109,6 +152,21 @@ pub struct LocalizationConfig {
     pub offset_threshold_mm: f64,
     /// Stop when the rotation update is below this (zeta_th).
     pub rotation_threshold_rad: f64,
+    /// Robust method: colour of the walls (a boundary point needs a wall or goal colour just
+    /// beyond the floor).
+    pub wall: ColorClass,
+    /// Robust method, decision rule: the fit's standard deviation of the position (from the
+    /// least squares, along each field axis) must not exceed this, mm.
+    pub max_sigma_mm: f64,
+    /// ... and of the heading, degrees.
+    pub max_sigma_deg: f64,
+    /// ... the share of the boundary points the fitted field explains (within `gate_mm`, or
+    /// two of a far point's pixels) must reach this.
+    pub min_inlier_fraction: f64,
+    /// ... the fit's weighted RMS residual must not exceed this, mm.
+    pub max_rms_mm: f64,
+    /// ... each field axis needs at least this many boundary points on segments across it.
+    pub min_points_per_axis: usize,
 }
 
 impl Default for LocalizationConfig {
@@ -135,28 +193,64 @@ impl Default for LocalizationConfig {
             max_iterations: 30,
             offset_threshold_mm: 0.05,
             rotation_threshold_rad: 1e-5,
+            method: LocalizationMethod::Robust,
+            wall: ColorClass {
+                r: [0.28, 0.40],
+                g: [0.28, 0.40],
+                min_sum: 300,
+            },
+            max_sigma_mm: 20.0,
+            max_sigma_deg: 1.0,
+            min_inlier_fraction: 0.6,
+            max_rms_mm: 25.0,
+            min_points_per_axis: 8,
         }
     }
 }
 
+/// How a pose estimate was made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LocalizationMode {
+    /// From the image alone.
+    Global,
+    /// From a prior pose, the estimator's.
+    Tracking,
+}
+
 /// How good a pose estimate is.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct LocalizationQuality {
     /// Weighted RMS distance of the used boundary points to their lines, mm.
     pub rms_residual_mm: f64,
     /// Boundary points used in the final fit.
     pub points: usize,
-    /// How many of the six lines had points.
+    /// How many of the model's lines (segments) had points.
     pub lines: usize,
+    /// Boundary points used on each of the model's segments (robust method; empty for the
+    /// paper's).
+    pub points_per_line: Vec<usize>,
+    /// Boundary points found (after leaving out silhouettes and the image's edge).
+    pub boundary_points: usize,
+    /// Share of them the fitted field explains (robust method: leaving out those seen past a
+    /// goal post).
+    pub inlier_fraction: f64,
+    /// Standard deviations of the position along the field's x and y axes (mm) and of the
+    /// heading (rad), from the least squares (robust method; NaN for the paper's).
+    pub sigma: [f64; 3],
+    /// Whether the floor ran on past the analysed image's edge somewhere (the region seen is
+    /// cut there, not bounded by the field).
+    pub hull_cut: bool,
     /// Iterations of eqs. (15)-(18).
     pub iterations: usize,
+    /// Global or tracking.
+    pub mode: LocalizationMode,
     /// Whether the goal colours decided between the two solutions (otherwise the prior did, or
     /// nothing did).
     pub resolved_by_goals: bool,
 }
 
 /// A pose of the robot in the field frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PoseEstimate {
     /// The chosen solution.
     pub pose: Isometry2<f64>,
@@ -190,6 +284,38 @@ impl Localization {
 struct BoundaryPoint {
     p: Point2<f64>,
     w: f64,
+}
+
+/// The field's frame in the robot's: where its centre is and where its x axis points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct FieldFrame {
+    centre: Point2<f64>,
+    psi: f64,
+}
+
+impl FieldFrame {
+    /// The frame of a robot pose in the field (the first of eq. (19)'s two solutions).
+    fn of_pose(pose: &Isometry2<f64>) -> Self {
+        // pose_for below inverted: t = -R(theta) g, theta = -psi.
+        let theta = pose.rotation.angle();
+        Self {
+            centre: Point2::from(-(Rotation2::new(-theta) * pose.translation.vector)),
+            psi: -theta,
+        }
+    }
+
+    /// Step 7: the robot in the field frame. The field's x axis is at psi in the robot frame,
+    /// so the robot's heading in the field is -psi, and its position is the field centre's
+    /// position seen from the field: -R(theta) g (eqs. (19)-(21)); the other solution turns the
+    /// field a half turn. (The rotation takes theta modulo 2 pi; its angle() reads back in
+    /// (-pi, pi].)
+    fn poses(&self) -> (Isometry2<f64>, Isometry2<f64>) {
+        let pose_for = |theta: f64| {
+            let t = -(Rotation2::new(theta) * self.centre.coords);
+            Isometry2::new(t, theta)
+        };
+        (pose_for(-self.psi), pose_for(-self.psi + PI))
+    }
 }
 
 /// Localizes a robot from images of one calibrated sensor.
@@ -237,13 +363,56 @@ impl FloorLocalizer {
         &self.config
     }
 
-    /// Localizes from one image; with `prior` (a pose in the field frame, e.g. from odometry)
-    /// the solution nearer to it is taken when no goal is seen.
+    /// Global mode: localizes from one image alone. `hint`, a pose in the field frame (e.g.
+    /// dead reckoning), when given, chooses between the two solutions when no goal is seen.
     pub fn locate(
         &mut self,
         img: &RgbaImage,
-        prior: Option<&Isometry2<f64>>,
+        hint: Option<&Isometry2<f64>>,
     ) -> Result<Localization, VisionError> {
+        if let Some(why) = self.prepare(img)? {
+            return Ok(Localization::NotLocalized(why));
+        }
+        Ok(match self.config.method {
+            LocalizationMethod::Paper => self.locate_paper(img, hint),
+            LocalizationMethod::Robust => self.locate_robust(img, None, hint),
+        })
+    }
+
+    /// Tracking mode: localizes from one image starting from `prior`, the estimator's pose in
+    /// the field frame, which replaces the moments as the first guess and chooses between the
+    /// two solutions when no goal is seen. (With the paper's method, global mode with the prior
+    /// as the hint.)
+    ///
+    /// The robust method's decision rule, in either mode: an estimate is "not localized" (with
+    /// the reason) unless
+    /// - at least 20 boundary points were found where the floor meets a wall or a goal;
+    /// - the fit converged with points on segments across both field axes, at least
+    ///   `min_points_per_axis` on each;
+    /// - it explains at least `min_inlier_fraction` of the boundary points (within `gate_mm`);
+    /// - its weighted RMS residual is at most `max_rms_mm`;
+    /// - the standard deviations of eq. (15)'s least squares (the residual variance times the
+    ///   inverse normal matrix) are at most `max_sigma_mm` along each field axis and
+    ///   `max_sigma_deg` in heading;
+    /// - in global mode, no other first guess converges to a different pose (other than the
+    ///   half-turn twin) that explains nearly as many points.
+    pub fn track(
+        &mut self,
+        img: &RgbaImage,
+        prior: &Isometry2<f64>,
+    ) -> Result<Localization, VisionError> {
+        if self.config.method == LocalizationMethod::Paper {
+            return self.locate(img, Some(prior));
+        }
+        if let Some(why) = self.prepare(img)? {
+            return Ok(Localization::NotLocalized(why));
+        }
+        Ok(self.locate_robust(img, Some(prior), Some(prior)))
+    }
+
+    /// Step 1 on the square around the circle where boundary points are taken; the reason
+    /// there is nothing to localize from, if so.
+    fn prepare(&mut self, img: &RgbaImage) -> Result<Option<String>, VisionError> {
         if img.width() != self.cal.width_px || img.height() != self.cal.height_px {
             return Err(VisionError::InvalidParameter {
                 name: "image width (px)",
@@ -251,84 +420,32 @@ impl FloorLocalizer {
                 rule: "must match the calibrated sensor's image size",
             });
         }
-        // Step 1, on the square around the circle where boundary points are taken.
         let region = self.region();
         self.mask.binarize_region(img, &self.config.floor, region);
         self.mask
             .clean(self.config.morphology_iterations, &mut self.scratch);
         let floor_pixels = self.mask.data.iter().filter(|&&m| m != 0).count();
-        if floor_pixels < self.config.min_floor_pixels {
-            return Ok(Localization::NotLocalized(format!(
+        Ok((floor_pixels < self.config.min_floor_pixels).then(|| {
+            format!(
                 "floor region too small ({floor_pixels} pixels, need {})",
                 self.config.min_floor_pixels
-            )));
-        }
-        // Steps 2 and 4.
-        let points = self.boundary_points();
-        if points.len() < 20 {
-            return Ok(Localization::NotLocalized(format!(
-                "too few floor boundary points ({})",
-                points.len()
-            )));
-        }
-        // Step 3 (on the floor) and 5.
-        let pts: Vec<Point2<f64>> = points.iter().map(|b| b.p).collect();
-        let hull = convex_hull(&pts);
-        let m = Moments::of_polygon(&hull);
-        let f = &self.config.field;
-        let field_area = 4.0 * f.a1_mm * f.b_mm;
-        if hull.len() < 3 || m.m00 < 0.1 * field_area {
-            return Ok(Localization::NotLocalized(format!(
-                "floor region hull too small ({:.2} m^2)",
-                m.m00 * 1e-6
-            )));
-        }
-        let mut centre = m.centroid();
-        let mut psi = m.long_axis();
-        // Step 6.
-        let mut iterations = 0;
-        let mut fit = None;
-        while iterations < self.config.max_iterations {
-            let gate = if iterations < 2 {
-                self.config.gate_initial_mm
-            } else {
-                self.config.gate_mm
-            };
-            let Some((du, dv, zeta, rms, used, lines)) = self.fit_step(&points, centre, psi, gate)
-            else {
-                return Ok(Localization::NotLocalized(
-                    "boundary points do not fix the field (need a goal line or back and a \
-                     touchline)"
-                        .into(),
-                ));
-            };
-            iterations += 1;
-            // Eqs. (16)-(18): move the estimate by the fitted offset and rotation.
-            centre += Rotation2::new(psi) * Vector2::new(du, dv);
-            psi += zeta;
-            fit = Some((rms, used, lines));
-            if du.abs() < self.config.offset_threshold_mm
-                && dv.abs() < self.config.offset_threshold_mm
-                && zeta.abs() < self.config.rotation_threshold_rad
-            {
-                break;
-            }
-        }
-        let (rms, used, lines) = fit.expect("at least one iteration ran");
-        // Step 7: the robot in the field frame. The field's x axis is at psi in the robot
-        // frame, so the robot's heading in the field is -psi, and its position is the field
-        // centre's position seen from the field: -R(theta) g.
-        // (The rotation takes theta modulo 2 pi; its angle() reads back in (-pi, pi].)
-        let pose_for = |theta: f64| {
-            let t = -(Rotation2::new(theta) * centre.coords);
-            Isometry2::new(t, theta)
-        };
-        let a = pose_for(-psi);
-        let b = pose_for(-psi + PI);
-        let (chosen, other, by_goals) = match self.goal_vote(img, &a, &b) {
+            )
+        }))
+    }
+
+    /// The two solutions of a fitted field frame, the chosen one first: the goals' colours
+    /// decide when seen, else the solution nearer `hint`, else the first.
+    fn choose(
+        &self,
+        img: &RgbaImage,
+        frame: &FieldFrame,
+        hint: Option<&Isometry2<f64>>,
+    ) -> (Isometry2<f64>, Isometry2<f64>, bool) {
+        let (a, b) = frame.poses();
+        match self.goal_vote(img, &a, &b) {
             Some(true) => (a, b, true),
             Some(false) => (b, a, true),
-            None => match prior {
+            None => match hint {
                 Some(p) => {
                     let d =
                         |q: &Isometry2<f64>| (q.translation.vector - p.translation.vector).norm();
@@ -340,18 +457,7 @@ impl FloorLocalizer {
                 }
                 None => (a, b, false),
             },
-        };
-        Ok(Localization::Localized(PoseEstimate {
-            pose: chosen,
-            alternative: other,
-            quality: LocalizationQuality {
-                rms_residual_mm: rms,
-                points: used,
-                lines,
-                iterations,
-                resolved_by_goals: by_goals,
-            },
-        }))
+        }
     }
 
     /// The image region `[x0, y0, x1, y1)` around the circle of usable boundary points, with
@@ -368,130 +474,6 @@ impl FloorLocalizer {
         ]
     }
 
-    /// Outermost floor pixels of each row and column, converted to the floor.
-    fn boundary_points(&self) -> Vec<BoundaryPoint> {
-        let (w, h) = (self.mask.width, self.mask.height);
-        let r_max = self.config.max_radius_frac * self.cal.horizon_px;
-        let [x0, y0, _, _] = self.region();
-        // Mask pixel (u, v) is image pixel (u + x0, v + y0).
-        let cx = self.cal.principal_point_px[0] - x0 as f64;
-        let cy = self.cal.principal_point_px[1] - y0 as f64;
-        let mut out = Vec::with_capacity(2 * (w + h));
-        let mut push = |u: f64, v: f64| {
-            // (u, v) in continuous mask coordinates (pixel k spans [k, k + 1)).
-            let x = u - cx;
-            let y = cy - v;
-            let big_r = x.hypot(y);
-            if big_r > r_max {
-                return;
-            }
-            if let (Some(p), Some(slope)) = (
-                self.cal.image_to_floor(x, y),
-                self.cal.slope_mm_per_px(big_r),
-            ) {
-                out.push(BoundaryPoint {
-                    p,
-                    w: 1.0 / (slope * slope).max(1e-9),
-                });
-            }
-        };
-        for v in 1..h.saturating_sub(1) {
-            let row = &self.mask.data[v * w..(v + 1) * w];
-            if let (Some(a), Some(b)) = (
-                row.iter().position(|&m| m != 0),
-                row.iter().rposition(|&m| m != 0),
-            ) {
-                // A run touching the region's edge continues beyond it: not a boundary (and
-                // beyond the usable radius anyway, unless the region is the image's edge).
-                if a > 0 {
-                    push(a as f64, v as f64 + 0.5);
-                }
-                if b + 1 < w {
-                    push(b as f64 + 1.0, v as f64 + 0.5);
-                }
-            }
-        }
-        for u in 1..w.saturating_sub(1) {
-            let first = (0..h).find(|&v| self.mask.data[v * w + u] != 0);
-            let last = (0..h).rev().find(|&v| self.mask.data[v * w + u] != 0);
-            if let (Some(a), Some(b)) = (first, last) {
-                if a > 0 {
-                    push(u as f64 + 0.5, a as f64);
-                }
-                if b + 1 < h {
-                    push(u as f64 + 0.5, b as f64 + 1.0);
-                }
-            }
-        }
-        out
-    }
-
-    /// One step of eq. (15): assign points to lines in the current frame and solve the
-    /// linearised weighted least squares for the field's offset (du, dv) and rotation zeta.
-    #[allow(clippy::type_complexity)]
-    fn fit_step(
-        &self,
-        points: &[BoundaryPoint],
-        centre: Point2<f64>,
-        psi: f64,
-        gate: f64,
-    ) -> Option<(f64, f64, f64, f64, usize, usize)> {
-        let f = &self.config.field;
-        let (s, c) = psi.sin_cos();
-        let mut ata = Matrix3::<f64>::zeros();
-        let mut atb = Vector3::<f64>::zeros();
-        let mut seen = [false; 6];
-        let mut used = 0;
-        let mut sum_w = 0.0;
-        let mut sum_wd2 = 0.0;
-        for bp in points {
-            // Eqs. (13)-(14).
-            let dx = bp.p.x - centre.x;
-            let dy = bp.p.y - centre.y;
-            let x = dx * c + dy * s;
-            let y = -dx * s + dy * c;
-            // Candidate lines as (index, signed distance, jacobian wrt (u, v, zeta)):
-            // residual r = d0 + J . (u, v, zeta), linearised for small zeta. Each line takes
-            // points along its extent plus `ends` beyond, so that near a corner both lines are
-            // candidates and the nearer wins.
-            let g = f.goal_half_width_mm;
-            let ends = 0.5 * gate;
-            let mut best: Option<(usize, f64, Vector3<f64>)> = None;
-            let mut consider = |k: usize, d0: f64, j: Vector3<f64>| {
-                if d0.abs() <= gate && best.is_none_or(|b| d0.abs() < b.1.abs()) {
-                    best = Some((k, d0, j));
-                }
-            };
-            if y.abs() <= g + ends {
-                consider(0, x - f.a2_mm, Vector3::new(-1.0, 0.0, y));
-                consider(3, -x - f.a2_mm, Vector3::new(1.0, 0.0, -y));
-            }
-            if y.abs() >= g - ends {
-                consider(1, x - f.a1_mm, Vector3::new(-1.0, 0.0, y));
-                consider(4, -x - f.a1_mm, Vector3::new(1.0, 0.0, -y));
-            }
-            if x.abs() <= f.a1_mm + ends {
-                consider(2, y - f.b_mm, Vector3::new(0.0, -1.0, -x));
-                consider(5, -y - f.b_mm, Vector3::new(0.0, 1.0, x));
-            }
-            let Some((k, d0, j)) = best else { continue };
-            seen[k] = true;
-            used += 1;
-            ata += j * j.transpose() * bp.w;
-            atb -= j * (d0 * bp.w);
-            sum_w += bp.w;
-            sum_wd2 += bp.w * d0 * d0;
-        }
-        let lines = seen.iter().filter(|&&s| s).count();
-        let along_x = seen[0] || seen[1] || seen[3] || seen[4];
-        let along_y = seen[2] || seen[5];
-        if !(along_x && along_y) || used < 10 {
-            return None;
-        }
-        let sol = ata.lu().solve(&atb)?;
-        Some((sol.x, sol.y, sol.z, (sum_wd2 / sum_w).sqrt(), used, lines))
-    }
-
     /// Which solution the goal colours support: `Some(true)` for `a`, `Some(false)` for `b`,
     /// `None` when no goal is seen or the vote is even.
     fn goal_vote(&self, img: &RgbaImage, a: &Isometry2<f64>, b: &Isometry2<f64>) -> Option<bool> {
@@ -505,10 +487,15 @@ impl FloorLocalizer {
         let u1 = ((cx + r_max).ceil() as i64).min(w);
         let v0 = (cy - r_max).floor().max(0.0) as i64;
         let v1 = ((cy + r_max).ceil() as i64).min(h);
-        for v in v0..v1 {
-            for u in u0..u1 {
-                let p = img.get_pixel(u as u32, v as u32);
-                let rgb = [p.0[0], p.0[1], p.0[2]];
+        // Every other pixel of every other row (each standing for four): the goals' directions
+        // are averages over many pixels.
+        let raw = img.as_raw();
+        let stride = w as usize * 4;
+        for v in (v0..v1).step_by(2) {
+            let row =
+                &raw[v as usize * stride + u0 as usize * 4..v as usize * stride + u1 as usize * 4];
+            for (u, p) in (u0..u1).step_by(2).zip(row.chunks(8)) {
+                let rgb = [p[0], p[1], p[2]];
                 let class = if self.config.goal_pos_x.contains(rgb) {
                     0
                 } else if self.config.goal_neg_x.contains(rgb) {
@@ -524,7 +511,7 @@ impl FloorLocalizer {
                 }
                 sums[class].0 += x / r;
                 sums[class].1 += y / r;
-                sums[class].2 += 1;
+                sums[class].2 += 4;
             }
         }
         let a2 = self.config.field.a2_mm;
@@ -559,15 +546,18 @@ mod tests {
     use super::*;
     use crate::calibration::tests::table as paper_calibration;
     use image::Rgba;
+    use nalgebra::Vector2;
 
     const GREEN: Rgba<u8> = Rgba([30, 130, 55, 255]);
     const BROWN: Rgba<u8> = Rgba([120, 100, 80, 255]);
     const YELLOW: Rgba<u8> = Rgba([235, 200, 20, 255]);
     const BLUE: Rgba<u8> = Rgba([25, 60, 220, 255]);
     const GREY: Rgba<u8> = Rgba([40, 40, 40, 255]);
+    const WHITE: Rgba<u8> = Rgba([235, 235, 235, 255]);
 
     /// A synthetic image of the field seen from `pose` (field frame) through the paper's
-    /// f(R): floor inside the outline, goal colour just beyond the goal backs, a cube.
+    /// f(R): floor inside the outline, goal colour just beyond the goal backs, a white wall
+    /// band around the rest, a cube.
     fn field_image(pose: Isometry2<f64>, cube: Option<Point2<f64>>) -> RgbaImage {
         let cal = paper_calibration();
         let f = FieldModel::default();
@@ -584,6 +574,8 @@ mod tests {
                 *px = GREEN;
             } else if w.x.abs() <= f.a2_mm + 400.0 && w.y.abs() <= f.goal_half_width_mm + 60.0 {
                 *px = if w.x > 0.0 { YELLOW } else { BLUE };
+            } else if w.x.abs() <= f.a1_mm + 100.0 && w.y.abs() <= f.b_mm + 100.0 {
+                *px = WHITE;
             }
             if cube.is_some_and(|c| (w.x - c.x).abs() <= 65.0 && (w.y - c.y).abs() <= 65.0) {
                 *px = GREY;
