@@ -53,29 +53,42 @@ fn main() {
         "{:<44} {:>10} {:>10}",
         "self-localization (256x220, 10 places)", "median ms", "p90 ms"
     );
-    for (name, method, tracking) in [
+    let configs = [
         ("paper's method (global)", LocalizationMethod::Paper, false),
         ("robust, global", LocalizationMethod::Robust, false),
         ("robust, tracking", LocalizationMethod::Robust, true),
-    ] {
-        let config = LocalizationConfig {
-            method,
-            ..s.vision.localization.clone()
-        };
-        let mut loc = FloorLocalizer::new(config, &cal).expect("localizer");
-        let mut t: Vec<f64> = (0..400)
-            .map(|k| {
-                let (img, prior) = &frames[k % frames.len()];
-                let t0 = Instant::now();
-                let r = if tracking {
-                    loc.track(img, prior)
-                } else {
-                    loc.locate(img, None)
-                };
-                std::hint::black_box(r.expect("locate"));
-                t0.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
+    ];
+    let mut localizers: Vec<FloorLocalizer> = configs
+        .iter()
+        .map(|&(_, method, _)| {
+            let config = LocalizationConfig {
+                method,
+                ..s.vision.localization.clone()
+            };
+            FloorLocalizer::new(config, &cal).expect("localizer")
+        })
+        .collect();
+    // The configurations take turns frame by frame, so that a shared machine's changing load
+    // falls on all of them alike.
+    let rounds = std::env::var("OMNILOOP_BENCH_ROUNDS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(600);
+    let mut times = vec![Vec::with_capacity(rounds); configs.len()];
+    for k in 0..rounds {
+        let (img, prior) = &frames[k % frames.len()];
+        for ((loc, &(_, _, tracking)), t) in localizers.iter_mut().zip(&configs).zip(&mut times) {
+            let t0 = Instant::now();
+            let r = if tracking {
+                loc.track(img, prior)
+            } else {
+                loc.locate(img, None)
+            };
+            std::hint::black_box(r.expect("locate"));
+            t.push(t0.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    for ((name, _, _), t) in configs.iter().zip(&mut times) {
         t.sort_by(f64::total_cmp);
         println!(
             "{:<44} {:>10.4} {:>10.4}",

@@ -69,7 +69,14 @@ impl Mask {
         self.width = w;
         self.height = h;
         self.data.resize(w * h, 0);
-        let (lo, hi) = (floor.rgb_min, floor.rgb_max);
+        let lo = floor.rgb_min;
+        // An empty range (min > max) holds nothing: span 0 would still hold p == lo.
+        let empty = (0..3).any(|k| floor.rgb_min[k] > floor.rgb_max[k]);
+        if empty {
+            self.data.iter_mut().for_each(|m| *m = 0);
+            return;
+        }
+        let span = [0, 1, 2].map(|k| floor.rgb_max[k] - floor.rgb_min[k]);
         let raw = img.as_raw();
         let stride = img.width() as usize * 4;
         for y in 0..h {
@@ -78,28 +85,37 @@ impl Mask {
                 .iter_mut()
                 .zip(row.chunks_exact(4))
             {
-                *o = (p[0] >= lo[0]
-                    && p[0] <= hi[0]
-                    && p[1] >= lo[1]
-                    && p[1] <= hi[1]
-                    && p[2] >= lo[2]
-                    && p[2] <= hi[2]) as u8;
+                // Unsigned wrap-around: `p - lo <= hi - lo` holds exactly when
+                // `lo <= p <= hi`.
+                *o = ((p[0].wrapping_sub(lo[0]) <= span[0])
+                    & (p[1].wrapping_sub(lo[1]) <= span[1])
+                    & (p[2].wrapping_sub(lo[2]) <= span[2])) as u8;
             }
         }
     }
 
     /// The first and last set row of every column (`None` for an empty column), in one pass
-    /// over the rows.
+    /// over the rows (branch-free, so that the compiler vectorises it).
     pub fn column_extents(&self) -> Vec<Option<(usize, usize)>> {
-        let mut ext: Vec<Option<(usize, usize)>> = vec![None; self.width];
-        for (v, row) in self.data.chunks_exact(self.width.max(1)).enumerate() {
-            for (e, &m) in ext.iter_mut().zip(row) {
-                if m != 0 {
-                    *e = Some(e.map_or((v, v), |(a, _)| (a, v)));
-                }
+        let w = self.width;
+        // Rows as u32: first (u32::MAX while unset) and last set row + 1 (0 while unset),
+        // updated through all-ones / all-zeros lane masks.
+        let mut first = vec![u32::MAX; w];
+        let mut last = vec![0u32; w];
+        for (v, row) in self.data.chunks_exact(w.max(1)).enumerate() {
+            let v = v as u32;
+            let (first, last, row) = (&mut first[..w], &mut last[..w], &row[..w]);
+            for i in 0..w {
+                let set = 0u32.wrapping_sub((row[i] != 0) as u32);
+                first[i] = first[i].min((v & set) | !set);
+                last[i] = (last[i] & !set) | ((v + 1) & set);
             }
         }
-        ext
+        first
+            .iter()
+            .zip(&last)
+            .map(|(&f, &l)| (l > 0).then(|| (f as usize, l as usize - 1)))
+            .collect()
     }
 
     /// Value at `(x, y)`.
@@ -124,31 +140,29 @@ impl Mask {
         if w == 0 || h == 0 {
             return;
         }
-        // Along rows.
+        // Along rows, into the scratch: the three neighbours as shifted slices, so that each
+        // pass is one vectorisable zip.
         for (row, out) in self.data.chunks_exact(w).zip(scratch.chunks_exact_mut(w)) {
             out.copy_from_slice(row);
             if w > 1 {
-                for (o, &r) in out[..w - 1].iter_mut().zip(&row[1..]) {
-                    *o = op(*o, r);
-                }
-                for (o, &l) in out[1..].iter_mut().zip(&row[..w - 1]) {
-                    *o = op(*o, l);
+                out[0] = op(row[0], row[1]);
+                out[w - 1] = op(row[w - 1], row[w - 2]);
+                for (o, ((&l, &c), &r)) in out[1..w - 1]
+                    .iter_mut()
+                    .zip(row.iter().zip(&row[1..]).zip(&row[2..]))
+                {
+                    *o = op(op(l, c), r);
                 }
             }
         }
-        // Along columns.
-        self.data.copy_from_slice(scratch);
+        // Along columns, back into the mask.
         for y in 0..h {
             let out = &mut self.data[y * w..(y + 1) * w];
-            if y > 0 {
-                for (o, &u) in out.iter_mut().zip(&scratch[(y - 1) * w..y * w]) {
-                    *o = op(*o, u);
-                }
-            }
-            if y + 1 < h {
-                for (o, &d) in out.iter_mut().zip(&scratch[(y + 1) * w..(y + 2) * w]) {
-                    *o = op(*o, d);
-                }
+            let centre = &scratch[y * w..(y + 1) * w];
+            let up = &scratch[y.saturating_sub(1) * w..(y.saturating_sub(1) + 1) * w];
+            let down = &scratch[(y + 1).min(h - 1) * w..((y + 1).min(h - 1) + 1) * w];
+            for (o, ((&u, &c), &d)) in out.iter_mut().zip(up.iter().zip(centre).zip(down)) {
+                *o = op(op(u, c), d);
             }
         }
     }

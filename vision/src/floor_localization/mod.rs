@@ -98,12 +98,14 @@ impl ColorClass {
     /// Whether a pixel belongs to the class.
     pub fn contains(&self, p: [u8; 3]) -> bool {
         let s = p[0] as u32 + p[1] as u32 + p[2] as u32;
-        if s < self.min_sum.max(1) {
-            return false;
-        }
-        // r in [r0, r1] <=> r0 s <= R <= r1 s (no division).
+        // r in [r0, r1] <=> r0 s <= R <= r1 s (no division); `&`, not `&&`: no branches in
+        // the per-pixel loops.
         let (rr, gg, ss) = (p[0] as f64, p[1] as f64, s as f64);
-        rr >= self.r[0] * ss && rr <= self.r[1] * ss && gg >= self.g[0] * ss && gg <= self.g[1] * ss
+        (s >= self.min_sum.max(1))
+            & (rr >= self.r[0] * ss)
+            & (rr <= self.r[1] * ss)
+            & (gg >= self.g[0] * ss)
+            & (gg <= self.g[1] * ss)
     }
 }
 
@@ -283,7 +285,21 @@ impl Localization {
 #[derive(Debug, Clone, Copy)]
 struct BoundaryPoint {
     p: Point2<f64>,
+    /// Eq. (15)'s weight `1 / (df/dR)^2`.
     w: f64,
+    /// `df/dR`: the floor distance one image pixel spans there, mm.
+    pixel_mm: f64,
+}
+
+impl BoundaryPoint {
+    /// A point at `p` where one image pixel spans `slope_mm_per_px` of floor.
+    fn new(p: Point2<f64>, slope_mm_per_px: f64) -> Self {
+        Self {
+            p,
+            w: 1.0 / (slope_mm_per_px * slope_mm_per_px).max(1e-9),
+            pixel_mm: slope_mm_per_px.abs(),
+        }
+    }
 }
 
 /// The field's frame in the robot's: where its centre is and where its x axis points.
@@ -496,13 +512,14 @@ impl FloorLocalizer {
                 &raw[v as usize * stride + u0 as usize * 4..v as usize * stride + u1 as usize * 4];
             for (u, p) in (u0..u1).step_by(2).zip(row.chunks(8)) {
                 let rgb = [p[0], p[1], p[2]];
-                let class = if self.config.goal_pos_x.contains(rgb) {
-                    0
-                } else if self.config.goal_neg_x.contains(rgb) {
-                    1
-                } else {
+                let (pos, neg) = (
+                    self.config.goal_pos_x.contains(rgb),
+                    self.config.goal_neg_x.contains(rgb),
+                );
+                if !(pos | neg) {
                     continue;
-                };
+                }
+                let class = if pos { 0 } else { 1 };
                 let x = u as f64 + 0.5 - cx;
                 let y = cy - (v as f64 + 0.5);
                 let r = x.hypot(y);
@@ -609,10 +626,7 @@ mod tests {
                 Point2::new(f.a1_mm, f.goal_half_width_mm + (t + 1.0) / 2.0 * 500.0),
                 Point2::new(-f.a1_mm, -f.goal_half_width_mm - (t + 1.0) / 2.0 * 500.0),
             ] {
-                pts.push(BoundaryPoint {
-                    p: truth * p,
-                    w: 1.0,
-                });
+                pts.push(BoundaryPoint::new(truth * p, 1.0));
             }
         }
         let mut centre = Point2::new(60.0, -20.0);

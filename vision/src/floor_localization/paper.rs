@@ -111,10 +111,7 @@ impl FloorLocalizer {
                 self.cal.image_to_floor(x, y),
                 self.cal.slope_mm_per_px(big_r),
             ) {
-                out.push(BoundaryPoint {
-                    p,
-                    w: 1.0 / (slope * slope).max(1e-9),
-                });
+                out.push(BoundaryPoint::new(p, slope));
             }
         };
         for v in 1..h.saturating_sub(1) {

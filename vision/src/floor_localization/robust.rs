@@ -39,7 +39,7 @@ struct Step {
     /// Points assigned.
     used: usize,
     /// Points assigned to each segment.
-    per_segment: Vec<usize>,
+    per_segment: [usize; Model::SEGMENTS],
     /// The share of the points that are assigned, of all but those seen past a goal post.
     explained: f64,
     /// Standard deviations of (du, dv, zeta) from the least squares.
@@ -57,6 +57,56 @@ enum Beyond {
     Occluder,
 }
 
+/// The boundary points of an image.
+struct WallPoints {
+    points: Vec<BoundaryPoint>,
+    /// Whether the floor ran on past the analysed image's edge somewhere.
+    cut: bool,
+    /// The directions between neighbouring points.
+    directions: Directions,
+}
+
+/// The boundary's direction modulo a quarter turn, from the steps between boundary points
+/// [`Directions::BASE`] rows (or columns) apart on the same side: each step `d` at angle `phi`
+/// adds `|d| (cos 4 phi, sin 4 phi)`, so that steps along either of two perpendicular walls add
+/// up, and the sum's angle over four is the walls' direction. (Steps between neighbouring rows
+/// are too short: the pixel staircase turns them by several degrees.)
+#[derive(Debug, Default, Clone, Copy)]
+struct Directions {
+    c4: f64,
+    s4: f64,
+    total: f64,
+}
+
+impl Directions {
+    /// Rows or columns between the two ends of a step.
+    const BASE: usize = 6;
+    /// Steps longer than this jump between walls or across a gap, mm.
+    const MAX_STEP_MM: f64 = 400.0;
+    /// The sum must be at least this share of the steps' length: the steps agree.
+    const MIN_AGREEMENT: f64 = 0.5;
+
+    fn add(&mut self, d: Vector2<f64>) {
+        let l2 = d.norm_squared();
+        if l2 <= 0.0 || l2 > Self::MAX_STEP_MM * Self::MAX_STEP_MM {
+            return;
+        }
+        // Double angles of the unit step, then of those.
+        let (c2, s2) = ((d.x * d.x - d.y * d.y) / l2, 2.0 * d.x * d.y / l2);
+        let l = l2.sqrt();
+        self.c4 += l * (c2 * c2 - s2 * s2);
+        self.s4 += l * 2.0 * c2 * s2;
+        self.total += l;
+    }
+
+    /// The walls' direction in [0, pi/2), if the steps agree on one.
+    fn angle(&self) -> Option<f64> {
+        let agreement = self.c4.hypot(self.s4);
+        (self.total > 0.0 && agreement >= Self::MIN_AGREEMENT * self.total)
+            .then(|| (self.s4.atan2(self.c4) / 4.0).rem_euclid(FRAC_PI_2))
+    }
+}
+
 impl FloorLocalizer {
     /// The robust method on the prepared mask: tracking from `prior` when given, else global;
     /// `hint` chooses between the two solutions when no goal is seen.
@@ -66,7 +116,11 @@ impl FloorLocalizer {
         prior: Option<&Isometry2<f64>>,
         hint: Option<&Isometry2<f64>>,
     ) -> Localization {
-        let (points, hull_cut) = self.wall_points(img);
+        let WallPoints {
+            points,
+            cut: hull_cut,
+            directions,
+        } = self.wall_points(img);
         if points.len() < MIN_BOUNDARY_POINTS {
             return Localization::NotLocalized(format!(
                 "too few points where the floor meets a wall or a goal ({}, need \
@@ -80,7 +134,10 @@ impl FloorLocalizer {
                 LocalizationMode::Tracking,
                 self.track_from(&points, &model, p, hull_cut),
             ),
-            None => (LocalizationMode::Global, self.search(&points, &model)),
+            None => (
+                LocalizationMode::Global,
+                self.search(&points, &model, directions.angle()),
+            ),
         };
         let (frame, step, iterations) = match found {
             Ok(f) => f,
@@ -144,15 +201,15 @@ impl FloorLocalizer {
             (f.centre - start.centre).norm() < TRACKING_REACH_MM
                 && turn.min(PI - turn) < TRACKING_REACH_RAD
         };
-        let mut guesses = first_guesses(points, &self.config.field);
+        let mut guesses = first_guesses(points, &self.config.field, None);
         guesses.push(start);
         let best = guesses
             .into_iter()
-            .filter_map(|g| self.refine(points, model, g, TRIAL_ITERATIONS))
-            .filter(|(f, _, _)| near_prior(f))
-            .max_by(|a, b| a.1.explained.total_cmp(&b.1.explained));
+            .filter_map(|g| self.trial(points, model, g))
+            .filter(|(f, _)| near_prior(f))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
         match best {
-            Some((f, _, _)) => self
+            Some((f, _)) => self
                 .refine(points, model, f, self.config.max_iterations)
                 .ok_or_else(|| "the fit near the prior did not converge".to_string()),
             None => direct.ok_or_else(|| "the fit from the prior did not converge".to_string()),
@@ -202,28 +259,35 @@ impl FloorLocalizer {
     /// Boundary points where the outermost floor pixel of a row or column has a wall or a goal
     /// just beyond it, converted to the floor; and whether the floor ran on past the analysed
     /// image's edge somewhere.
-    fn wall_points(&self, img: &RgbaImage) -> (Vec<BoundaryPoint>, bool) {
+    fn wall_points(&self, img: &RgbaImage) -> WallPoints {
         let (w, h) = (self.mask.width, self.mask.height);
         let r_max = self.config.max_radius_frac * self.cal.horizon_px;
         let [x0, y0, _, _] = self.region();
         // Mask pixel (u, v) is image pixel (u + x0, v + y0).
         let cx = self.cal.principal_point_px[0] - x0 as f64;
         let cy = self.cal.principal_point_px[1] - y0 as f64;
-        let mut out = Vec::with_capacity(2 * (w + h));
-        let mut cut = false;
+        let mut out = WallPoints {
+            points: Vec::with_capacity(2 * (w + h)),
+            cut: false,
+            directions: Directions::default(),
+        };
+        // The last few points of each of the four traces (first and last floor pixel of the
+        // rows, of the columns), by the row or column they came from.
+        const BASE: usize = Directions::BASE;
+        let mut last: [[Option<(usize, Point2<f64>)>; BASE]; 4] = [[None; BASE]; 4];
         // (eu, ev): the outer edge of the outermost floor pixel of a row or column, in
-        // continuous mask coordinates.
-        let mut consider = |eu: f64, ev: f64| {
+        // continuous mask coordinates; trace and row or column.
+        let mut consider = |eu: f64, ev: f64, trace: usize, index: usize| {
             let (x, y) = (eu - cx, cy - ev);
             let big_r = x.hypot(y);
             if big_r > r_max {
-                cut = true;
+                out.cut = true;
                 return;
             }
             match self.beyond(img, x, y) {
                 Beyond::Boundary => {}
                 Beyond::Cut => {
-                    cut = true;
+                    out.cut = true;
                     return;
                 }
                 Beyond::Occluder => return,
@@ -231,10 +295,15 @@ impl FloorLocalizer {
             // Eqs. (1)-(4): distance f(R) along the pixel's azimuth, and the weight of eq. (15).
             if let Some((r, slope)) = self.cal.floor_distance_and_slope(big_r) {
                 let [mx, my] = self.cal.mount_mm;
-                out.push(BoundaryPoint {
-                    p: Point2::new(mx + r * x / big_r, my + r * y / big_r),
-                    w: 1.0 / (slope * slope).max(1e-9),
-                });
+                let p = Point2::new(mx + r * x / big_r, my + r * y / big_r);
+                let slot = index % BASE;
+                if let Some((k, q)) = last[trace][slot]
+                    && k + BASE == index
+                {
+                    out.directions.add(p - q);
+                }
+                last[trace][slot] = Some((index, p));
+                out.points.push(BoundaryPoint::new(p, slope));
             }
         };
         for v in 1..h.saturating_sub(1) {
@@ -243,18 +312,18 @@ impl FloorLocalizer {
                 row.iter().position(|&m| m != 0),
                 row.iter().rposition(|&m| m != 0),
             ) {
-                consider(a as f64, v as f64 + 0.5);
-                consider(b as f64 + 1.0, v as f64 + 0.5);
+                consider(a as f64, v as f64 + 0.5, 0, v);
+                consider(b as f64 + 1.0, v as f64 + 0.5, 1, v);
             }
         }
         let columns = self.mask.column_extents();
         for (u, extent) in columns.iter().enumerate().take(w.saturating_sub(1)).skip(1) {
             if let Some((a, b)) = *extent {
-                consider(u as f64 + 0.5, a as f64);
-                consider(u as f64 + 0.5, b as f64 + 1.0);
+                consider(u as f64 + 0.5, a as f64, 2, u);
+                consider(u as f64 + 0.5, b as f64 + 1.0, 3, u);
             }
         }
-        (out, cut)
+        out
     }
 
     /// Classifies what lies radially outward of the boundary point at image coordinates
@@ -316,6 +385,29 @@ impl FloorLocalizer {
         Some((frame, step, iterations))
     }
 
+    /// A first guess refined by [`TRIAL_ITERATIONS`] of eq. (15), and the share of the points
+    /// its last step explained (cheaper than [`Self::refine`]'s closing step, and as good for
+    /// comparing guesses).
+    fn trial(
+        &self,
+        points: &[BoundaryPoint],
+        model: &Model,
+        mut frame: FieldFrame,
+    ) -> Option<(FieldFrame, f64)> {
+        let c = &self.config;
+        let posts = posts(&c.field);
+        let mut explained = 0.0;
+        for k in 0..TRIAL_ITERATIONS {
+            let gate = if k < 2 { c.gate_initial_mm } else { c.gate_mm };
+            let step = fit_step(points, model, &posts, &frame, gate)?;
+            let d = step.delta;
+            frame.centre += Rotation2::new(frame.psi) * Vector2::new(d.x, d.y);
+            frame.psi += d.z;
+            explained = step.explained;
+        }
+        Some((frame, explained))
+    }
+
     /// Global mode: refines every first guess a little, keeps the one that explains most
     /// boundary points, finishes it, and refuses when another, different pose explains nearly
     /// as many.
@@ -323,15 +415,19 @@ impl FloorLocalizer {
         &self,
         points: &[BoundaryPoint],
         model: &Model,
+        rough_direction: Option<f64>,
     ) -> Result<(FieldFrame, Step, usize), String> {
         // The trials run on every third point: enough to tell the guesses apart. Each guess is
-        // scored by what its first step explains, and the best few are refined further.
+        // scored by what its first step explains on every sixth, and the best few are refined
+        // further.
         let sample: Vec<BoundaryPoint> = points.iter().step_by(3).copied().collect();
+        let sparse: Vec<BoundaryPoint> = points.iter().step_by(6).copied().collect();
         let posts = posts(&self.config.field);
-        let mut guesses: Vec<(FieldFrame, f64)> = first_guesses(points, &self.config.field)
+        let mut guesses: Vec<(FieldFrame, f64)> =
+            first_guesses(points, &self.config.field, rough_direction)
             .into_iter()
             .filter_map(|g| {
-                fit_step(&sample, model, &posts, &g, self.config.gate_initial_mm)
+                fit_step(&sparse, model, &posts, &g, self.config.gate_initial_mm)
                     .map(|s| (g, s.explained))
             })
             .collect();
@@ -339,8 +435,7 @@ impl FloorLocalizer {
         let mut trials: Vec<(FieldFrame, f64)> = guesses
             .into_iter()
             .take(TRIALS)
-            .filter_map(|(g, _)| self.refine(&sample, model, g, TRIAL_ITERATIONS))
-            .map(|(f, s, _)| (f, s.explained))
+            .filter_map(|(g, _)| self.trial(&sample, model, g))
             .collect();
         trials.sort_by(|a, b| b.1.total_cmp(&a.1));
         let best_trial = trials.first().map_or(0.0, |t| t.1);
@@ -378,15 +473,17 @@ impl FloorLocalizer {
 /// may be the post's silhouette against the floor behind it, not the floor's edge, mm.
 const POST_SHADOW_MM: f64 = 40.0;
 
-/// Whether `p` (robot frame) lies behind `post` with its line of sight passing within
+/// Whether `p` lies behind `post` (both from the robot) with its line of sight passing within
 /// [`POST_SHADOW_MM`] of the post.
 fn past_post(p: Vector2<f64>, post: Vector2<f64>) -> bool {
-    let along = post.dot(&p) / p.norm_squared().max(1e-9);
-    along > 0.0 && along < 1.0 && (post - p * along).norm() < POST_SHADOW_MM
+    // Along the sight line: 0 < post . p < |p|^2; across it: |p x post| / |p| < the shadow.
+    let (along, len2) = (post.dot(&p), p.norm_squared());
+    let across = p.perp(&post);
+    along > 0.0 && along < len2 && across * across < POST_SHADOW_MM * POST_SHADOW_MM * len2
 }
 
 /// The goal posts: where the goal lines meet the goal pockets' side walls, the only corners of
-/// the floor's outline that hide floor behind them.
+/// the floor's outline that hide floor behind them; those at +x first.
 fn posts(f: &FieldModel) -> [Vector2<f64>; 4] {
     let (a, g) = (f.a1_mm, f.goal_half_width_mm);
     [
@@ -409,7 +506,7 @@ fn quality(
         rms_residual_mm: step.rms_mm,
         points: step.used,
         lines: step.per_segment.iter().filter(|&&n| n > 0).count(),
-        points_per_line: step.per_segment.clone(),
+        points_per_line: step.per_segment.to_vec(),
         boundary_points,
         inlier_fraction: step.explained,
         sigma: step.sigma,
@@ -476,11 +573,11 @@ impl Model {
 
     /// The nearest segment whose extent (widened by half the gate) holds `q` and whose line
     /// lies within the gate, or within [`GATE_PIXELS`] of the point's pixel when that is
-    /// coarser (a pixel spans `1 / sqrt(w)` mm): index and signed distance `n . q - c`. The
+    /// coarser (a pixel spans `pixel_mm` there): index and signed distance `n . q - c`. The
     /// field's symmetry leaves only the segments on the point's side of each axis to try.
-    fn assign(&self, q: Vector2<f64>, gate: f64, w: f64) -> Option<(usize, f64)> {
+    fn assign(&self, q: Vector2<f64>, gate: f64, pixel_mm: f64) -> Option<(usize, f64)> {
         let ends = 0.5 * gate;
-        let gate = gate.max(GATE_PIXELS / w.sqrt());
+        let gate = gate.max(GATE_PIXELS * pixel_mm);
         let (ax, ay) = (q.x.abs(), q.y.abs());
         let base = if q.x >= 0.0 { 0 } else { 6 };
         let upper = q.y >= 0.0;
@@ -523,28 +620,46 @@ impl Model {
 fn fit_step(
     points: &[BoundaryPoint],
     model: &Model,
-    posts: &[Vector2<f64>],
+    posts: &[Vector2<f64>; 4],
     frame: &FieldFrame,
     gate: f64,
 ) -> Option<Step> {
     let (s, c) = frame.psi.sin_cos();
-    let posts_robot: Vec<Vector2<f64>> = posts
-        .iter()
-        .map(|q| frame.centre.coords + Rotation2::new(frame.psi) * q)
-        .collect();
+    // Eqs. (13)-(14): robot-frame point to field frame.
+    let to_field = |p: Point2<f64>| {
+        let d = p - frame.centre;
+        Vector2::new(d.x * c + d.y * s, -d.x * s + d.y * c)
+    };
+    // The robot in the field frame. Seen from between the goal lines, a point can lie behind a
+    // post only beyond the goal line less the shadow's width; from elsewhere, anywhere.
+    let robot = to_field(Point2::origin());
+    let shadow_x = posts[0].x.abs() - POST_SHADOW_MM;
+    let inside = robot.x.abs() <= shadow_x;
+    // The posts a point may lie behind: none, those on its side of the field (seen from
+    // between the goal lines), or all.
+    let candidates = |q: &Vector2<f64>| -> &[Vector2<f64>] {
+        match (inside, q.x.abs() > shadow_x, q.x > 0.0) {
+            (false, _, _) => &posts[..],
+            (true, false, _) => &[],
+            (true, true, true) => &posts[..2],
+            (true, true, false) => &posts[2..],
+        }
+    };
     let mut ata = Matrix3::<f64>::zeros();
     let mut atb = Vector3::<f64>::zeros();
-    let mut per_segment = vec![0usize; Model::SEGMENTS];
+    let mut per_segment = [0usize; Model::SEGMENTS];
     let (mut sum_w, mut sum_wd2) = (0.0, 0.0);
     let mut seen = 0usize;
     for bp in points {
-        if posts_robot.iter().any(|post| past_post(bp.p.coords, *post)) {
+        let q = to_field(bp.p);
+        if candidates(&q)
+            .iter()
+            .any(|post| past_post(q - robot, post - robot))
+        {
             continue;
         }
         seen += 1;
-        let d = bp.p - frame.centre;
-        let q = Vector2::new(d.x * c + d.y * s, -d.x * s + d.y * c);
-        let best = model.assign(q, gate, bp.w);
+        let best = model.assign(q, gate, bp.pixel_mm);
         let Some((k, d0)) = best else { continue };
         let n = Model::normal(k);
         let j = Vector3::new(-n.x, -n.y, n.x * q.y - n.y * q.x);
@@ -578,8 +693,12 @@ fn fit_step(
 /// Global first guesses: the field's orientation from the directions of the boundary, then,
 /// for each of its two axes as the field's x axis, offsets that put the outermost walls seen on
 /// the model's walls.
-fn first_guesses(points: &[BoundaryPoint], f: &FieldModel) -> Vec<FieldFrame> {
-    let theta = dominant_orientation(points);
+fn first_guesses(
+    points: &[BoundaryPoint],
+    f: &FieldModel,
+    rough_direction: Option<f64>,
+) -> Vec<FieldFrame> {
+    let theta = dominant_orientation(points, rough_direction);
     let (x_walls, y_wall) = (
         [f.a1_mm - f.boundary_line_mm, f.a2_mm],
         f.b_mm - f.boundary_line_mm,
@@ -590,10 +709,8 @@ fn first_guesses(points: &[BoundaryPoint], f: &FieldModel) -> Vec<FieldFrame> {
             Vector2::new(psi.cos(), psi.sin()),
             Vector2::new(-psi.sin(), psi.cos()),
         );
-        let xs: Vec<f64> = points.iter().map(|b| b.p.coords.dot(&u)).collect();
-        let ys: Vec<f64> = points.iter().map(|b| b.p.coords.dot(&v)).collect();
-        let (x_lo, x_hi) = (outer_wall(&xs, -1.0), outer_wall(&xs, 1.0));
-        let (y_lo, y_hi) = (outer_wall(&ys, -1.0), outer_wall(&ys, 1.0));
+        let (x_lo, x_hi) = outer_walls(points.iter().map(|b| b.p.coords.dot(&u)).collect());
+        let (y_lo, y_hi) = outer_walls(points.iter().map(|b| b.p.coords.dot(&v)).collect());
         let ox: Vec<f64> = x_walls
             .iter()
             .flat_map(|&wx| [x_hi - wx, x_lo + wx])
@@ -615,52 +732,103 @@ fn first_guesses(points: &[BoundaryPoint], f: &FieldModel) -> Vec<FieldFrame> {
     out
 }
 
-/// The outermost coordinate (toward `side`, +1 or -1) backed by at least four points within
-/// 40 mm: a wall, not a stray point.
-fn outer_wall(values: &[f64], side: f64) -> f64 {
-    let mut v: Vec<f64> = values.iter().map(|x| x * side).collect();
-    v.sort_by(|a, b| b.total_cmp(a));
-    let backed = v
-        .windows(4)
-        .find(|w| w[0] - w[3] <= 40.0)
-        .map_or(v.first().copied().unwrap_or(0.0), |w| w[0]);
-    backed * side
+/// The outermost coordinates on either side (least, greatest) backed by at least four points
+/// within 40 mm: walls, not stray points.
+fn outer_walls(mut values: Vec<f64>) -> (f64, f64) {
+    const BACKING: usize = 4;
+    let backed = |w: &[f64]| (w[BACKING - 1] - w[0]).abs() <= 40.0;
+    // Mostly the outermost few points are backed: sort only the 16 least and greatest (all
+    // when there are few), and the rest only when those hold no wall.
+    let n = values.len();
+    let k = 16.min(n);
+    let lo = {
+        if k < n {
+            values.select_nth_unstable_by(k, f64::total_cmp);
+        }
+        values[..k].sort_unstable_by(f64::total_cmp);
+        values[..k].windows(BACKING).find(|w| backed(w)).map(|w| w[0])
+    };
+    let hi = {
+        if k < n {
+            values.select_nth_unstable_by(n - k - 1, f64::total_cmp);
+        }
+        values[n - k..].sort_unstable_by(f64::total_cmp);
+        values[n - k..]
+            .windows(BACKING)
+            .rev()
+            .find(|w| backed(w))
+            .map(|w| w[BACKING - 1])
+    };
+    if let (Some(lo), Some(hi)) = (lo, hi) {
+        return (lo, hi);
+    }
+    values.sort_unstable_by(f64::total_cmp);
+    let lo = values.windows(BACKING).find(|w| backed(w)).map(|w| w[0]);
+    let hi = values.windows(BACKING).rev().find(|w| backed(w)).map(|w| w[BACKING - 1]);
+    (
+        lo.or(values.first().copied()).unwrap_or(0.0),
+        hi.or(values.last().copied()).unwrap_or(0.0),
+    )
 }
 
 /// The rotation in [0, pi/2) at which the boundary points' coordinates along both axes are
 /// most concentrated (the sum of the squared counts of 25 mm bins): walls meet at right angles,
 /// so their points pile up in few bins when the axes run along them.
-fn dominant_orientation(points: &[BoundaryPoint]) -> f64 {
+fn dominant_orientation(points: &[BoundaryPoint], rough: Option<f64>) -> f64 {
     const BIN_MM: f64 = 25.0;
-    const BINS: usize = 480;
-    let mut bins = vec![0u32; BINS];
-    let mut score = |theta: f64| -> u64 {
+    // Every other point is plenty to find the walls' direction; every fourth for the coarse
+    // steps.
+    let sample: Vec<Point2<f64>> = points.iter().step_by(2).map(|b| b.p).collect();
+    let reach = sample.iter().map(|p| p.coords.norm()).fold(0.0, f64::max);
+    let half = (reach / BIN_MM).ceil() as usize + 1;
+    let mut bins = vec![0f64; 2 * half + 1];
+    let mut keys = vec![0usize; sample.len()];
+    // Each point is shared between its two nearest bins in proportion (so that the score
+    // changes smoothly with the rotation, not in steps as points cross bin edges).
+    let mut score = |theta: f64, stride: usize| -> f64 {
         let (s, c) = theta.sin_cos();
-        let mut total = 0u64;
+        let mut total = 0.0;
         for axis in [(c, s), (-s, c)] {
-            bins.iter_mut().for_each(|b| *b = 0);
-            // Every other point is plenty to find the walls' direction.
-            for b in points.iter().step_by(2) {
-                let x = b.p.x * axis.0 + b.p.y * axis.1;
-                let k = x / BIN_MM + BINS as f64 / 2.0;
-                if k >= 0.0 && k < BINS as f64 {
-                    bins[k as usize] += 1;
-                }
+            // The sum of squared counts, kept as the bins fill: (n + a)^2 - n^2 = (2 n + a) a.
+            for (key, p) in keys.iter_mut().zip(sample.iter().step_by(stride)) {
+                let x = (p.x * axis.0 + p.y * axis.1) / BIN_MM + half as f64;
+                let k = (x.max(0.0) as usize).min(2 * half - 1);
+                let b = (x - k as f64).clamp(0.0, 1.0);
+                let a = 1.0 - b;
+                total += (2.0 * bins[k] + a) * a + (2.0 * bins[k + 1] + b) * b;
+                bins[k] += a;
+                bins[k + 1] += b;
+                *key = k;
             }
-            total += bins.iter().map(|&n| (n as u64) * (n as u64)).sum::<u64>();
+            for &k in keys.iter().take(sample.len().div_ceil(stride)) {
+                bins[k] = 0.0;
+                bins[k + 1] = 0.0;
+            }
         }
         total
     };
-    // Three degrees, then half a degree, then a tenth.
-    let mut best = (0..30)
-        .map(|k| (3.0 * k as f64).to_radians())
-        .max_by_key(|&t| score(t))
-        .unwrap_or(0.0);
-    for step in [0.5f64, 0.1] {
-        best = (-6..=6)
+    // From the rough direction of the boundary's steps when they agree on one, else the best
+    // of every five degrees; then one degree, then a fifth, each searching the span the step
+    // before leaves open.
+    let mut best_of = |angles: Vec<f64>, stride: usize| {
+        angles
+            .into_iter()
+            .map(|t| (t, score(t, stride)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(t, _)| t)
+    };
+    let mut best = match rough {
+        Some(r) => r,
+        None => {
+            let coarse = (0..18).map(|k| (5.0 * k as f64).to_radians()).collect();
+            best_of(coarse, 2).unwrap_or(0.0)
+        }
+    };
+    for (step, stride) in [(1.0f64, 2), (0.2, 1)] {
+        let around = (-3..=3)
             .map(|k| best + (step * k as f64).to_radians())
-            .max_by_key(|&t| score(t))
-            .unwrap_or(best);
+            .collect();
+        best = best_of(around, stride).unwrap_or(best);
     }
     best.rem_euclid(FRAC_PI_2)
 }
@@ -716,13 +884,10 @@ mod tests {
         for k in 0..60 {
             let s = k as f64 * 20.0;
             for p in [Point2::new(400.0, s - 300.0), Point2::new(s - 500.0, 700.0)] {
-                pts.push(BoundaryPoint {
-                    p: Point2::from(r * p.coords),
-                    w: 1.0,
-                });
+                pts.push(BoundaryPoint::new(Point2::from(r * p.coords), 1.0));
             }
         }
-        let theta = dominant_orientation(&pts);
+        let theta = dominant_orientation(&pts, None);
         assert!((theta - 0.3).abs() < 0.01, "{theta}");
     }
 }
