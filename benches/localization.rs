@@ -70,10 +70,7 @@ fn main() {
         .collect();
     // The configurations take turns frame by frame, so that a shared machine's changing load
     // falls on all of them alike.
-    let rounds = std::env::var("OMNILOOP_BENCH_ROUNDS")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(600);
+    let rounds = 600;
     let mut times = vec![Vec::with_capacity(rounds); configs.len()];
     for k in 0..rounds {
         let (img, prior) = &frames[k % frames.len()];

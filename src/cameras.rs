@@ -143,6 +143,16 @@ impl Cameras {
             .collect()
     }
 
+    /// The last capture of camera `name`, if it is rendered.
+    pub fn image(&self, name: &str) -> Option<&RgbaImage> {
+        self.cameras
+            .iter()
+            .filter(|c| c.live)
+            .zip(&self.images)
+            .find(|(c, _)| c.sensor.name == name)
+            .map(|(_, image)| image)
+    }
+
     /// The state of the pan units.
     pub fn actuator_state(&self) -> Vec<ActuatorState> {
         self.cameras

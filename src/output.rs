@@ -16,8 +16,8 @@ pub fn default_out_dir(scenario: &Scenario) -> PathBuf {
     Path::new("runs").join(&scenario.name)
 }
 
-/// Writes `summary.json`, `trajectory.csv`, `estimates.jsonl` and `topview.png` into `dir`
-/// (created if needed).
+/// Writes `summary.json`, `trajectory.csv`, `estimates.jsonl`, `topview.png` and the
+/// experiment's own files into `dir` (created if needed).
 pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let summary_path = dir.join("summary.json");
@@ -33,6 +33,10 @@ pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Re
     write_estimates_jsonl(&out.trajectory, &out.estimates, BufWriter::new(f))
         .with_context(|| format!("writing {}", est_path.display()))?;
     draw_run_topview(&dir.join("topview.png"), scenario, out)?;
+    for f in &out.files {
+        let path = dir.join(&f.name);
+        std::fs::write(&path, &f.bytes).with_context(|| format!("writing {}", path.display()))?;
+    }
     Ok(())
 }
 

@@ -2,6 +2,7 @@
 
 use nalgebra::Isometry2;
 use omniloop_robot::{Estimates, Fix, FixOutcome, Measurement};
+use omniloop_vision::{LocalizationMode, LocalizationQuality};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 
@@ -60,6 +61,11 @@ pub fn write_trajectory_csv(rows: &[TrajectoryRow], mut w: impl Write) -> std::i
     Ok(())
 }
 
+/// Reads a number that JSON wrote as `null` because it was infinite.
+fn null_as_infinity<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+}
+
 /// The metrics of a run, written to `summary.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
@@ -87,7 +93,9 @@ pub struct Summary {
     pub reached_goal: bool,
     /// When it did.
     pub time_to_goal_s: Option<f64>,
-    /// Smallest distance from the robot's edge to a wall, cube, pillar or robot.
+    /// Smallest distance from the robot's edge to a wall, cube, pillar or robot (infinite,
+    /// written as `null`, when no cycle ran).
+    #[serde(deserialize_with = "null_as_infinity")]
     pub min_clearance_mm: f64,
     /// Length of the path the robot centre travelled.
     pub path_length_mm: f64,
@@ -153,6 +161,50 @@ struct FixRecord<'a> {
     outcome: &'static str,
     #[serde(skip_serializing_if = "Option::is_none")]
     why: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    quality: Option<QualityRecord<'a>>,
+}
+
+/// A fix's quality record as written in `estimates.jsonl`.
+#[derive(Debug, Serialize)]
+struct QualityRecord<'a> {
+    mode: &'static str,
+    rms_residual_mm: f64,
+    points: usize,
+    points_per_line: &'a [usize],
+    lines: usize,
+    boundary_points: usize,
+    inlier_fraction: f64,
+    sigma_x_mm: f64,
+    sigma_y_mm: f64,
+    sigma_deg: f64,
+    hull_cut: bool,
+    resolved_by_goals: bool,
+    iterations: usize,
+}
+
+impl<'a> QualityRecord<'a> {
+    fn of(q: &'a LocalizationQuality) -> Self {
+        // NaN (the paper's method keeps no standard deviations) is written as null.
+        Self {
+            mode: match q.mode {
+                LocalizationMode::Global => "global",
+                LocalizationMode::Tracking => "tracking",
+            },
+            rms_residual_mm: q.rms_residual_mm,
+            points: q.points,
+            points_per_line: &q.points_per_line,
+            lines: q.lines,
+            boundary_points: q.boundary_points,
+            inlier_fraction: q.inlier_fraction,
+            sigma_x_mm: q.sigma[0],
+            sigma_y_mm: q.sigma[1],
+            sigma_deg: q.sigma[2].to_degrees(),
+            hull_cut: q.hull_cut,
+            resolved_by_goals: q.resolved_by_goals,
+            iterations: q.iterations,
+        }
+    }
 }
 
 impl<'a> FixRecord<'a> {
@@ -185,6 +237,7 @@ impl<'a> FixRecord<'a> {
             theta_rad: t,
             outcome,
             why,
+            quality: f.quality.as_ref().map(QualityRecord::of),
         }
     }
 }
@@ -231,4 +284,23 @@ pub fn write_estimates_jsonl(
         writeln!(w)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_summary_without_cycles_reads_back() {
+        // No cycle ran: no clearance was measured, and JSON has no infinity.
+        let text = r#"{"scenario":"s","seed":1,"controller":"idle","cycles":0,"sim_time_s":0.0,
+            "wall_time_s":0.1,"cycles_per_s":0.0,"wall_contacts":0,"peak_speed_mm_s":0.0,
+            "peak_accel_mm_s2":0.0,"reached_goal":false,"time_to_goal_s":null,
+            "min_clearance_mm":null,"path_length_mm":0.0,"places":[]}"#;
+        let m: Summary = serde_json::from_str(text).unwrap();
+        assert_eq!(m.min_clearance_mm, f64::INFINITY);
+        assert!(m.experiment.contains_key("places"));
+        let again: Summary = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
+        assert_eq!(again, m);
+    }
 }

@@ -76,6 +76,17 @@ pub struct RunOutput {
     pub estimates: Vec<Estimates>,
     /// The paths of the other robots, one point a control cycle.
     pub other_paths: Vec<Vec<Point2<f64>>>,
+    /// Files of the experiment's own (tables, figures), written beside the run's.
+    pub files: Vec<OutputFile>,
+}
+
+/// A file an experiment produced: its name in the output folder and its contents.
+#[derive(Debug, Clone)]
+pub struct OutputFile {
+    /// File name (`selfloc_map.csv`).
+    pub name: String,
+    /// Contents.
+    pub bytes: Vec<u8>,
 }
 
 /// The calibrations of the cameras the robot's vision uses: the scenario's file, or the
@@ -100,6 +111,7 @@ pub struct Simulation {
     scenario: Scenario,
     world: World,
     cameras: Option<Cameras>,
+    calibrations: Vec<RadialCalibration>,
     odometry: WheelOdometry,
     robot: Robot,
     pilot: Option<Pilot>,
@@ -125,7 +137,8 @@ impl Simulation {
             &scenario.robot_bodies(),
             scenario.run.physics_step_s,
         )?;
-        let robot = Robot::new(&scenario.robot_config(calibrations(scenario)?))?;
+        let calibrations = calibrations(scenario)?;
+        let robot = Robot::new(&scenario.robot_config(calibrations.clone()))?;
         let r = &scenario.robot;
         let pilot = match (&scenario.goal, scenario.control.kind) {
             (Some(g), ControllerKind::GoToGoalTruth) => Some(Pilot::new(
@@ -160,6 +173,7 @@ impl Simulation {
             scenario: scenario.clone(),
             world,
             cameras,
+            calibrations,
             odometry: WheelOdometry::new(&scenario.odometry, scenario.seed),
             robot,
             pilot,
@@ -202,6 +216,25 @@ impl Simulation {
     pub fn finished(&self) -> bool {
         self.cycle >= self.scenario.max_cycles()
             || (self.scenario.run.stop_at_goal && self.truth.time_to_goal_s().is_some())
+    }
+
+    /// The calibration of the camera the robot's vision uses, when its software uses one.
+    pub fn vision_calibration(&self) -> Option<&RadialCalibration> {
+        self.calibrations.first()
+    }
+
+    /// Renders the camera the robot's vision uses as it sees the world now, with its noise (a
+    /// frame of its own, as an experimenter would take one): `None` when no camera is rendered.
+    pub fn vision_frame(&mut self) -> Result<Option<&image::RgbaImage>, RunError> {
+        let index = self.scenario.vision_sensor_index().ok();
+        let name = index.map(|i| self.scenario.robot.sensors[i].name.as_str());
+        match (&mut self.cameras, name) {
+            (Some(c), Some(name)) => {
+                c.capture(&self.world)?;
+                Ok(c.image(name))
+            }
+            _ => Ok(None),
+        }
     }
 
     /// Puts the robot under test at `pose`, at rest (an experimenter carrying it there).
@@ -367,6 +400,7 @@ impl Simulation {
             trajectory: self.trajectory,
             estimates: self.estimates,
             other_paths: self.other_paths,
+            files: Vec::new(),
         }
     }
 }
@@ -398,6 +432,7 @@ pub fn run_scenario(
         out.summary.cycles_per_s = out.summary.cycles as f64 / loop_s;
     }
     out.summary.experiment = experiment.metrics(&out);
+    out.files = experiment.files(scenario, &out)?;
     Ok(out)
 }
 

@@ -104,7 +104,12 @@ fn outline(shape: &SolidShape) -> Vec<(f64, f64)> {
 }
 
 /// The bounding box of everything drawn, with a margin.
-fn bounds(layout: &Layout, paths: &[PathLayer<'_>], markers: &[Marker]) -> (f64, f64, f64, f64) {
+fn bounds(
+    layout: &Layout,
+    paths: &[PathLayer<'_>],
+    markers: &[Marker],
+    spots: &[Spots],
+) -> (f64, f64, f64, f64) {
     let mut pts: Vec<(f64, f64)> = Vec::new();
     for r in layout.all_floor_rects() {
         pts.extend(rect_corners(
@@ -123,6 +128,9 @@ fn bounds(layout: &Layout, paths: &[PathLayer<'_>], markers: &[Marker]) -> (f64,
         pts.push((m.at.x - m.radius_mm, m.at.y - m.radius_mm));
         pts.push((m.at.x + m.radius_mm, m.at.y + m.radius_mm));
     }
+    for s in spots {
+        pts.extend(s.points.iter().map(|q| (q.x, q.y)));
+    }
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for (x, y) in pts {
         if x.is_finite() && y.is_finite() {
@@ -136,10 +144,41 @@ fn bounds(layout: &Layout, paths: &[PathLayer<'_>], markers: &[Marker]) -> (f64,
         return (-1000.0, 1000.0, -1000.0, 1000.0);
     }
     let m = 0.04 * (x1 - x0).max(y1 - y0) + 50.0;
-    (x0 - m, x1 + m, y0 - m, y1 + m)
+    // Room below for the spots' legend.
+    let below = if spots.is_empty() {
+        0.0
+    } else {
+        (24.0 * spots.len() as f64 + 20.0) * (x1 - x0) / 1000.0
+    };
+    (x0 - m, x1 + m, y0 - m - below, y1 + m)
 }
 
-/// One panel of a figure: a title, the world, paths and markers.
+/// How a spot is marked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mark {
+    /// A filled disc with a white rim.
+    Disc,
+    /// A diagonal cross.
+    Cross,
+}
+
+/// Spots of one colour with one legend entry (e.g. the grid places whose error falls in one
+/// band).
+#[derive(Debug, Clone)]
+pub struct Spots {
+    /// Legend text.
+    pub label: String,
+    /// Colour.
+    pub rgb: [u8; 3],
+    /// Where, in world mm.
+    pub points: Vec<Point2<f64>>,
+    /// How each is marked.
+    pub mark: Mark,
+    /// Radius of a mark, pixels.
+    pub size_px: i32,
+}
+
+/// One panel of a figure: a title, the world, paths, markers and spots.
 #[derive(Debug, Clone)]
 pub struct Panel<'a> {
     /// Title above the panel.
@@ -150,6 +189,8 @@ pub struct Panel<'a> {
     pub paths: Vec<PathLayer<'a>>,
     /// Markers.
     pub markers: Vec<Marker>,
+    /// Spots, drawn over the rest.
+    pub spots: Vec<Spots>,
 }
 
 type Area<'b> = DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>;
@@ -271,13 +312,45 @@ fn draw_panel(
             .label(p.label.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
     }
-    if !panel.paths.is_empty() {
+    for spots in &panel.spots {
+        let c = color(spots.rgb);
+        let r = spots.size_px;
+        let pts = spots.points.iter().map(|q| (q.x, q.y));
+        let series = match spots.mark {
+            Mark::Disc => {
+                chart
+                    .draw_series(pts.clone().map(|q| Circle::new(q, r + 1, WHITE.filled())))
+                    .map_err(|e| err(&e))?;
+                chart
+                    .draw_series(pts.map(|q| Circle::new(q, r, c.filled())))
+                    .map_err(|e| err(&e))?
+            }
+            Mark::Cross => chart
+                .draw_series(pts.map(|q| Cross::new(q, r, c.stroke_width(2))))
+                .map_err(|e| err(&e))?,
+        };
+        let mark = spots.mark;
+        series.label(spots.label.clone()).legend(move |(x, y)| {
+            let at = (x + 9, y);
+            match mark {
+                Mark::Disc => EmptyElement::at(at) + Circle::new((0, 0), r, c.filled()),
+                Mark::Cross => EmptyElement::at(at) + Circle::new((0, 0), r, c.stroke_width(2)),
+            }
+        });
+    }
+    if !panel.paths.is_empty() || !panel.spots.is_empty() {
+        // Spots cover the floor: their legend goes below it.
+        let position = if panel.spots.is_empty() {
+            SeriesLabelPosition::UpperLeft
+        } else {
+            SeriesLabelPosition::LowerLeft
+        };
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 13))
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(position)
             .draw()
             .map_err(|e| err(&e))?;
     }
@@ -296,15 +369,41 @@ fn circle_points(c: Point2<f64>, r: f64, n: usize) -> Vec<(f64, f64)> {
 /// Draws panels side by side into a PNG; each panel is `width` pixels wide and all share the
 /// bounds of everything drawn, with millimetres square.
 pub fn draw_panels(file: &Path, panels: &[Panel<'_>], width: u32) -> Result<(), FigureError> {
-    register_font();
     let name = file.display().to_string();
+    render_panels(&name, panels, width)?
+        .save(file)
+        .map_err(|source| FigureError::Write { file: name, source })
+}
+
+/// [`draw_panels`] into PNG bytes; `name` names the figure in errors.
+pub fn panels_png(name: &str, panels: &[Panel<'_>], width: u32) -> Result<Vec<u8>, FigureError> {
+    let mut bytes = Vec::new();
+    render_panels(name, panels, width)?
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .map_err(|source| FigureError::Write {
+            file: name.to_string(),
+            source,
+        })?;
+    Ok(bytes)
+}
+
+/// Draws panels side by side into an image.
+fn render_panels(
+    name: &str,
+    panels: &[Panel<'_>],
+    width: u32,
+) -> Result<image::RgbImage, FigureError> {
+    register_font();
     let fail = |message: String| FigureError::Draw {
-        file: name.clone(),
+        file: name.to_string(),
         message,
     };
     let mut b = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for p in panels {
-        let (x0, x1, y0, y1) = bounds(p.layout, &p.paths, &p.markers);
+        let (x0, x1, y0, y1) = bounds(p.layout, &p.paths, &p.markers, &p.spots);
         b = (b.0.min(x0), b.1.max(x1), b.2.min(y0), b.3.max(y1));
     }
     let plot_w = width.saturating_sub(105).max(100);
@@ -323,13 +422,7 @@ pub fn draw_panels(file: &Path, panels: &[Panel<'_>], width: u32) -> Result<(), 
         }
         root.present().map_err(|e| fail(e.to_string()))?;
     }
-    image::RgbImage::from_raw(total_w, height, buf)
-        .expect("buffer size matches the image")
-        .save(file)
-        .map_err(|source| FigureError::Write {
-            file: file.display().to_string(),
-            source,
-        })
+    Ok(image::RgbImage::from_raw(total_w, height, buf).expect("buffer size matches the image"))
 }
 
 /// Draws one panel into a PNG `width` pixels wide.
@@ -348,6 +441,7 @@ pub fn draw_topview(
             layout,
             paths: paths.to_vec(),
             markers: markers.to_vec(),
+            spots: Vec::new(),
         }],
         width,
     )

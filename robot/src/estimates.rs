@@ -1,7 +1,7 @@
 //! What the robot believes: the typed record it returns each cycle, written beside the truth.
 
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop_vision::FreeSpace;
+use omniloop_vision::{FreeSpace, LocalizationQuality};
 
 /// A measurement a perception stage gives the estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,6 +55,9 @@ pub struct Fix {
     pub measurement: Measurement,
     /// What the estimator did with it.
     pub outcome: FixOutcome,
+    /// How good the stage judged it (floor-region localization: residual, points per line,
+    /// standard deviations, whether the view was cut, global or tracking).
+    pub quality: Option<LocalizationQuality>,
 }
 
 /// A stage that looked and found nothing, and why.

@@ -86,10 +86,11 @@ impl Robot {
         let fixes: Vec<Fix> = percepts
             .fixes
             .into_iter()
-            .map(|(source, measurement)| Fix {
-                source,
-                outcome: self.estimator.fuse(&measurement),
-                measurement,
+            .map(|s| Fix {
+                source: s.source,
+                outcome: self.estimator.fuse(&s.measurement),
+                measurement: s.measurement,
+                quality: s.quality,
             })
             .collect();
         let pose = self.estimator.estimate();

@@ -264,6 +264,7 @@ fn draw_comparison(file: &Path, runs: &[ReplayRun]) -> anyhow::Result<()> {
                     discs: Some((every, r.scenario.robot.radius_mm)),
                 }],
                 markers,
+                spots: Vec::new(),
             }
         })
         .collect();

@@ -8,13 +8,14 @@
 //! `docs/experiments.md`.
 
 pub mod corner;
+pub mod localization_map;
 pub mod places;
 
 use crate::load::parse_scenario;
 use crate::output::write_run;
 use crate::record::Summary;
 use crate::scenario::Scenario;
-use crate::simulation::{RunError, RunOptions, RunOutput, Simulation, run_scenario};
+use crate::simulation::{OutputFile, RunError, RunOptions, RunOutput, Simulation, run_scenario};
 use crate::validate::Checker;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
@@ -39,6 +40,12 @@ pub trait Experiment {
     fn metrics(&self, _out: &RunOutput) -> Metrics {
         Metrics::new()
     }
+
+    /// The experiment's own files (tables, figures) of a finished run, written beside the
+    /// run's outputs.
+    fn files(&self, _scenario: &Scenario, _out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
+        Ok(Vec::new())
+    }
 }
 
 /// The driving procedure: control cycles until the run is over, then the final state.
@@ -57,7 +64,8 @@ struct Drive;
 
 impl Experiment for Drive {}
 
-/// The experiment a scenario belongs to (`[experiment.corner]`, `[experiment.places]`).
+/// The experiment a scenario belongs to (`[experiment.corner]`, `[experiment.places]`,
+/// `[experiment.localization_map]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExperimentSpec {
@@ -65,6 +73,8 @@ pub enum ExperimentSpec {
     Corner(corner::CornerSpec),
     /// E2: localize at places on the field.
     Places(places::PlacesSpec),
+    /// The self-localization error map: a grid over the whole floor region, both modes.
+    LocalizationMap(localization_map::MapSpec),
 }
 
 impl ExperimentSpec {
@@ -73,6 +83,7 @@ impl ExperimentSpec {
         match self {
             Self::Corner(spec) => spec.validate(c),
             Self::Places(spec) => spec.validate(s, c),
+            Self::LocalizationMap(spec) => spec.validate(s, c),
         }
     }
 
@@ -80,7 +91,7 @@ impl ExperimentSpec {
     pub(crate) fn prepare(&self, s: &mut Scenario) {
         match self {
             Self::Corner(spec) => spec.prepare(s),
-            Self::Places(_) => {}
+            Self::Places(_) | Self::LocalizationMap(_) => {}
         }
     }
 
@@ -89,6 +100,7 @@ impl ExperimentSpec {
         match self {
             Self::Corner(_) => None,
             Self::Places(_) => Some(places::places_table(summary)),
+            Self::LocalizationMap(_) => Some(localization_map::map_table(summary)),
         }
     }
 }
@@ -98,7 +110,12 @@ pub fn procedure(s: &Scenario) -> Box<dyn Experiment> {
     match &s.experiment {
         None => Box::new(Drive),
         Some(ExperimentSpec::Corner(_)) => Box::new(corner::Corner),
-        Some(ExperimentSpec::Places(spec)) => Box::new(places::Places::new(spec)),
+        Some(ExperimentSpec::Places(spec)) => {
+            Box::new(places::Places::new(spec, s.vision.localization.method))
+        }
+        Some(ExperimentSpec::LocalizationMap(spec)) => Box::new(
+            localization_map::LocalizationMap::new(spec, s.vision.localization.method),
+        ),
     }
 }
 
@@ -154,6 +171,13 @@ impl ReplayContext<'_> {
         text: &str,
         dir: &Path,
     ) -> anyhow::Result<ReplayRun> {
+        let run = self.simulate(name, file, text)?;
+        write_run(dir, &run.scenario, &run.output)?;
+        Ok(run)
+    }
+
+    /// Runs the built-in scenario `text` (from `file`) with the replay's seed, writing nothing.
+    pub fn simulate(&mut self, name: &str, file: &str, text: &str) -> anyhow::Result<ReplayRun> {
         let path = Path::new(file);
         let stem = path
             .file_stem()
@@ -167,7 +191,6 @@ impl ReplayContext<'_> {
             progress(name, k, n)
         })
         .with_context(|| format!("running {file}"))?;
-        write_run(dir, &scenario, &output)?;
         Ok(ReplayRun {
             name: name.to_string(),
             scenario,

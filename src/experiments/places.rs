@@ -3,15 +3,19 @@
 //! frames with fresh sensor noise; each place is scored by its RMS errors. Its replay,
 //! `selfloc`, runs the six places on the Small-Size field.
 
+use super::localization_map::map_table;
 use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
+use crate::output::write_run;
 use crate::record::Summary;
 use crate::scenario::{PoseSpec, Scenario};
 use crate::simulation::{RunError, RunOutput, Simulation};
 use crate::topview::{Marker, Panel, PathLayer, draw_panels};
 use crate::validate::Checker;
+use anyhow::Context;
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::wrap_pi;
 use omniloop_robot::{Measurement, PoseSource};
+use omniloop_vision::LocalizationMethod;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -129,17 +133,28 @@ impl Tally {
 /// The procedure and metrics of E2.
 pub struct Places {
     spec: PlacesSpec,
+    method: LocalizationMethod,
     results: Vec<PlaceResult>,
 }
 
 impl Places {
-    /// E2 at the places of `spec`.
-    pub fn new(spec: &PlacesSpec) -> Self {
+    /// E2 at the places of `spec`, localizing with `method`.
+    pub fn new(spec: &PlacesSpec, method: LocalizationMethod) -> Self {
         Self {
             spec: spec.clone(),
+            method,
             results: Vec::new(),
         }
     }
+}
+
+/// How E2 localized (`summary.json`: `localization`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlacesMethod {
+    /// The method of `[vision.localization]`.
+    pub method: LocalizationMethod,
+    /// The mode: every frame from no prior.
+    pub mode: String,
 }
 
 impl Experiment for Places {
@@ -177,6 +192,14 @@ impl Experiment for Places {
             "places".into(),
             serde_json::to_value(&self.results).unwrap_or_default(),
         );
+        let how = PlacesMethod {
+            method: self.method,
+            mode: "global".into(),
+        };
+        keys.insert(
+            "localization".into(),
+            serde_json::to_value(how).unwrap_or_default(),
+        );
         keys
     }
 }
@@ -192,7 +215,8 @@ pub fn place_results(m: &Summary) -> Vec<PlaceResult> {
 /// `omniloop replay selfloc`.
 pub const REPLAY: Replay = Replay {
     name: "selfloc",
-    title: "E2: floor-region self-localization at six places on the field (Fig. 8)",
+    title: "E2: floor-region self-localization at six places on the field (Fig. 8), and its \
+            error map over the whole field",
     run: replay,
 };
 
@@ -202,15 +226,34 @@ pub const SCENARIO: (&str, &str) = (
     include_str!("../../scenarios/selfloc_field.toml"),
 );
 
+/// The error map's scenario file, built into the binary.
+pub const MAP_SCENARIO: (&str, &str) = (
+    "scenarios/selfloc_map.toml",
+    include_str!("../../scenarios/selfloc_map.toml"),
+);
+
 /// Runs E2, writes the run into `out/`, the places with their errors (like Fig. 8) into
-/// `places.png` and the table into `places.md`.
+/// `places.png` and the table into `places.md`; then the error map over the whole field,
+/// its run into `out/map/`, its figure and rows into `selfloc_map.png` and `selfloc_map.csv`
+/// and its table into `selfloc_map.md`.
 fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
     let out = ctx.out.to_path_buf();
     let run = ctx.run("selfloc_field", SCENARIO.0, SCENARIO.1, &out)?;
     draw_places(&out.join("places.png"), &run.scenario, &run.output)?;
     let md = places_table(&run.output.summary);
     write_text(&out.join("places.md"), &md)?;
-    Ok(md)
+
+    let mut map = ctx.simulate("selfloc_map", MAP_SCENARIO.0, MAP_SCENARIO.1)?;
+    // The map's own files go to the top, where a user looks first; the rest of its run below.
+    let files = std::mem::take(&mut map.output.files);
+    write_run(&out.join("map"), &map.scenario, &map.output)?;
+    for f in files {
+        let path = out.join(&f.name);
+        std::fs::write(&path, &f.bytes).with_context(|| format!("writing {}", path.display()))?;
+    }
+    let map_md = map_table(&map.output.summary);
+    write_text(&out.join("selfloc_map.md"), &map_md)?;
+    Ok(format!("{md}\n{map_md}"))
 }
 
 /// Fig. 8: the field with its cubes, each place with the robot's outline, its estimates, and
@@ -247,6 +290,7 @@ fn draw_places(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Res
             discs: None,
         }],
         markers,
+        spots: Vec::new(),
     };
     draw_panels(file, &[panel], 1100)?;
     Ok(())
@@ -256,10 +300,18 @@ fn draw_places(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Res
 pub fn places_table(m: &Summary) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# E2: self-localization on the field\n");
+    let method = m
+        .experiment
+        .get("localization")
+        .and_then(|v| serde_json::from_value::<PlacesMethod>(v.clone()).ok())
+        .map_or("-", |h| match h.method {
+            LocalizationMethod::Paper => "the paper's (Sect. 4, steps 1-7, as published)",
+            LocalizationMethod::Robust => "robust (boundary points, decision rule)",
+        });
     let _ = writeln!(
         s,
-        "Renderer: {}. Seed {}. Global mode: every frame from no prior. Paper: errors of \
-         \"dozens of mm\" at each place.\n",
+        "Renderer: {}. Seed {}. Method: {method}. Global mode: every frame from no prior. \
+         Paper: errors of \"dozens of mm\" at each place.\n",
         m.renderer.clone().unwrap_or_else(|| "-".into()),
         m.seed
     );

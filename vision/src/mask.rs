@@ -76,20 +76,28 @@ impl Mask {
             self.data.iter_mut().for_each(|m| *m = 0);
             return;
         }
-        let span = [0, 1, 2].map(|k| floor.rgb_max[k] - floor.rgb_min[k]);
+        // Four bytes a pixel as one 32-bit word (R in the low byte), and every byte compared
+        // at once in it ("SWAR", so that the compiler vectorises the loop over 32-bit lanes):
+        // per byte, `d = p - lo` (wrapping) and then `d <= hi - lo`, which holds exactly when
+        // `lo <= p <= hi`. Alpha is left out.
+        const H: u32 = 0x8080_8080;
+        const RGB_HIGH: u32 = 0x0080_8080;
+        let word = |b: [u8; 3]| u32::from_le_bytes([b[0], b[1], b[2], 0]);
+        let lo = word(lo);
+        let span = word([0, 1, 2].map(|k| floor.rgb_max[k] - floor.rgb_min[k]));
         let raw = img.as_raw();
         let stride = img.width() as usize * 4;
         for y in 0..h {
             let row = &raw[(y + y0) * stride + x0 * 4..(y + y0) * stride + x1 * 4];
-            for (o, p) in self.data[y * w..(y + 1) * w]
-                .iter_mut()
-                .zip(row.chunks_exact(4))
-            {
-                // Unsigned wrap-around: `p - lo <= hi - lo` holds exactly when
-                // `lo <= p <= hi`.
-                *o = ((p[0].wrapping_sub(lo[0]) <= span[0])
-                    & (p[1].wrapping_sub(lo[1]) <= span[1])
-                    & (p[2].wrapping_sub(lo[2]) <= span[2])) as u8;
+            let (pixels, _) = row.as_chunks::<4>();
+            for (o, p) in self.data[y * w..(y + 1) * w].iter_mut().zip(pixels) {
+                let p = u32::from_le_bytes(*p);
+                // Bytewise p - lo with no borrow between bytes.
+                let d = ((p | H).wrapping_sub(lo & !H)) ^ ((p ^ !lo) & H);
+                // Bytewise span >= d: the high bits decide, else the low seven.
+                let low = (span | H).wrapping_sub(d & !H);
+                let ge = ((span & !d) | (!(span ^ d) & low)) & RGB_HIGH;
+                *o = (ge == RGB_HIGH) as u8;
             }
         }
     }
@@ -198,6 +206,53 @@ impl Mask {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn binarization_agrees_with_the_colour_box_for_every_red_and_green() {
+        // Every (r, g) pair, with blue at and around the box's bounds and the extremes, alpha
+        // anything: the word-at-a-time comparison must give exactly the box's answer.
+        let boxes = [
+            FloorColor::default(),
+            FloorColor {
+                rgb_min: [0, 0, 0],
+                rgb_max: [255, 255, 255],
+            },
+            FloorColor {
+                rgb_min: [128, 127, 129],
+                rgb_max: [128, 200, 255],
+            },
+            FloorColor {
+                rgb_min: [1, 254, 0],
+                rgb_max: [254, 255, 0],
+            },
+        ];
+        let mut m = Mask::new(0, 0);
+        for floor in &boxes {
+            let (lo, hi) = (floor.rgb_min[2], floor.rgb_max[2]);
+            let blues = [
+                0,
+                1,
+                127,
+                128,
+                254,
+                255,
+                lo,
+                hi,
+                lo.saturating_sub(1),
+                hi.saturating_add(1),
+            ];
+            for b in blues {
+                let img = RgbaImage::from_fn(256, 256, |r, g| {
+                    image::Rgba([r as u8, g as u8, b, (r ^ g) as u8])
+                });
+                m.binarize(&img, floor);
+                for (k, p) in img.pixels().enumerate() {
+                    let want = floor.contains([p[0], p[1], p[2]]);
+                    assert_eq!(m.data[k] == 1, want, "{p:?} in {floor:?}");
+                }
+            }
+        }
+    }
 
     fn mask(rows: &[&str]) -> Mask {
         let h = rows.len();

@@ -4,7 +4,7 @@
 //! back to the global search when tracking fails; before, it searches globally, the
 //! prediction (the start pose moved by odometry) only choosing between the twins.
 
-use super::{Belief, Percepts, Stage, image};
+use super::{Belief, Percepts, Sighting, Stage, image};
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::estimates::{Measurement, NotFound};
@@ -61,14 +61,15 @@ impl Stage for FloorLocalizationStage {
             _ => self.localizer.locate(img, belief.pose.as_ref())?,
         };
         match result {
-            Localization::Localized(e) => out.fixes.push((
-                self.name(),
-                Measurement::Pose {
+            Localization::Localized(e) => out.fixes.push(Sighting {
+                source: self.name(),
+                measurement: Measurement::Pose {
                     pose: e.pose,
                     alternative: Some(e.alternative),
                     unambiguous: e.quality.resolved_by_goals,
                 },
-            )),
+                quality: Some(e.quality),
+            }),
             Localization::NotLocalized(reason) => out.not_found.push(NotFound {
                 source: self.name(),
                 reason,

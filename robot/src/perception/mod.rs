@@ -13,17 +13,28 @@ use crate::config::RobotConfig;
 use crate::estimates::{Measurement, NotFound};
 use image::RgbaImage;
 use nalgebra::Isometry2;
-use omniloop_vision::{FreeSpace, RadialCalibration};
+use omniloop_vision::{FreeSpace, LocalizationQuality, RadialCalibration};
 
 /// What the stages of one cycle found.
 #[derive(Debug, Clone, Default)]
 pub struct Percepts {
     /// Free space around the robot.
     pub freespace: Option<FreeSpace>,
-    /// Measurements for the estimator, with the stage that made each.
-    pub fixes: Vec<(&'static str, Measurement)>,
+    /// Measurements for the estimator.
+    pub fixes: Vec<Sighting>,
     /// Stages that found nothing, and why.
     pub not_found: Vec<NotFound>,
+}
+
+/// A measurement, the stage that made it and how good that stage judged it.
+#[derive(Debug, Clone)]
+pub struct Sighting {
+    /// The stage.
+    pub source: &'static str,
+    /// The measurement.
+    pub measurement: Measurement,
+    /// Its quality record, when the stage keeps one.
+    pub quality: Option<LocalizationQuality>,
 }
 
 /// What the estimator believes at the start of a cycle, as the stages may use it.

@@ -440,7 +440,13 @@ impl FloorLocalizer {
         self.mask.binarize_region(img, &self.config.floor, region);
         self.mask
             .clean(self.config.morphology_iterations, &mut self.scratch);
-        let floor_pixels = self.mask.data.iter().filter(|&&m| m != 0).count();
+        // The mask holds 0 or 1: a sum by rows of at most 255 pixels' worth in u16 lanes.
+        let floor_pixels: usize = self
+            .mask
+            .data
+            .chunks(255)
+            .map(|c| c.iter().map(|&m| u16::from(m)).sum::<u16>() as usize)
+            .sum();
         Ok((floor_pixels < self.config.min_floor_pixels).then(|| {
             format!(
                 "floor region too small ({floor_pixels} pixels, need {})",

@@ -57,6 +57,15 @@ enum Beyond {
     Occluder,
 }
 
+/// A sector of the image: azimuths `from..to` (rad, image angle about the principal point)
+/// and radii `r_in..r_out` (px).
+struct GoalSector {
+    from: f64,
+    to: f64,
+    r_in: f64,
+    r_out: f64,
+}
+
 /// The boundary points of an image.
 struct WallPoints {
     points: Vec<BoundaryPoint>,
@@ -148,7 +157,7 @@ impl FloorLocalizer {
             return Localization::NotLocalized(why);
         }
         // Tracking: the solution turned like the prior (the twin is turned half round from it);
-        // global: the goals, else the hint.
+        // global: the goals' colours where the solutions put the goals, else the hint.
         let (chosen, other, by_goals) = match prior {
             Some(p) => {
                 let (a, b) = frame.poses();
@@ -159,7 +168,26 @@ impl FloorLocalizer {
                     (b, a, false)
                 }
             }
-            None => self.choose(img, &frame, hint),
+            None => {
+                let (a, b) = frame.poses();
+                match self.sector_vote(img, &a) {
+                    Some(true) => (a, b, true),
+                    Some(false) => (b, a, true),
+                    None => {
+                        let nearer_b = hint.is_some_and(|h| {
+                            let d = |q: &Isometry2<f64>| {
+                                (q.translation.vector - h.translation.vector).norm()
+                            };
+                            d(&b) < d(&a)
+                        });
+                        if nearer_b {
+                            (b, a, false)
+                        } else {
+                            (a, b, false)
+                        }
+                    }
+                }
+            }
         };
         Localization::Localized(PoseEstimate {
             pose: chosen,
@@ -214,6 +242,116 @@ impl FloorLocalizer {
                 .ok_or_else(|| "the fit near the prior did not converge".to_string()),
             None => direct.ok_or_else(|| "the fit from the prior did not converge".to_string()),
         }
+    }
+
+    /// Which of the two solutions the goals' colours support: `Some(true)` for `a`,
+    /// `Some(false)` for its half-turn twin, `None` when neither goal colour is seen where the
+    /// solutions put the goals.
+    ///
+    /// The twin puts the +x goal where `a` puts the -x goal and the other way round, so only
+    /// two sectors of the image matter: `S1`, where `a` sees the +x goal, and `S2`, where it
+    /// sees the -x goal. `a` predicts the +x colour in `S1` and the -x colour in `S2`, the twin
+    /// the opposite; the colours counted there vote. (The paper's method counts goal colours
+    /// over the whole image; looking only where the goals can be is cheaper, and another
+    /// robot's blue or yellow marker elsewhere cannot sway it.)
+    fn sector_vote(&self, img: &RgbaImage, a: &Isometry2<f64>) -> Option<bool> {
+        let c = &self.config;
+        let (s1, s2) = (
+            self.goal_sector(a, 1.0)
+                .map(|s| self.count_goal_colours(img, &s)),
+            self.goal_sector(a, -1.0)
+                .map(|s| self.count_goal_colours(img, &s)),
+        );
+        let [y1, b1] = s1.unwrap_or([0, 0]);
+        let [y2, b2] = s2.unwrap_or([0, 0]);
+        let (for_a, for_b) = (y1 + b2, b1 + y2);
+        if for_a.max(for_b) < c.min_goal_pixels || for_a == for_b {
+            return None;
+        }
+        Some(for_a > for_b)
+    }
+
+    /// Where, in the image, the goal at `side` (+1: +x, -1: -x) lies when the robot stands at
+    /// `pose`: its azimuth range about the camera axis (from the goal box's corners, widened by
+    /// three degrees) and the image radius of its nearest point on the floor.
+    fn goal_sector(&self, pose: &Isometry2<f64>, side: f64) -> Option<GoalSector> {
+        let f = &self.config.field;
+        // The goal box: the pocket from the goal line back, with room for the walls.
+        let (x0, x1, half) = (f.a1_mm, f.a2_mm + 60.0, f.goal_half_width_mm + 60.0);
+        let [mx, my] = self.cal.mount_mm;
+        let corners: Vec<Vector2<f64>> = [(x0, -half), (x0, half), (x1, -half), (x1, half)]
+            .iter()
+            .map(|&(x, y)| {
+                let q = pose.inverse_transform_point(&Point2::new(side * x, y));
+                Vector2::new(q.x - mx, q.y - my)
+            })
+            .collect();
+        let mid = corners.iter().sum::<Vector2<f64>>() / 4.0;
+        let centre = mid.y.atan2(mid.x);
+        let offsets = corners
+            .iter()
+            .map(|q| Rotation2::new(q.y.atan2(q.x) - centre).angle());
+        let (lo, hi) = offsets.fold((0.0f64, 0.0f64), |(lo, hi), o| (lo.min(o), hi.max(o)));
+        let margin = 3f64.to_radians();
+        // Inside the box (in the pocket) the goal is all around.
+        let inside = {
+            let q = pose * Point2::new(mx, my);
+            (x0..=x1).contains(&(side * q.x)) && q.y.abs() <= half
+        };
+        let (from, to) = if inside {
+            (-PI, PI)
+        } else {
+            (lo - margin, hi + margin)
+        };
+        let nearest = if inside {
+            0.0
+        } else {
+            corners
+                .iter()
+                .map(|q| q.norm())
+                .fold(f64::INFINITY, f64::min)
+                .min(mid.norm())
+        };
+        let r_in = self
+            .cal
+            .image_radius_px(nearest)
+            .unwrap_or(self.cal.samples.first()?[0])
+            .max(self.cal.samples.first()?[0]);
+        Some(GoalSector {
+            from: centre + from,
+            to: centre + to,
+            r_in,
+            r_out: self.cal.horizon_px * 1.1,
+        })
+    }
+
+    /// Pixels of the +x and -x goal colours in a sector of the image, sampled every other
+    /// pixel along and across the rays (each sample standing for four pixels).
+    fn count_goal_colours(&self, img: &RgbaImage, s: &GoalSector) -> [usize; 2] {
+        let c = &self.config;
+        let [cx, cy] = self.cal.principal_point_px;
+        let (w, h) = (img.width() as f64, img.height() as f64);
+        let mut n = [0usize; 2];
+        let mut r = s.r_in.max(1.0);
+        while r <= s.r_out {
+            let steps = ((s.to - s.from) * r / 2.0).ceil().max(1.0) as usize;
+            // The ray's direction turned step by step (a rotation a sample), not recomputed.
+            let (ds, dc) = ((s.to - s.from) / steps as f64).sin_cos();
+            let (mut sin, mut cos) = s.from.sin_cos();
+            for _ in 0..=steps {
+                let (u, v) = ((cx + r * cos).floor(), (cy - r * sin).floor());
+                (cos, sin) = (cos * dc - sin * ds, sin * dc + cos * ds);
+                if u < 0.0 || v < 0.0 || u >= w || v >= h {
+                    continue;
+                }
+                let p = img.get_pixel(u as u32, v as u32).0;
+                let rgb = [p[0], p[1], p[2]];
+                n[0] += 4 * c.goal_pos_x.contains(rgb) as usize;
+                n[1] += 4 * c.goal_neg_x.contains(rgb) as usize;
+            }
+            r += 2.0;
+        }
+        n
     }
 
     /// The decision rule's reason to say "not localized", if any.
@@ -274,7 +412,9 @@ impl FloorLocalizer {
         // The last few points of each of the four traces (first and last floor pixel of the
         // rows, of the columns), by the row or column they came from.
         const BASE: usize = Directions::BASE;
-        let mut last: [[Option<(usize, Point2<f64>)>; BASE]; 4] = [[None; BASE]; 4];
+        /// A point and the row or column it came from.
+        type Traced = Option<(usize, Point2<f64>)>;
+        let mut last: [[Traced; BASE]; 4] = [[None; BASE]; 4];
         // (eu, ev): the outer edge of the outermost floor pixel of a row or column, in
         // continuous mask coordinates; trace and row or column.
         let mut consider = |eu: f64, ev: f64, trace: usize, index: usize| {
@@ -359,12 +499,25 @@ impl FloorLocalizer {
         &self,
         points: &[BoundaryPoint],
         model: &Model,
+        frame: FieldFrame,
+        max: usize,
+    ) -> Option<(FieldFrame, Step, usize)> {
+        self.refine_from(points, model, frame, max, 0)
+    }
+
+    /// [`Self::refine`] from a frame that has already had `settled` of its iterations (a
+    /// trial's, at most two of them with the initial gate): those are not run again.
+    fn refine_from(
+        &self,
+        points: &[BoundaryPoint],
+        model: &Model,
         mut frame: FieldFrame,
         max: usize,
+        settled: usize,
     ) -> Option<(FieldFrame, Step, usize)> {
         let c = &self.config;
         let mut last = None;
-        for k in 0..max.max(3) {
+        for k in settled.min(2)..max.max(3) {
             let gate = if k < 2 { c.gate_initial_mm } else { c.gate_mm };
             let step = fit_step(points, model, &posts(&self.config.field), &frame, gate)?;
             let d = step.delta;
@@ -417,20 +570,20 @@ impl FloorLocalizer {
         model: &Model,
         rough_direction: Option<f64>,
     ) -> Result<(FieldFrame, Step, usize), String> {
-        // The trials run on every third point: enough to tell the guesses apart. Each guess is
+        // The trials run on every fourth point: enough to tell the guesses apart. Each guess is
         // scored by what its first step explains on every sixth, and the best few are refined
         // further.
-        let sample: Vec<BoundaryPoint> = points.iter().step_by(3).copied().collect();
+        let sample: Vec<BoundaryPoint> = points.iter().step_by(4).copied().collect();
         let sparse: Vec<BoundaryPoint> = points.iter().step_by(6).copied().collect();
         let posts = posts(&self.config.field);
         let mut guesses: Vec<(FieldFrame, f64)> =
             first_guesses(points, &self.config.field, rough_direction)
-            .into_iter()
-            .filter_map(|g| {
-                fit_step(&sparse, model, &posts, &g, self.config.gate_initial_mm)
-                    .map(|s| (g, s.explained))
-            })
-            .collect();
+                .into_iter()
+                .filter_map(|g| {
+                    fit_step(&sparse, model, &posts, &g, self.config.gate_initial_mm)
+                        .map(|s| (g, s.explained))
+                })
+                .collect();
         guesses.sort_by(|a, b| b.1.total_cmp(&a.1));
         let mut trials: Vec<(FieldFrame, f64)> = guesses
             .into_iter()
@@ -443,13 +596,22 @@ impl FloorLocalizer {
             return Err("no first guess converged to a field the boundary fits".into());
         };
         let (frame, step, iterations) = self
-            .refine(points, model, best, self.config.max_iterations)
+            .refine_from(
+                points,
+                model,
+                best,
+                self.config.max_iterations,
+                TRIAL_ITERATIONS,
+            )
             .ok_or_else(|| "the best first guess did not converge".to_string())?;
         // Rivals: the other trials that came near the best, finished too.
         let rival = trials
             .iter()
             .filter(|(f, e)| !same_field(f, &frame) && *e >= AMBIGUOUS_SHARE * best_trial - 0.05)
-            .filter_map(|(f, _)| self.refine(points, model, *f, self.config.max_iterations))
+            .filter_map(|(f, _)| {
+                let max = self.config.max_iterations;
+                self.refine_from(points, model, *f, max, TRIAL_ITERATIONS)
+            })
             .find(|(f, s, _)| {
                 !same_field(f, &frame) && s.explained >= AMBIGUOUS_SHARE * step.explained
             });
@@ -746,7 +908,10 @@ fn outer_walls(mut values: Vec<f64>) -> (f64, f64) {
             values.select_nth_unstable_by(k, f64::total_cmp);
         }
         values[..k].sort_unstable_by(f64::total_cmp);
-        values[..k].windows(BACKING).find(|w| backed(w)).map(|w| w[0])
+        values[..k]
+            .windows(BACKING)
+            .find(|w| backed(w))
+            .map(|w| w[0])
     };
     let hi = {
         if k < n {
@@ -764,7 +929,11 @@ fn outer_walls(mut values: Vec<f64>) -> (f64, f64) {
     }
     values.sort_unstable_by(f64::total_cmp);
     let lo = values.windows(BACKING).find(|w| backed(w)).map(|w| w[0]);
-    let hi = values.windows(BACKING).rev().find(|w| backed(w)).map(|w| w[BACKING - 1]);
+    let hi = values
+        .windows(BACKING)
+        .rev()
+        .find(|w| backed(w))
+        .map(|w| w[BACKING - 1]);
     (
         lo.or(values.first().copied()).unwrap_or(0.0),
         hi.or(values.last().copied()).unwrap_or(0.0),
