@@ -93,6 +93,14 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             BASE.replace("x_mm = 0.0, y_mm = 0.0", "x_mm = 0.0, y_mm = 2000.0"),
             ":4:11: field `robot.start.x_mm`: start (0, 2000) mm is outside the floor region",
         ),
+        (
+            "map_spacing",
+            format!(
+                "{BASE}\n[control]\npose_source = \"localization\"\n\n\
+                 [experiment.localization_map]\nspacing_mm = 5.0\n"
+            ),
+            ":14:1: field `experiment.localization_map.spacing_mm`: must be a finite number >= 20",
+        ),
     ];
     for (name, text, expected) in cases {
         let (code, err) = broken(name, &text);
