@@ -103,6 +103,7 @@ fn main() {
                     range_mm: fs.range_mm,
                     obstacle_points: &obstacles,
                     clear_points: &clear,
+                    blind_points: &[],
                 };
                 for v in velocities {
                     let t0 = Instant::now();

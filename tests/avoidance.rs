@@ -114,3 +114,23 @@ fn the_robot_reaches_waypoints_150_mm_from_the_walls_in_every_corner_of_the_fiel
         "{m:?}"
     );
 }
+
+#[test]
+fn a_robot_started_in_a_corner_of_the_field_leaves_it() {
+    // 150 mm from two walls, with nothing remembered yet: its body hides the walls' feet in more
+    // than half of the directions. It must still leave the corner and reach the goal along the
+    // touchline.
+    let mut s = scenario("field_corners.toml");
+    s.robot.start = Some(omniloop::scenario::PoseSpec {
+        x_mm: 1220.0,
+        y_mm: -612.5,
+        heading_deg: 0.0,
+    });
+    let goal = s.goal.as_mut().unwrap();
+    goal.waypoints_mm.clear();
+    s.run.duration_s = 15.0;
+    let m = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
+    eprintln!("{m:?}");
+    assert!(m.reached_goal, "{m:?}");
+    assert_eq!(m.wall_contacts, 0, "{m:?}");
+}

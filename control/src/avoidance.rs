@@ -29,6 +29,11 @@ pub struct Surroundings<'a> {
     /// Points on the boundary of the surely free space: obstacles placed as near as they may
     /// be, and where the unknown begins beyond the template, mm.
     pub clear_points: &'a [Vec2],
+    /// Something stands in these directions inside the blind zone of the robot's body, at a
+    /// distance nobody knows (vision sees only that the first ring is blocked, and nothing
+    /// remembers it): points at the body's edge, mm. The robot may pass them at a slant but
+    /// never head into them (see [`crate::VelocityAware`]).
+    pub blind_points: &'a [Vec2],
 }
 
 /// How the velocity-aware controller sets the speed of its command.

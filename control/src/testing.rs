@@ -25,6 +25,7 @@ pub fn surroundings(seen: &Seen) -> Surroundings<'_> {
         range_mm: 1000.0,
         obstacle_points: &seen.obstacles,
         clear_points: &seen.clear,
+        blind_points: &[],
     }
 }
 

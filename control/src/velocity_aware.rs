@@ -11,7 +11,9 @@
 //!   the boundary of the *surely* free space rather than the obstacle points: space beyond the
 //!   template's outer edge is unknown, not free, and a cell eq. (6) judges free may still be
 //!   partly occupied, so the robot never commits to a speed whose stopping distance exceeds what
-//!   it has seen to be free; an obstacle already within the clearance need only get no nearer.
+//!   it has seen to be free; an obstacle already within the clearance need only get no nearer,
+//!   and a blind point (something at an unknown distance inside the body's blind zone) may be
+//!   passed at a slant of up to 30 degrees, never headed into.
 //!   And the next decision comes one control period later, so the path that holds `v_b`
 //!   for that period and then brakes must be clear too: whatever the next cycle sees, braking
 //!   stays safe. In each direction the fastest admissible of `speeds` speeds is found (by
@@ -45,6 +47,13 @@ pub struct VelocityAware {
 const COURSE_WEIGHT: f64 = 0.5;
 /// Below this speed the robot has no course to keep.
 const COURSE_MIN_SPEED_MM_S: f64 = 50.0;
+/// Chosen speeds: a path may pass a blind point (something at an unknown distance, placed at
+/// the body's edge) at this slant from it, radians: it keeps `cos` of the point's distance.
+/// Held to "no nearer" (a right angle), a robot that starts in a corner, its blind zone
+/// holding walls in more than half of the directions, could not move at all; at this slant
+/// it leaves along the free arc's middle, and moving toward a wall stays forbidden (the
+/// nearer the wall, the wider the blocked arc).
+const BLIND_SLANT_RAD: f64 = std::f64::consts::FRAC_PI_6;
 
 /// An obstacle point and the squared distance every predicted path must keep from it.
 #[derive(Debug, Clone, Copy)]
@@ -241,7 +250,12 @@ impl VelocityAware {
         // can always move away.
         let clearance = self.radius_mm + self.config.margin_mm;
         let points = [s.clear_points];
-        let near = self.reachable(&points, v_now, speed, clearance, true);
+        let mut near = self.reachable(&points, v_now, speed, clearance, true);
+        let keep = BLIND_SLANT_RAD.cos();
+        near.extend(s.blind_points.iter().map(|&p| Obstacle {
+            p,
+            c2: (clearance * clearance).min(p.norm_squared() * keep * keep),
+        }));
         // Moving, the robot keeps to its course unless another serves the goal clearly better,
         // so that it follows a wall round to a goal behind it instead of dithering where the
         // goal direction is blocked and both ways along the wall look alike.
@@ -310,6 +324,7 @@ impl VelocityAware {
 mod tests {
     use super::*;
     use crate::testing::{drive, rush_at_wall, surroundings, wall_ahead};
+    use std::f64::consts::FRAC_PI_3;
 
     fn controller(speed: SpeedChoice, check_period_brake: bool, v_max: f64) -> VelocityAware {
         let cfg = AvoidanceConfig {
@@ -393,6 +408,7 @@ mod tests {
             range_mm: 1000.0,
             obstacle_points: &pts,
             clear_points: &pts,
+            blind_points: &[],
         };
         for speed in [SpeedChoice::Fixed, SpeedChoice::Chosen] {
             let d = controller(speed, false, 400.0).decide(
@@ -402,6 +418,62 @@ mod tests {
             );
             assert_eq!(d.v_mm_s, Vec2::zeros());
             assert!(d.heading_rad.is_none());
+        }
+    }
+
+    /// Blind points at the body's edge (90 mm) in the directions `from_deg..=to_deg`, three a
+    /// sector of 32 as the near-field memory gives them, and clear space (1000 mm) elsewhere.
+    fn blind_arc(from_deg: i32, to_deg: i32) -> (Vec<f64>, Vec<f64>, Vec<Vec2>, Vec<Vec2>) {
+        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
+        let half = TAU / 64.0;
+        let (mut clear, mut blind) = (Vec::new(), Vec::new());
+        for &c in &dirs {
+            let deg = (c.to_degrees().round() as i32 - from_deg).rem_euclid(360);
+            let is_blind = deg <= (to_deg - from_deg).rem_euclid(360);
+            let (out, r) = if is_blind {
+                (&mut blind, 90.0)
+            } else {
+                (&mut clear, 1000.0)
+            };
+            for phi in [c - half, c, c + half] {
+                out.push(Vec2::new(phi.cos(), phi.sin()) * r);
+            }
+        }
+        (dirs, vec![1000.0; 32], clear, blind)
+    }
+
+    #[test]
+    fn from_a_corner_it_leaves_along_the_free_arc_and_never_heads_into_a_blind_point() {
+        let c = controller(SpeedChoice::Chosen, false, 400.0);
+        let decide = |from: i32, to: i32, goal: Vec2| {
+            let (dirs, free, clear, blind) = blind_arc(from, to);
+            let s = Surroundings {
+                direction_rad: &dirs,
+                free_mm: &free,
+                range_mm: 1000.0,
+                obstacle_points: &[],
+                clear_points: &clear,
+                blind_points: &blind,
+            };
+            (c.decide(&s, goal, Vec2::zeros()).v_mm_s, blind)
+        };
+        // A corner: walls behind and to the right, blind from 225 through 45 degrees (a half
+        // turn and more with the sectors' edges); the goal up and to the left.
+        let (v, blind) = decide(225, 45, Vec2::new(-1200.0, 600.0));
+        assert!(v.norm() > 1.0, "stood still in the corner");
+        for p in &blind {
+            let off = (v.dot(p) / (v.norm() * p.norm())).acos();
+            assert!(
+                off >= FRAC_PI_3 - 1e-9,
+                "{:.1} deg off a blind point",
+                off.to_degrees()
+            );
+        }
+        // Something blind straight ahead, the goal beyond it: the robot does not head into it.
+        let (v, blind) = decide(-45, 45, Vec2::new(1000.0, 0.0));
+        for p in &blind {
+            let off = (v.dot(p) / (v.norm().max(1e-12) * p.norm())).acos();
+            assert!(v.norm() < 1e-9 || off >= FRAC_PI_3 - 1e-9, "{v:?}");
         }
     }
 

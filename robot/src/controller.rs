@@ -3,7 +3,7 @@
 use crate::RobotError;
 use crate::boundary::BodyCommand;
 use crate::config::{ControllerKind, RobotConfig};
-use crate::near_field::NearField;
+use crate::near_field::{NearField, NearSpace};
 use nalgebra::{Isometry2, Vector2};
 use omniloop_control::{
     AccelLimitedDrive, GoalDirection, SpeedChoice, Surroundings, VelocityAware,
@@ -67,11 +67,11 @@ impl Controller for Idle {
     }
 }
 
-/// Runs `f` on the surroundings vision reported (with `clear` as the surely free boundary, when
+/// Runs `f` on the surroundings vision reported (with `near` as the surely free boundary, when
 /// given) and the target, or stops without either.
 fn with_surroundings(
     s: &Situation<'_>,
-    clear: Option<Vec<Vector2<f64>>>,
+    near: Option<NearSpace>,
     f: impl FnOnce(&Surroundings<'_>, Vector2<f64>) -> Vector2<f64>,
 ) -> BodyCommand {
     let (Some(fs), Some(target)) = (s.freespace, s.target_body_mm) else {
@@ -81,13 +81,17 @@ fn with_surroundings(
         pts.iter().map(|p| p.coords).collect()
     };
     let obstacles = coords(&fs.obstacle_points);
-    let clear = clear.unwrap_or_else(|| coords(&fs.clear_points));
+    let near = near.unwrap_or_else(|| NearSpace {
+        clear: coords(&fs.clear_points),
+        blind: Vec::new(),
+    });
     let surroundings = Surroundings {
         direction_rad: &fs.direction_rad,
         free_mm: &fs.free_mm,
         range_mm: fs.range_mm,
         obstacle_points: &obstacles,
-        clear_points: &clear,
+        clear_points: &near.clear,
+        blind_points: &near.blind,
     };
     BodyCommand::translate(f(&surroundings, target))
 }

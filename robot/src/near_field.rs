@@ -6,8 +6,9 @@
 //! saw the obstacle, though, while it approached: this memory keeps the surely-free boundary
 //! points of near obstacles in the odometry frame for a few seconds and, in a direction whose
 //! first ring is blocked, hands the controller the remembered points there (moved by the
-//! odometry since), or a point at the body's edge when it remembers none (something is there:
-//! the robot may move along it or away from it, never toward it).
+//! odometry since), or, when it remembers none, a blind point at the body's edge (something is
+//! there at a distance nobody knows: the robot may pass it at a slant or move away from it,
+//! never head into it).
 
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_vision::FreeSpace;
@@ -19,6 +20,15 @@ const NEAR_MM: f64 = 450.0;
 const KEEP_S: f64 = 2.0;
 /// Points closer than this to a remembered one refresh it instead of adding another, mm.
 const MERGE_MM: f64 = 12.0;
+
+/// The surely free space's boundary handed to the controller (robot frame).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NearSpace {
+    /// Seen this cycle, or remembered where the first ring is blocked, mm.
+    pub clear: Vec<Vector2<f64>>,
+    /// Where the first ring is blocked and nothing is remembered: at the body's edge, mm.
+    pub blind: Vec<Vector2<f64>>,
+}
 
 /// Remembered obstacle points near the robot.
 #[derive(Debug, Clone)]
@@ -39,18 +49,21 @@ impl NearField {
 
     /// Takes this cycle's free space, seen at odometry pose `odo` at time `t_s`, and returns
     /// the boundary of the surely free space (robot frame): fresh where the first ring is clear,
-    /// remembered (or at the body's edge) where it is blocked.
-    pub fn update(&mut self, fs: &FreeSpace, odo: &Isometry2<f64>, t_s: f64) -> Vec<Vector2<f64>> {
+    /// remembered (or blind points at the body's edge) where it is blocked.
+    pub fn update(&mut self, fs: &FreeSpace, odo: &Isometry2<f64>, t_s: f64) -> NearSpace {
         let here = Point2::from(odo.translation.vector);
         self.points
             .retain(|&(p, t)| t_s - t <= KEEP_S && (p - here).norm() <= 2.0 * NEAR_MM);
         let n = fs.direction_rad.len();
         let half = 0.5 * TAU / n as f64;
-        let mut out = Vec::with_capacity(3 * n);
+        let mut out = NearSpace {
+            clear: Vec::with_capacity(3 * n),
+            blind: Vec::new(),
+        };
         for j in 0..n {
             let fresh = &fs.clear_points[3 * j..3 * j + 3];
             if fs.a[j] > 0 {
-                out.extend(fresh.iter().map(|p| p.coords));
+                out.clear.extend(fresh.iter().map(|p| p.coords));
                 // An obstacle, not the template's edge, and near: its point on the direction's
                 // centre line is remembered (the points at the sector's edges stand in for the
                 // whole cell and, at a wall seen at a grazing angle, lie well inside the floor).
@@ -61,17 +74,18 @@ impl NearField {
             }
             // The first ring is blocked: the obstacle may be nearer than vision can tell.
             let c = fs.direction_rad[j];
-            let before = out.len();
+            let before = out.clear.len();
             for (p, _) in &self.points {
                 let q = odo.inverse_transform_point(p).coords;
                 let off = (q.y.atan2(q.x) - c + TAU / 2.0).rem_euclid(TAU) - TAU / 2.0;
                 if off.abs() <= half {
-                    out.push(q);
+                    out.clear.push(q);
                 }
             }
-            if out.len() == before {
+            if out.clear.len() == before {
                 for phi in [c - half, c, c + half] {
-                    out.push(Vector2::new(phi.cos(), phi.sin()) * self.radius_mm);
+                    out.blind
+                        .push(Vector2::new(phi.cos(), phi.sin()) * self.radius_mm);
                 }
             }
         }
@@ -141,18 +155,25 @@ mod tests {
                 .fold(f64::INFINITY, f64::min)
         };
         let out = m.update(&seen(300.0), &Isometry2::identity(), 0.0);
-        assert!((ahead(&out) - 300.0).abs() < 1e-9);
+        assert!((ahead(&out.clear) - 300.0).abs() < 1e-9);
+        assert!(out.blind.is_empty());
         // The robot moves 150 mm toward it: vision only says "blocked within 200 mm"; the
         // memory puts the wall at 150 mm, where it is.
         let odo = Isometry2::new(Vector2::new(150.0, 0.0), 0.0);
         let out = m.update(&seen(150.0), &odo, 0.5);
-        assert!((ahead(&out) - 150.0).abs() < 1e-9, "{}", ahead(&out));
-        // Without a memory of it, a blocked first ring means the body's edge.
+        assert!(
+            (ahead(&out.clear) - 150.0).abs() < 1e-9,
+            "{}",
+            ahead(&out.clear)
+        );
+        assert!(out.blind.is_empty());
+        // Without a memory of it, a blocked first ring means a blind point at the body's edge.
         let mut fresh = NearField::new(90.0);
         let out = fresh.update(&seen(150.0), &odo, 0.5);
-        assert!((ahead(&out) - 90.0).abs() < 1e-9);
+        assert!((ahead(&out.blind) - 90.0).abs() < 1e-9);
+        assert_eq!(ahead(&out.clear), f64::INFINITY);
         // Forgotten after a while.
         let out = m.update(&seen(150.0), &odo, 3.0);
-        assert!((ahead(&out) - 90.0).abs() < 1e-9);
+        assert!((ahead(&out.blind) - 90.0).abs() < 1e-9);
     }
 }
