@@ -57,6 +57,7 @@ fn trace(spec: &SensorSpec) -> Result<RadialCalibration, SimError> {
         mount_mm: sensor.mount_mm,
         samples: map.samples,
         horizon_px: map.horizon_px,
+        elevation: map.elevation,
         fit,
     })
 }

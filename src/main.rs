@@ -335,6 +335,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 cal.samples.len(),
                 cal.horizon_px
             );
+            if let (Some(first), Some(last)) = (cal.elevation.first(), cal.elevation.last()) {
+                println!(
+                    "elevation of the scene rays: {:.1} deg at R = 0 to {:.1} deg at R = {:.1} px",
+                    first[1].to_degrees(),
+                    last[1].to_degrees(),
+                    last[0]
+                );
+            }
             if let Some(f) = &cal.fit {
                 println!(
                     "f(R) = R / (A - B sqrt(C + R^2)), fitted for R <= {:.1} px:",

@@ -13,6 +13,9 @@ pub struct RadialMap {
     pub samples: Vec<[f64; 2]>,
     /// Image radius beyond which rays no longer reach the floor.
     pub horizon_px: f64,
+    /// `(R_px, elevation_rad)` every `step_px` from 0 to the mirror's edge in the image: the
+    /// angle of the pixel's scene ray above the horizontal (negative: toward the floor).
+    pub elevation: Vec<[f64; 2]>,
 }
 
 fn floor_distance(sensor: &Sensor, r_px: f64) -> Option<f64> {
@@ -70,7 +73,21 @@ pub fn trace_radial_map(sensor: &Sensor, step_px: f64) -> Result<RadialMap, SimE
     Ok(RadialMap {
         samples,
         horizon_px: 0.5 * (lo + hi),
+        elevation: trace_elevation(sensor, step_px, r_max),
     })
+}
+
+/// The elevation of the scene ray of image radius R along the image x axis, every `step_px`
+/// from 0 while the camera sees the mirror.
+fn trace_elevation(sensor: &Sensor, step_px: f64, r_max: f64) -> Vec<[f64; 2]> {
+    (0..)
+        .map(|k| k as f64 * step_px)
+        .take_while(|&big_r| big_r <= r_max)
+        .map_while(|big_r| {
+            let ray = sensor.optics.scene_ray(big_r.max(1e-9), 0.0)?;
+            Some([big_r, ray.dir.z.atan2(ray.dir.xy().norm())])
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -90,5 +107,43 @@ mod tests {
             map.horizon_px
         );
         assert!(map.samples.len() > 400);
+        // A single viewpoint: the rays turn horizontal exactly at the floor horizon.
+        let zero = map
+            .elevation
+            .windows(2)
+            .find(|w| w[0][1] < 0.0 && w[1][1] >= 0.0)
+            .unwrap();
+        assert!(zero[0][0] <= map.horizon_px + 1e-9 && map.horizon_px <= zero[1][0]);
+    }
+
+    #[test]
+    fn the_hemisphere_looks_down_at_its_centre_and_up_past_the_horizontal_at_its_rim() {
+        let spec = SensorSpec {
+            width_px: 256,
+            height_px: 256,
+            hyperbolic: None,
+            spherical: Some(crate::optics::SphericalMirror {
+                radius_mm: 30.0,
+                camera_distance_mm: 150.0,
+                focal_px: 530.0,
+                lens_height_mm: 150.0,
+            }),
+            ..SensorSpec::corner_paper("hemi")
+        };
+        let map = trace_radial_map(&spec.build().unwrap(), 0.25).unwrap();
+        let e = &map.elevation;
+        assert!((e[0][1] + std::f64::consts::FRAC_PI_2).abs() < 1e-6);
+        assert!(
+            e.windows(2).all(|w| w[1][1] > w[0][1]),
+            "elevation rises outward"
+        );
+        assert!(e.last().unwrap()[1] > 0.0);
+        // The floor horizon is where the rays turn horizontal (every ray pointing down meets
+        // the floor plane somewhere).
+        let zero = e
+            .windows(2)
+            .find(|w| w[0][1] < 0.0 && w[1][1] >= 0.0)
+            .unwrap();
+        assert!(zero[0][0] <= map.horizon_px + 1e-9 && map.horizon_px <= zero[1][0]);
     }
 }

@@ -49,6 +49,11 @@ pub struct RadialCalibration {
     pub samples: Vec<[f64; 2]>,
     /// Image radius of the floor horizon (rays beyond it do not reach the floor).
     pub horizon_px: f64,
+    /// `(R, elevation)` pairs, R strictly increasing from 0: the angle of the scene ray of
+    /// image radius R above the horizontal, radians (negative: toward the floor). Empty in
+    /// tables written before it was traced.
+    #[serde(default)]
+    pub elevation: Vec<[f64; 2]>,
     /// The paper's closed form fitted to the samples, where it applies.
     #[serde(default)]
     pub fit: Option<HyperbolicFit>,
@@ -144,6 +149,17 @@ impl RadialCalibration {
         }
         let u = (r_mm - a[1]) / (b[1] - a[1]);
         Some(a[0] + u * (b[0] - a[0]))
+    }
+
+    /// The image radius whose scene rays are at `elevation_rad` above the horizontal (the
+    /// first crossing outward, interpolated in the elevation column); `None` when the table
+    /// has no elevation column or never reaches it.
+    pub fn radius_at_elevation_px(&self, elevation_rad: f64) -> Option<f64> {
+        self.elevation.windows(2).find_map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let crosses = (a[1] - elevation_rad) * (b[1] - elevation_rad) <= 0.0 && a[1] != b[1];
+            crosses.then(|| a[0] + (elevation_rad - a[1]) / (b[1] - a[1]) * (b[0] - a[0]))
+        })
     }
 
     /// Image coordinates `(X, Y)` (from the principal point, Y up) of pixel `(u, v)`'s centre.
@@ -288,8 +304,30 @@ pub(crate) mod tests {
             mount_mm: [0.0, 0.0],
             samples,
             horizon_px: 113.9,
+            // A made-up elevation column, straight from -90 degrees at R = 0 to +10 at 120 px.
+            elevation: (0..=480)
+                .map(|k| {
+                    let r = k as f64 * 0.25;
+                    [r, (-90.0 + 100.0 * r / 120.0f64).to_radians()]
+                })
+                .collect(),
             fit: None,
         }
+    }
+
+    #[test]
+    fn the_horizontal_circle_is_where_the_elevation_crosses_zero() {
+        use std::f64::consts::PI;
+        let cal = table();
+        // -90 + 100 R / 120 = 0 at R = 108.
+        assert!((cal.radius_at_elevation_px(0.0).unwrap() - 108.0).abs() < 1e-9);
+        assert!((cal.radius_at_elevation_px(-0.5 * PI).unwrap()).abs() < 1e-9);
+        assert!(cal.radius_at_elevation_px(0.5).is_none());
+        let old = RadialCalibration {
+            elevation: Vec::new(),
+            ..cal
+        };
+        assert!(old.radius_at_elevation_px(0.0).is_none());
     }
 
     #[test]

@@ -7,6 +7,7 @@ pub mod calibration;
 pub mod floor_localization;
 pub mod freespace;
 pub mod geometry;
+pub mod luminance_heading;
 pub mod mask;
 
 pub use calibration::{HyperbolicFit, RadialCalibration};
