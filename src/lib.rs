@@ -6,11 +6,12 @@
 //! (`omniloop-robot`) what its sensors give and applies its commands ([`simulation`]), the
 //! sensors and actuators it simulates ([`cameras`], [`odometry`]), the truth-side scores
 //! ([`score`]), the experiments with their replays ([`experiments`]), what a run writes
-//! ([`record`], [`output`]) and the figures ([`topview`]). The world lives in `omniloop-sim`,
+//! ([`record`], [`output`]) and the figures ([`topview`], [`charts`]). The world lives in `omniloop-sim`,
 //! image processing in `omniloop-vision`, controllers in `omniloop-control`.
 
 pub mod calibrate;
 pub mod cameras;
+pub mod charts;
 pub mod experiments;
 pub mod load;
 pub mod odometry;

@@ -282,6 +282,14 @@ impl Scenario {
     pub fn needs_calibration(&self) -> bool {
         self.control.kind.uses_freespace()
             || self.control.pose_source == omniloop_robot::PoseSource::Localization
+            || self.experiment_takes_frames()
+    }
+
+    /// Whether the scenario's experiment takes camera frames itself.
+    pub fn experiment_takes_frames(&self) -> bool {
+        self.experiment
+            .as_ref()
+            .is_some_and(ExperimentSpec::takes_frames)
     }
 
     /// Where the robot under test starts (validation makes sure it is given).

@@ -165,7 +165,7 @@ impl Simulation {
         let cameras = Cameras::open(
             scenario,
             robot.cameras(),
-            options.save_frames_every.is_some(),
+            options.save_frames_every.is_some() || scenario.experiment_takes_frames(),
             options.renderer,
             notice,
         )?;

@@ -32,7 +32,7 @@ pub enum FigureError {
 static FONT: Once = Once::new();
 const FONT_BYTES: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() {
+pub(crate) fn register_font() {
     FONT.call_once(|| {
         // The font ships with the binary, so registering it cannot fail at run time.
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT_BYTES);

@@ -3,6 +3,7 @@
 
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::AvoidanceConfig;
+use omniloop_vision::luminance_heading::LuminanceConfig;
 use omniloop_vision::{FreeSpaceConfig, LocalizationConfig, RadialCalibration};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -93,6 +94,8 @@ pub struct VisionSpec {
     pub freespace: FreeSpaceConfig,
     /// Self-localization from the floor region (Sect. 4 of the corner paper).
     pub localization: LocalizationConfig,
+    /// Heading from a luminance circle (Kim, Kim and Kwon, Sect. 3).
+    pub luminance_heading: LuminanceConfig,
 }
 
 /// The goal point, reached through optional waypoints (`[goal]`), in the world (field) frame.

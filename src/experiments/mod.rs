@@ -8,6 +8,7 @@
 //! `docs/experiments.md`.
 
 pub mod corner;
+pub mod heading;
 pub mod localization_map;
 pub mod places;
 
@@ -65,7 +66,7 @@ struct Drive;
 impl Experiment for Drive {}
 
 /// The experiment a scenario belongs to (`[experiment.corner]`, `[experiment.places]`,
-/// `[experiment.localization_map]`).
+/// `[experiment.localization_map]`, `[experiment.heading]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExperimentSpec {
@@ -75,6 +76,8 @@ pub enum ExperimentSpec {
     Places(places::PlacesSpec),
     /// The self-localization error map: a grid over the whole floor region, both modes.
     LocalizationMap(localization_map::MapSpec),
+    /// E3: heading error from a luminance circle at a checkpoint.
+    Heading(heading::HeadingSpec),
 }
 
 impl ExperimentSpec {
@@ -84,6 +87,7 @@ impl ExperimentSpec {
             Self::Corner(spec) => spec.validate(c),
             Self::Places(spec) => spec.validate(s, c),
             Self::LocalizationMap(spec) => spec.validate(s, c),
+            Self::Heading(spec) => spec.validate(s, c),
         }
     }
 
@@ -91,8 +95,14 @@ impl ExperimentSpec {
     pub(crate) fn prepare(&self, s: &mut Scenario) {
         match self {
             Self::Corner(spec) => spec.prepare(s),
-            Self::Places(_) | Self::LocalizationMap(_) => {}
+            Self::Places(_) | Self::LocalizationMap(_) | Self::Heading(_) => {}
         }
+    }
+
+    /// Whether the experiment takes frames of the robot's camera itself (so the camera is
+    /// rendered and calibrated whatever the robot's software uses).
+    pub fn takes_frames(&self) -> bool {
+        matches!(self, Self::Heading(_))
     }
 
     /// The table `omniloop run` prints for a run of this experiment, if it has one.
@@ -101,6 +111,7 @@ impl ExperimentSpec {
             Self::Corner(_) => None,
             Self::Places(_) => Some(places::places_table(summary)),
             Self::LocalizationMap(_) => Some(localization_map::map_table(summary)),
+            Self::Heading(_) => Some(heading::heading_table(summary)),
         }
     }
 }
@@ -116,6 +127,9 @@ pub fn procedure(s: &Scenario) -> Box<dyn Experiment> {
         Some(ExperimentSpec::LocalizationMap(spec)) => Box::new(
             localization_map::LocalizationMap::new(spec, s.vision.localization.method),
         ),
+        Some(ExperimentSpec::Heading(spec)) => {
+            Box::new(heading::Heading::new(spec, &s.vision.luminance_heading))
+        }
     }
 }
 
@@ -130,7 +144,7 @@ pub struct Replay {
 }
 
 /// Every replay, in the order `omniloop replay --list` shows them.
-pub const REPLAYS: &[Replay] = &[corner::REPLAY, places::REPLAY];
+pub const REPLAYS: &[Replay] = &[corner::REPLAY, places::REPLAY, heading::REPLAY];
 
 /// The replay called `name`.
 pub fn replay(name: &str) -> Option<&'static Replay> {

@@ -33,12 +33,20 @@ pub struct LuminanceConfig {
     pub radius_px: Option<f64>,
     /// Samples on the circle (the paper: 360, one a degree).
     pub samples: usize,
+    /// The shift search a reading reports (both are computed where an experiment compares
+    /// them).
+    pub method: ShiftMethod,
     /// Eq. (1): samples averaged before (`N`) ...
     pub average_before: usize,
     /// ... and after (`M`) each one (the paper: M = N = 2, a 5-point moving average).
     pub average_after: usize,
     /// Eq. (11): a sample matches when the aligned reference and current grey levels differ by
-    /// less than this (`theta_th`, grey levels of 255).
+    /// less than this (`theta_th`, grey levels of 255; the paper gives no value). Default 20:
+    /// some fifteen times the smoothed circle's noise (sensor sigma 4 a channel is about 1.2
+    /// grey levels after eq. (1)), so noise alone never breaks a match, and a tenth of a
+    /// room's range of grey levels, so that a view from 40-50 cm away no longer matches. In
+    /// E3's room, 20 cm off the checkpoint, 12 levels match 70-72% of the samples (the edge of
+    /// the requirement), 20 levels 79-83%; with 20, N/A comes by 50 cm in every direction.
     pub match_threshold: f64,
     /// Eq. (10): a difference between neighbouring samples within this many grey levels has
     /// sign 0. Sect. 3.1: "variations within the threshold value are ignored"; without it the
@@ -56,9 +64,10 @@ impl Default for LuminanceConfig {
             elevation_deg: 0.0,
             radius_px: None,
             samples: 360,
+            method: ShiftMethod::Signs,
             average_before: 2,
             average_after: 2,
-            match_threshold: 12.0,
+            match_threshold: 20.0,
             sign_dead_band: 1.0,
             near_threshold: 25.0,
         }

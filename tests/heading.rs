@@ -1,0 +1,35 @@
+//! E3 end to end: heading error from a luminance circle through the hemispherical mirror, at
+//! the checkpoint of the room and off it.
+
+mod common;
+
+use common::{cpu, scenario};
+use omniloop::experiments::heading::heading_results;
+use omniloop::run_scenario;
+
+#[test]
+fn e3_turns_are_read_within_a_degree_and_translations_turn_na() {
+    let s = scenario("heading_room.toml");
+    let out = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
+    let h = heading_results(&out.summary).unwrap();
+    eprintln!("{h:#?}");
+    // The paper's turns, 20 noisy frames each: every frame within +-1 degree, none N/A.
+    assert_eq!(h.rotations.len(), 3);
+    for r in &h.rotations {
+        assert_eq!((r.frames, r.na_frames), (20, 0), "{r:?}");
+        assert!(r.max_abs_error_deg.unwrap() <= 1.0, "{r:?}");
+    }
+    // The whole turn in 5-degree steps.
+    assert_eq!(h.sweep_na, 0);
+    assert!(h.sweep_max_abs_error_deg.unwrap() <= 1.0, "{h:?}");
+    // Off the checkpoint: at 20 cm still read, within a few degrees; by 50 cm N/A everywhere.
+    for (dir, readings) in &h.translation_shift_deg {
+        let readings = readings.as_array().unwrap();
+        let at = |cm: usize| readings[cm / 5].as_f64();
+        let at20 = at(20).unwrap_or_else(|| panic!("{dir}: N/A at 20 cm"));
+        assert!(at20.abs() <= 3.0, "{dir}: {at20} deg at 20 cm");
+        for cm in [50, 55, 60] {
+            assert!(at(cm).is_none(), "{dir}: read at {cm} cm: {readings:?}");
+        }
+    }
+}
