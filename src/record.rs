@@ -115,6 +115,10 @@ pub struct Summary {
     /// With localization in the loop: how many localizations corrected the pose.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub localization_fixes: Option<usize>,
+    /// With checkpoints: the heading error at the end of each visit (the estimate within the
+    /// goal's `checkpoint_radius_mm` of a checkpoint), degrees.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub checkpoint_heading_error_deg: Option<Vec<f64>>,
     /// The experiment's own metrics (`turn_onset_mm`, `overshoot_mm` of E1, `places` of E2,
     /// ...), written as keys of the summary beside the others.
     #[serde(flatten)]

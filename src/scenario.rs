@@ -283,6 +283,10 @@ impl Scenario {
         self.control.kind.uses_freespace()
             || self.control.pose_source == omniloop_robot::PoseSource::Localization
             || self.experiment_takes_frames()
+            || self
+                .goal
+                .as_ref()
+                .is_some_and(|g| !g.checkpoints_mm.is_empty())
     }
 
     /// Whether the scenario's experiment takes camera frames itself.

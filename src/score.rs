@@ -15,6 +15,11 @@ pub struct TruthScore {
     time_to_goal_s: Option<f64>,
     freespace_errors_mm: Vec<f64>,
     pose_errors_mm: Vec<f64>,
+    checkpoints: Vec<Point2<f64>>,
+    checkpoint_radius_mm: f64,
+    /// The heading error at the last cycle of the visit in progress, if one is.
+    visit: Option<f64>,
+    visit_errors_deg: Vec<f64>,
 }
 
 impl TruthScore {
@@ -25,8 +30,45 @@ impl TruthScore {
             reached: vec![false; targets.len()],
             tolerance_mm: goal.map_or(0.0, |g| g.tolerance_mm),
             targets,
+            checkpoints: goal.map_or(Vec::new(), |g| {
+                g.checkpoints_mm
+                    .iter()
+                    .map(|c| Point2::new(c[0], c[1]))
+                    .collect()
+            }),
+            checkpoint_radius_mm: goal.map_or(0.0, |g| g.checkpoint_radius_mm),
             ..Self::default()
         }
+    }
+
+    /// After a cycle whose pose estimate was `estimate` and true pose `truth`: a visit to a
+    /// checkpoint lasts while the estimate is within the goal's `checkpoint_radius_mm` of
+    /// one (the robot reads its heading there), and is scored by the heading error at its
+    /// last cycle.
+    pub fn checkpoint(&mut self, estimate: &Isometry2<f64>, truth: &Isometry2<f64>) {
+        let here = Point2::from(estimate.translation.vector);
+        let inside = self
+            .checkpoints
+            .iter()
+            .any(|c| (c - here).norm() <= self.checkpoint_radius_mm);
+        if inside {
+            let err = (estimate.rotation.angle() - truth.rotation.angle()).to_degrees();
+            self.visit = Some((err + 180.0).rem_euclid(360.0) - 180.0);
+        } else if let Some(err) = self.visit.take() {
+            self.visit_errors_deg.push(err.abs());
+        }
+    }
+
+    /// The heading error at the end of each checkpoint visit, degrees (`None` without
+    /// checkpoints).
+    pub fn checkpoint_heading_errors_deg(&self) -> Option<Vec<f64>> {
+        (!self.checkpoints.is_empty()).then(|| {
+            self.visit_errors_deg
+                .iter()
+                .copied()
+                .chain(self.visit.map(f64::abs))
+                .collect()
+        })
     }
 
     /// After a cycle in which the robot headed for target `heading_for`, ending at `p` at time
@@ -114,10 +156,7 @@ mod tests {
     fn a_target_counts_only_while_the_robot_heads_for_it() {
         let goal = GoalSpec {
             waypoints_mm: vec![[1000.0, 0.0]],
-            x_mm: 0.0,
-            y_mm: 500.0,
-            tolerance_mm: 100.0,
-            estimate_margin_mm: 0.0,
+            ..GoalSpec::to([0.0, 500.0], 100.0)
         };
         let mut s = TruthScore::new(Some(&goal));
         // Passing the goal while heading for the waypoint does not reach the goal.

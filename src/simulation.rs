@@ -10,7 +10,7 @@ use crate::pilot::Pilot;
 use crate::record::{Summary, TrajectoryRow};
 use crate::scenario::Scenario;
 use crate::score::TruthScore;
-use nalgebra::{Isometry2, Point2, Rotation2};
+use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
 use omniloop_robot::{ControllerKind, Estimates, Observation, Robot, RobotError};
 use omniloop_sim::{RenderError, Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
@@ -328,6 +328,10 @@ impl Simulation {
     /// estimates, and scores the pose estimate.
     fn record(&mut self, t: f64, command: VelocityCommand, estimates: Estimates) {
         let row = self.row(t, command, estimates.pose);
+        if let Some(est) = &estimates.pose {
+            let truth = Isometry2::new(Vector2::new(row.x_mm, row.y_mm), row.theta_rad);
+            self.truth.checkpoint(est, &truth);
+        }
         if let (Some(x), Some(y)) = (row.est_x_mm, row.est_y_mm) {
             self.truth
                 .pose(Point2::new(x, y), Point2::new(row.x_mm, row.y_mm));
@@ -393,6 +397,7 @@ impl Simulation {
             pose_error_mm: self.truth.pose_error_mm(),
             targets_reached: self.truth.targets_reached(),
             localization_fixes: localizes.then(|| self.robot.fixes().0),
+            checkpoint_heading_error_deg: self.truth.checkpoint_heading_errors_deg(),
             experiment: serde_json::Map::new(),
         };
         RunOutput {

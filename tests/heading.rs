@@ -33,3 +33,26 @@ fn e3_turns_are_read_within_a_degree_and_translations_turn_na() {
         }
     }
 }
+
+#[test]
+fn on_patrol_the_checkpoint_keeps_the_heading_and_without_it_the_error_grows() {
+    // Ten laps through the checkpoint on odometry with a rotation-rate bias.
+    let mut s = scenario("heading_patrol.toml");
+    assert!(s.odometry.omega_bias_rad_s > 0.0);
+    let with = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
+    let visits = with.checkpoint_heading_error_deg.clone().unwrap();
+    eprintln!("with correction: {visits:.2?}; {with:?}");
+    assert!(with.reached_goal, "{with:?}");
+    assert_eq!(with.wall_contacts, 0);
+    // The start, nine passes and the arrival at the goal.
+    assert!(visits.len() >= 11, "{visits:?}");
+    assert!(visits.iter().all(|&e| e <= 1.5), "{visits:?}");
+    // The same patrol reading but not correcting: the error grows by the bias, lap by lap.
+    s.control.pose_source = omniloop_robot::PoseSource::Odometry;
+    let without = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
+    let drift = without.checkpoint_heading_error_deg.clone().unwrap();
+    eprintln!("without: {drift:.2?}");
+    assert!(drift.len() >= 11, "{drift:?}");
+    assert!(drift[1..].windows(2).all(|w| w[1] > w[0]), "{drift:?}");
+    assert!(*drift.last().unwrap() > 30.0, "{drift:?}");
+}

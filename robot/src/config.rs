@@ -53,6 +53,9 @@ pub enum PoseSource {
     /// Odometry corrected by floor-region self-localization (Sect. 4 of the corner paper) in
     /// every cycle that gives a fix.
     Localization,
+    /// Odometry whose heading is corrected at the goal's checkpoints from the luminance circle
+    /// (Kim, Kim and Kwon).
+    Checkpoints,
 }
 
 /// How the robot chooses its velocity (`[control]`).
@@ -118,6 +121,25 @@ pub struct GoalSpec {
     /// passes within the tolerance.
     #[serde(default)]
     pub estimate_margin_mm: f64,
+    /// Checkpoints (field frame): the robot stores the luminance circle at each the first time
+    /// its estimate is within `checkpoint_store_mm` of it, and reads its heading error against
+    /// it whenever its estimate is within `checkpoint_radius_mm` later.
+    #[serde(default)]
+    pub checkpoints_mm: Vec<[f64; 2]>,
+    /// See `checkpoints_mm`.
+    #[serde(default = "default_checkpoint_store")]
+    pub checkpoint_store_mm: f64,
+    /// See `checkpoints_mm`.
+    #[serde(default = "default_checkpoint_radius")]
+    pub checkpoint_radius_mm: f64,
+}
+
+fn default_checkpoint_store() -> f64 {
+    30.0
+}
+
+fn default_checkpoint_radius() -> f64 {
+    250.0
 }
 
 fn default_goal_tolerance() -> f64 {
@@ -125,6 +147,21 @@ fn default_goal_tolerance() -> f64 {
 }
 
 impl GoalSpec {
+    /// A goal at `point_mm` reached within `tolerance_mm`, with no waypoints, margin or
+    /// checkpoints.
+    pub fn to(point_mm: [f64; 2], tolerance_mm: f64) -> Self {
+        Self {
+            waypoints_mm: Vec::new(),
+            x_mm: point_mm[0],
+            y_mm: point_mm[1],
+            tolerance_mm,
+            estimate_margin_mm: 0.0,
+            checkpoints_mm: Vec::new(),
+            checkpoint_store_mm: default_checkpoint_store(),
+            checkpoint_radius_mm: default_checkpoint_radius(),
+        }
+    }
+
     /// The goal point.
     pub fn point(&self) -> Point2<f64> {
         Point2::new(self.x_mm, self.y_mm)
@@ -196,5 +233,12 @@ impl RobotConfig {
     /// Whether the robot runs floor-region self-localization.
     pub fn localizes(&self) -> bool {
         self.control.pose_source == PoseSource::Localization
+    }
+
+    /// The goal's checkpoints, where the robot reads its heading from the luminance circle.
+    pub fn checkpoints(&self) -> &[[f64; 2]] {
+        self.goal
+            .as_ref()
+            .map_or(&[], |g| g.checkpoints_mm.as_slice())
     }
 }

@@ -48,8 +48,8 @@ pub struct PoseEstimator {
 }
 
 impl PoseEstimator {
-    /// An estimator for a robot told it starts at `start` (world frame). With
-    /// `PoseSource::Localization` it takes fixes, each pulling the estimate by `gain`.
+    /// An estimator for a robot told it starts at `start` (world frame). With any source but
+    /// `PoseSource::Odometry` it takes fixes, each pulling the estimate by `gain`.
     pub fn new(start: Isometry2<f64>, source: PoseSource, gain: f64) -> Self {
         Self {
             reckoning: DeadReckoning::new(),
@@ -58,7 +58,7 @@ impl PoseEstimator {
                 odometry: None,
             }),
             anchored_by_fix: false,
-            takes_fixes: source == PoseSource::Localization,
+            takes_fixes: source != PoseSource::Odometry,
             gain,
             last_cycle: None,
             used: 0,

@@ -58,10 +58,8 @@ mod tests {
     fn moves_on_when_the_estimate_is_within_tolerance_and_holds_the_goal() {
         let goal = GoalSpec {
             waypoints_mm: vec![[1000.0, 0.0], [1000.0, 50.0]],
-            x_mm: 0.0,
-            y_mm: 0.0,
-            tolerance_mm: 100.0,
             estimate_margin_mm: 20.0,
+            ..GoalSpec::to([0.0, 0.0], 100.0)
         };
         let mut m = Mission::new(&goal);
         let at = |x: f64, y: f64| Isometry2::new(Vector2::new(x, y), 0.0);

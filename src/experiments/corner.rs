@@ -89,13 +89,7 @@ impl CornerSpec {
         });
         if s.goal.is_none() {
             let g = self.u2() * self.goal_mm;
-            s.goal = Some(GoalSpec {
-                waypoints_mm: Vec::new(),
-                x_mm: g.x,
-                y_mm: g.y,
-                tolerance_mm: self.goal_tolerance_mm,
-                estimate_margin_mm: 0.0,
-            });
+            s.goal = Some(GoalSpec::to([g.x, g.y], self.goal_tolerance_mm));
         }
     }
 

@@ -53,6 +53,10 @@ pub struct LuminanceConfig {
     /// signs of a flat panel are those of the sensor noise, and they blur the true shift by a
     /// degree or two.
     pub sign_dead_band: f64,
+    /// Ours: a reading that matches at least this much (percent) places the robot at the
+    /// checkpoint itself, close enough for a position fix (in E3's room 5 cm off the
+    /// checkpoint matches 89-94%, 10 cm 78-84%); the paper reads the heading only.
+    pub at_checkpoint_match_percent: f64,
     /// Sect. 4, the inner circle: a direction holds something near when its grey level differs
     /// from the floor's (the median of the inner circle) by more than this, grey levels.
     pub near_threshold: f64,
@@ -69,6 +73,7 @@ impl Default for LuminanceConfig {
             average_after: 2,
             match_threshold: 20.0,
             sign_dead_band: 1.0,
+            at_checkpoint_match_percent: 92.0,
             near_threshold: 25.0,
         }
     }

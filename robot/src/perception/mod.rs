@@ -3,9 +3,11 @@
 
 mod floor_localization;
 mod freespace;
+mod luminance_heading;
 
 pub use floor_localization::FloorLocalizationStage;
 pub use freespace::FreeSpaceStage;
+pub use luminance_heading::LuminanceHeadingStage;
 
 use crate::RobotError;
 use crate::boundary::Observation;
@@ -64,7 +66,7 @@ pub trait Stage: Send {
 /// The stages a configuration asks for, in the order they run.
 pub fn build(config: &RobotConfig) -> Result<Vec<Box<dyn Stage>>, RobotError> {
     let mut stages: Vec<Box<dyn Stage>> = Vec::new();
-    if !(config.detects_freespace() || config.localizes()) {
+    if !(config.detects_freespace() || config.localizes() || !config.checkpoints().is_empty()) {
         return Ok(stages);
     }
     let camera = config.vision_camera().ok_or_else(|| {
@@ -86,6 +88,20 @@ pub fn build(config: &RobotConfig) -> Result<Vec<Box<dyn Stage>>, RobotError> {
             camera,
             config.vision.localization.clone(),
             cal,
+        )?));
+    }
+    if let Some(goal) = config
+        .goal
+        .as_ref()
+        .filter(|g| !g.checkpoints_mm.is_empty())
+    {
+        stages.push(Box::new(LuminanceHeadingStage::new(
+            camera,
+            config.vision.luminance_heading.clone(),
+            cal,
+            &goal.checkpoints_mm,
+            goal.checkpoint_store_mm,
+            goal.checkpoint_radius_mm,
         )?));
     }
     Ok(stages)
