@@ -329,12 +329,19 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     .with_context(|| format!("creating {}", parent.display()))?;
             }
             cal.save(&out)?;
-            println!(
-                "sensor {}: {} samples every 0.25 px, floor horizon at R = {:.2} px",
-                spec.name,
-                cal.samples.len(),
-                cal.horizon_px
-            );
+            if cal.samples.is_empty() {
+                println!(
+                    "sensor {}: sees no floor along its image x axis (no floor map)",
+                    spec.name
+                );
+            } else {
+                println!(
+                    "sensor {}: {} samples every 0.25 px, floor horizon at R = {:.2} px",
+                    spec.name,
+                    cal.samples.len(),
+                    cal.horizon_px
+                );
+            }
             if let (Some(first), Some(last)) = (cal.elevation.first(), cal.elevation.last()) {
                 println!(
                     "elevation of the scene rays: {:.1} deg at R = 0 to {:.1} deg at R = {:.1} px",

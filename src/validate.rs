@@ -459,6 +459,19 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
             }
         },
     };
+    let needs_floor = s.control.kind.uses_freespace()
+        || s.control.pose_source == omniloop_robot::PoseSource::Localization;
+    if needs_floor && let Err(e) = cal.validate() {
+        c.fail(
+            format!("robot.sensors[{index}]"),
+            format!(
+                "free space and self-localization need the floor in the image: {e} in the \
+                 image-to-floor map of {:?}",
+                sensors[index].name
+            ),
+        );
+        return;
+    }
     if !c.out.is_empty() || !s.control.kind.uses_freespace() {
         return;
     }

@@ -6,7 +6,8 @@ use crate::optics::Optics;
 use crate::sensor::Sensor;
 
 /// `(R, r)` samples every `step_px` from 0 to just below the floor horizon, and the horizon's
-/// image radius (found by bisection to 1e-6 px).
+/// image radius (found by bisection to 1e-6 px); none, and horizon 0, for a mirror that sees
+/// no floor along the image x axis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RadialMap {
     /// `(R_px, r_mm)` pairs.
@@ -55,11 +56,14 @@ pub fn trace_radial_map(sensor: &Sensor, step_px: f64) -> Result<RadialMap, SimE
         }
         k += 1;
     }
+    // A mirror that sees no floor (a conical one reflecting only sideways and up) still has
+    // its elevation column: no floor samples, horizon 0.
     let Some(mut lo) = lo else {
-        return Err(SimError::Invalid(format!(
-            "sensor {:?} sees no floor along its image x axis",
-            sensor.name
-        )));
+        return Ok(RadialMap {
+            samples,
+            horizon_px: 0.0,
+            elevation: trace_elevation(sensor, step_px, r_max),
+        });
     };
     let mut hi = lo + step_px;
     for _ in 0..60 {
@@ -114,6 +118,24 @@ mod tests {
             .find(|w| w[0][1] < 0.0 && w[1][1] >= 0.0)
             .unwrap();
         assert!(zero[0][0] <= map.horizon_px + 1e-9 && map.horizon_px <= zero[1][0]);
+    }
+
+    #[test]
+    fn a_conical_mirror_that_sees_no_floor_still_has_its_elevations() {
+        let spec = SensorSpec {
+            hyperbolic: None,
+            conical: Some(crate::optics::ConicalMirror {
+                radius_mm: 30.0,
+                tip_distance_mm: 100.0,
+                focal_px: 300.0,
+                lens_height_mm: 300.0,
+                apex_angle_deg: 90.0,
+            }),
+            ..SensorSpec::corner_paper("cone")
+        };
+        let map = trace_radial_map(&spec.build().unwrap(), 0.25).unwrap();
+        assert!(map.samples.is_empty() && map.horizon_px == 0.0);
+        assert!(map.elevation.len() > 10);
     }
 
     #[test]

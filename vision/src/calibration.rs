@@ -109,7 +109,7 @@ impl RadialCalibration {
     /// The table segment `(R, r)` to `(R, r)` holding image radius `R`; `None` beyond it.
     fn segment(&self, r_px: f64) -> Option<([f64; 2], [f64; 2])> {
         let s = &self.samples;
-        if r_px.is_nan() || r_px < s[0][0] || r_px > self.max_radius_px() {
+        if r_px.is_nan() || r_px < s.first()?[0] || r_px > self.max_radius_px() {
             return None;
         }
         let k = s.partition_point(|p| p[0] <= r_px).clamp(1, s.len() - 1);
@@ -139,7 +139,7 @@ impl RadialCalibration {
     /// `R = f^-1(r)`; `None` beyond the table.
     pub fn image_radius_px(&self, r_mm: f64) -> Option<f64> {
         let s = &self.samples;
-        if r_mm.is_nan() || r_mm < s[0][1] || r_mm > s[s.len() - 1][1] {
+        if r_mm.is_nan() || r_mm < s.first()?[1] || r_mm > s.last()?[1] {
             return None;
         }
         let k = s.partition_point(|p| p[1] <= r_mm).clamp(1, s.len() - 1);
