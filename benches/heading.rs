@@ -48,10 +48,8 @@ fn main() {
         }
     }
     t.sort_by(f64::total_cmp);
-    println!(
-        "{:<52} {:>10} {:>10}",
-        "luminance heading (256x256, R = {radius:.1} px)", "median ms", "p90 ms"
-    );
+    let title = format!("luminance heading (256x256, R = {radius:.1} px)");
+    println!("{title:<52} {:>10} {:>10}", "median ms", "p90 ms");
     println!(
         "{:<52} {:>10.4} {:>10.4}",
         "sampling + signs + differences + pattern match",
