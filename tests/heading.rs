@@ -4,8 +4,12 @@
 mod common;
 
 use common::{cpu, scenario};
+use nalgebra::{Isometry2, Vector2};
+use omniloop::calibrate::calibrate_sensor;
 use omniloop::experiments::heading::heading_results;
 use omniloop::run_scenario;
+use omniloop_sim::{Renderer, Scene, SensorNoise, World};
+use omniloop_vision::luminance_heading::{LuminanceConfig, near_ring};
 
 #[test]
 fn e3_turns_are_read_within_a_degree_and_translations_turn_na() {
@@ -55,4 +59,34 @@ fn on_patrol_the_checkpoint_keeps_the_heading_and_without_it_the_error_grows() {
     assert!(drift.len() >= 11, "{drift:?}");
     assert!(drift[1..].windows(2).all(|w| w[1] > w[0]), "{drift:?}");
     assert!(*drift.last().unwrap() > 30.0, "{drift:?}");
+}
+
+#[test]
+fn the_inner_circle_tells_which_way_something_stands_near() {
+    // Sect. 4: a second circle looking down at the floor close by. The grey box at (1200,
+    // -2300), 700 mm wide, has its face 250 mm from a robot at (1200, -1700): seen toward -y.
+    let s = scenario("heading_room.toml");
+    let spec = &s.robot.sensors[0];
+    let sensor = spec.build().unwrap();
+    let cal = calibrate_sensor(spec).unwrap();
+    let config = LuminanceConfig::default();
+    let mut renderer = Renderer::cpu();
+    let mut noise = SensorNoise::new(2);
+    let mut near_at = |x: f64, y: f64| {
+        let pose = Isometry2::new(Vector2::new(x, y), 0.0);
+        let mut bodies = s.robot_bodies();
+        bodies[0].start = pose;
+        let world = World::new(&s.world, &bodies, 0.0025).unwrap();
+        let img = renderer
+            .render(&Scene::of_world(&world), &sensor, &pose, Some(&mut noise))
+            .unwrap();
+        near_ring(&img, &cal, &config).unwrap()
+    };
+    // At the room's centre nothing is near.
+    assert!(near_at(0.0, 0.0).iter().all(|&n| !n));
+    let near = near_at(1200.0, -1700.0);
+    let toward = |deg: i32| near[deg.rem_euclid(360) as usize];
+    // Toward the box (-90 degrees) it is near; away from it nothing is.
+    assert!((-110..=-70).all(toward), "{near:?}");
+    assert!((30..=150).all(|d| !toward(d)), "{near:?}");
 }

@@ -57,8 +57,12 @@ pub struct LuminanceConfig {
     /// checkpoint itself, close enough for a position fix (in E3's room 5 cm off the
     /// checkpoint matches 89-94%, 10 cm 78-84%); the paper reads the heading only.
     pub at_checkpoint_match_percent: f64,
-    /// Sect. 4, the inner circle: a direction holds something near when its grey level differs
-    /// from the floor's (the median of the inner circle) by more than this, grey levels.
+    /// Sect. 4, the inner circle `r2 < r1`: the image radius whose rays are at this elevation,
+    /// degrees (down toward the floor near the robot; -45 from a mirror 300 mm up meets the
+    /// floor 300 mm away).
+    pub inner_elevation_deg: f64,
+    /// ... a direction holds something near when its grey level differs from the floor's (the
+    /// median of the inner circle) by more than this, grey levels.
     pub near_threshold: f64,
 }
 
@@ -74,6 +78,7 @@ impl Default for LuminanceConfig {
             match_threshold: 20.0,
             sign_dead_band: 1.0,
             at_checkpoint_match_percent: 92.0,
+            inner_elevation_deg: -45.0,
             near_threshold: 25.0,
         }
     }
@@ -416,6 +421,28 @@ impl HeadingShift {
     pub fn accepted_deg(&self) -> Option<f64> {
         self.matched.accepted().then_some(self.shift_deg)
     }
+}
+
+/// Sect. 4, the inner circle of `cal`'s sensor (rays at `inner_elevation_deg`): for each of
+/// `samples` directions (sample `k` at `k * 360 / n` degrees), whether something near stands
+/// there, by [`near_directions`] on the smoothed circle.
+pub fn near_ring(
+    img: &RgbaImage,
+    cal: &RadialCalibration,
+    config: &LuminanceConfig,
+) -> Result<Vec<bool>, VisionError> {
+    config.validate()?;
+    let r2 = cal
+        .radius_at_elevation_px(config.inner_elevation_deg.to_radians())
+        .ok_or_else(|| {
+            VisionError::Calibration(format!(
+                "no image radius of sensor {:?} looks at {} deg elevation",
+                cal.sensor, config.inner_elevation_deg
+            ))
+        })?;
+    let raw = sample_circle(img, cal.principal_point_px, r2, config.samples)?;
+    let smooth = moving_average(&raw, config.average_before, config.average_after);
+    Ok(near_directions(&smooth, config.near_threshold))
 }
 
 /// Sect. 4, the inner circle (`r2 < r1`, rays toward the floor near the robot): for each
