@@ -1,6 +1,6 @@
 //! Charts: x-y plots of lines and dots in a grid of panels, drawn with plotters into a PNG.
 
-use crate::topview::{FigureError, register_font};
+use crate::topview::{FigureError, png_bytes, register_font};
 use plotters::prelude::*;
 
 /// How a series is drawn.
@@ -71,16 +71,7 @@ pub fn charts_png(
         root.present().map_err(|e| fail(e.to_string()))?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).expect("buffer size matches the image");
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .map_err(|source| FigureError::Write {
-        file: name.to_string(),
-        source,
-    })?;
-    Ok(bytes)
+    png_bytes(name, &img)
 }
 
 fn draw_chart(

@@ -377,16 +377,20 @@ pub fn draw_panels(file: &Path, panels: &[Panel<'_>], width: u32) -> Result<(), 
 
 /// [`draw_panels`] into PNG bytes; `name` names the figure in errors.
 pub fn panels_png(name: &str, panels: &[Panel<'_>], width: u32) -> Result<Vec<u8>, FigureError> {
+    png_bytes(name, &render_panels(name, panels, width)?)
+}
+
+/// `img` encoded as PNG; `name` names the figure in errors.
+pub(crate) fn png_bytes(name: &str, img: &image::RgbImage) -> Result<Vec<u8>, FigureError> {
     let mut bytes = Vec::new();
-    render_panels(name, panels, width)?
-        .write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
-        .map_err(|source| FigureError::Write {
-            file: name.to_string(),
-            source,
-        })?;
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .map_err(|source| FigureError::Write {
+        file: name.to_string(),
+        source,
+    })?;
     Ok(bytes)
 }
 
