@@ -2,6 +2,7 @@
 //! how far its free space and pose estimates were from the world.
 
 use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_control::wrap_pi;
 use omniloop_robot::GoalSpec;
 use omniloop_sim::World;
 use omniloop_vision::FreeSpace;
@@ -52,8 +53,8 @@ impl TruthScore {
             .iter()
             .any(|c| (c - here).norm() <= self.checkpoint_radius_mm);
         if inside {
-            let err = (estimate.rotation.angle() - truth.rotation.angle()).to_degrees();
-            self.visit = Some((err + 180.0).rem_euclid(360.0) - 180.0);
+            let err = wrap_pi(estimate.rotation.angle() - truth.rotation.angle());
+            self.visit = Some(err.to_degrees());
         } else if let Some(err) = self.visit.take() {
             self.visit_errors_deg.push(err.abs());
         }
