@@ -47,8 +47,10 @@ enum Command {
         /// Renderer for the sensors' images: auto, gpu or cpu.
         #[arg(long, default_value = "auto")]
         renderer: RendererChoice,
-        /// Save every sensor's image every K cycles to OUT/frames/.
-        #[arg(long, value_name = "K")]
+        /// Save every sensor's image to OUT/frames/ as `<sensor>_<cycle>.png`, beside
+        /// trajectory.csv (row k is cycle k): every cycle, or every K cycles.
+        #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "1",
+              value_parser = clap::value_parser!(u64).range(1..))]
         save_frames: Option<u64>,
         /// No progress bar.
         #[arg(long, short)]

@@ -256,11 +256,32 @@ struct EstimateLine<'a> {
     fixes: Vec<FixRecord<'a>>,
     not_found: Vec<(&'a str, &'a str)>,
     free_mm: Option<&'a [f64]>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    landmarks: Vec<LandmarkRecord>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    motion: Option<MotionRecord>,
+}
+
+/// A landmark ranged in one cycle.
+#[derive(Debug, Serialize)]
+struct LandmarkRecord {
+    landmark: usize,
+    range_mm: f64,
+    bearing_rad: f64,
+}
+
+/// The motion since the previous frame as vision read it.
+#[derive(Debug, Serialize)]
+struct MotionRecord {
+    rotation_rad: f64,
+    translation_mm: Option<[f64; 2]>,
+    features: usize,
+    inliers: usize,
 }
 
 /// Writes one JSON line a control cycle: time, true pose, the robot's pose estimate, the
 /// target it headed for, its fixes with their outcomes, the stages that found nothing (with
-/// why) and its free distances.
+/// why), its free distances, and (omnistereo) the landmarks it ranged and the motion it read.
 pub fn write_estimates_jsonl(
     rows: &[TrajectoryRow],
     estimates: &[Estimates],
@@ -283,6 +304,21 @@ pub fn write_estimates_jsonl(
                 .map(|n| (n.source, n.reason.as_str()))
                 .collect(),
             free_mm: e.freespace.as_ref().map(|f| f.free_mm.as_slice()),
+            landmarks: e
+                .landmarks
+                .iter()
+                .map(|l| LandmarkRecord {
+                    landmark: l.landmark,
+                    range_mm: l.range_mm,
+                    bearing_rad: l.bearing_rad,
+                })
+                .collect(),
+            motion: e.motion.map(|m| MotionRecord {
+                rotation_rad: m.rotation_rad,
+                translation_mm: m.translation_mm.map(|t| [t.x, t.y]),
+                features: m.features,
+                inliers: m.inliers,
+            }),
         };
         serde_json::to_writer(&mut w, &line)?;
         writeln!(w)?;

@@ -5,8 +5,11 @@
 
 use crate::experiments::ExperimentSpec;
 use crate::odometry::OdometrySpec;
-use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop_robot::{BodySpec, ControlSpec, GoalSpec, RobotConfig, VisionSpec};
+use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
+use omniloop_robot::{
+    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapSegment, RobotConfig, StereoRig, VisionSpec,
+    WorldMap,
+};
 use omniloop_sim::{Layout, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
 use serde::{Deserialize, Serialize};
@@ -275,7 +278,104 @@ impl Scenario {
             vision: self.vision.clone(),
             control: self.control.clone(),
             goal: self.goal.clone(),
+            map: self.robot_map(),
+            stereo: self.stereo_rig().ok(),
+            seed: self.seed,
         }
+    }
+
+    /// The map the robot is given: the world's pillars (landmarks, by colour) and its walls,
+    /// boards and boxes (straight obstacles). Corridor walls and the field are not on it.
+    pub fn robot_map(&self) -> WorldMap {
+        let w = &self.world;
+        let p = |a: [f64; 2]| Point2::new(a[0], a[1]);
+        let seg = |a: [f64; 2], b: [f64; 2], t: f64| MapSegment {
+            from_mm: p(a),
+            to_mm: p(b),
+            half_thickness_mm: 0.5 * t,
+        };
+        let mut segments: Vec<MapSegment> = w
+            .walls
+            .iter()
+            .map(|x| seg(x.from_mm, x.to_mm, x.thickness_mm))
+            .chain(w.boards.iter().map(|b| seg(b.from_mm, b.to_mm, b.thickness_mm)))
+            .collect();
+        for cube in &w.cubes {
+            let (h, a) = (0.5 * cube.size_mm, cube.angle_deg.to_radians());
+            let corner = |sx: f64, sy: f64| {
+                let v = Rotation2::new(a) * Vector2::new(sx * h, sy * h);
+                [cube.center_mm[0] + v.x, cube.center_mm[1] + v.y]
+            };
+            let c = [corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)];
+            segments.extend((0..4).map(|k| seg(c[k], c[(k + 1) % 4], 0.0)));
+        }
+        WorldMap {
+            landmarks: w
+                .pillars
+                .iter()
+                .map(|x| MapLandmark {
+                    centre_mm: p(x.center_mm),
+                    radius_mm: x.radius_mm,
+                    rgb: x.rgb.0,
+                })
+                .collect(),
+            segments,
+        }
+    }
+
+    /// The omnistereo rig of `vision.omnistereo`'s two sensors, or the field at fault and why.
+    pub fn stereo_rig(&self) -> Result<StereoRig, (String, String)> {
+        let o = &self.vision.omnistereo;
+        let cone = |key: &str, name: &str| {
+            let field = format!("vision.omnistereo.{key}");
+            let s = self
+                .robot
+                .sensors
+                .iter()
+                .find(|s| s.name == name)
+                .ok_or_else(|| (field.clone(), format!("the robot has no sensor {name:?}")))?;
+            let m = s.conical.as_ref().ok_or_else(|| {
+                (field.clone(), format!("sensor {name:?} is not a conical mirror"))
+            })?;
+            if (m.apex_angle_deg - 90.0).abs() > 1e-9 {
+                return Err((
+                    field,
+                    format!(
+                        "eqs. (1)-(2) hold for 90-degree cones; {name:?} has {} degrees",
+                        m.apex_angle_deg
+                    ),
+                ));
+            }
+            Ok((s, m))
+        };
+        let (ls, lower) = cone("lower_sensor", &o.lower_sensor)?;
+        let (us, upper) = cone("upper_sensor", &o.upper_sensor)?;
+        let field = || "vision.omnistereo.upper_sensor".to_string();
+        if ls.mount_mm != us.mount_mm {
+            return Err((field(), "the two cones must be coaxial (the same mount_mm)".into()));
+        }
+        if lower.radius_mm != upper.radius_mm || lower.tip_distance_mm != upper.tip_distance_mm {
+            return Err((
+                field(),
+                "the two cones must be alike (radius_mm, tip_distance_mm)".into(),
+            ));
+        }
+        let s = upper.lens_height_mm - lower.lens_height_mm;
+        if s <= 0.0 {
+            return Err((
+                field(),
+                format!(
+                    "must stand above the lower sensor (lens_height_mm {} <= {})",
+                    upper.lens_height_mm, lower.lens_height_mm
+                ),
+            ));
+        }
+        Ok(StereoRig {
+            mirror_radius_mm: lower.radius_mm,
+            tip_distance_mm: lower.tip_distance_mm,
+            separation_mm: s,
+            mount_mm: ls.mount_mm,
+        })
     }
 
     /// Whether the robot's software uses a mirror camera's image-to-floor map.

@@ -134,6 +134,15 @@ impl TruthScore {
     }
 }
 
+/// The `q` quantile of `values` (0.95: the 95th percentile), nearest rank on the sorted values
+/// (`None` when empty).
+pub fn quantile(values: &[f64], q: f64) -> Option<f64> {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.get(((v.len() as f64 - 1.0) * q.clamp(0.0, 1.0)).round() as usize)
+        .copied()
+}
+
 /// The median of `values` (`None` when empty).
 pub fn median(values: &[f64]) -> Option<f64> {
     if values.is_empty() {
@@ -174,5 +183,8 @@ mod tests {
         assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
         assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
         assert_eq!(median(&[]), None);
+        let hundred: Vec<f64> = (1..=101).map(f64::from).collect();
+        assert_eq!(quantile(&hundred, 0.95), Some(96.0));
+        assert_eq!(quantile(&[], 0.5), None);
     }
 }

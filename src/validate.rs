@@ -292,7 +292,8 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         }
     }
     check_vision_and_control(&mut c, s);
-    if s.control.kind != ControllerKind::Idle && s.goal.is_none() {
+    if !matches!(s.control.kind, ControllerKind::Idle | ControllerKind::Wander) && s.goal.is_none()
+    {
         c.fail(
             "control.kind",
             format!(
@@ -398,6 +399,7 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
         );
     }
     check_localization(c, s);
+    check_omnistereo(c, s);
     let o = &s.odometry;
     for (key, v) in [
         ("speed_noise_frac", o.speed_noise_frac),
@@ -544,6 +546,41 @@ fn check_localization(c: &mut Checker, s: &Scenario) {
             "control.pose_source",
             "self-localization matches the floor region to the field: add [world.field]",
         );
+    }
+}
+
+/// The omnistereo rig (`pose_source = "omnistereo"`) and the wandering controller's map.
+fn check_omnistereo(c: &mut Checker, s: &Scenario) {
+    let w = &s.control.wander;
+    c.positive("control.wander.clearance_mm", w.clearance_mm);
+    c.positive("control.wander.turn_rate_deg_s", w.turn_rate_deg_s);
+    if w.max_extra_turn_deg.is_nan() || w.max_extra_turn_deg < 0.0 {
+        c.fail(
+            "control.wander.max_extra_turn_deg",
+            format!("must be >= 0 (got {})", w.max_extra_turn_deg),
+        );
+    }
+    let map = s.robot_map();
+    if s.control.kind == ControllerKind::Wander && map.segments.is_empty() {
+        c.fail(
+            "control.kind",
+            "\"wander\" drives on a map of the world's walls and pillars: the world has no walls",
+        );
+    }
+    if s.control.pose_source != PoseSource::Omnistereo {
+        return;
+    }
+    if let Err(e) = s.vision.omnistereo.validate() {
+        c.fail("vision.omnistereo", e.to_string());
+    }
+    if map.landmarks.is_empty() {
+        c.fail(
+            "control.pose_source",
+            "omnistereo trilateration needs landmarks: add [[world.pillars]] of distinct colours",
+        );
+    }
+    if let Err((field, why)) = s.stereo_rig() {
+        c.fail(field, why);
     }
 }
 

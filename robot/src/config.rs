@@ -4,6 +4,7 @@
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::AvoidanceConfig;
 use omniloop_vision::luminance_heading::LuminanceConfig;
+use omniloop_vision::omnistereo::OmnistereoConfig;
 use omniloop_vision::{FreeSpaceConfig, LocalizationConfig, RadialCalibration};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -24,6 +25,9 @@ pub enum ControllerKind {
     GoalDirection,
     /// Velocity-aware avoidance of Sect. 3.2 of the corner paper, from the image.
     VelocityAware,
+    /// Random wandering on the map (E4, Spacek and Burbridge, Sect. 2.1): forward until the
+    /// map says a pillar or a wall is near, then a random turn left or right.
+    Wander,
 }
 
 impl ControllerKind {
@@ -39,6 +43,7 @@ impl ControllerKind {
             Self::GoToGoalTruth => "go_to_goal_truth",
             Self::GoalDirection => "goal_direction",
             Self::VelocityAware => "velocity_aware",
+            Self::Wander => "wander",
         }
     }
 }
@@ -56,6 +61,9 @@ pub enum PoseSource {
     /// Odometry whose heading is corrected at the goal's checkpoints from the luminance circle
     /// (Kim, Kim and Kwon).
     Checkpoints,
+    /// Odometry corrected by trilateration from the conical omnistereo ranges to the map's
+    /// landmarks (Spacek and Burbridge), every cycle that gives a fix.
+    Omnistereo,
 }
 
 /// How the robot chooses its velocity (`[control]`).
@@ -68,9 +76,36 @@ pub struct ControlSpec {
     pub avoidance: AvoidanceConfig,
     /// Where the pose estimate comes from.
     pub pose_source: PoseSource,
-    /// With `pose_source = "localization"`: how far each fix pulls the dead-reckoned pose
-    /// toward itself (0: odometry only, 1: jump to the measurement).
+    /// With `pose_source = "localization"` or `"omnistereo"`: how far each fix pulls the
+    /// dead-reckoned pose toward itself (0: odometry only, 1: jump to the measurement).
     pub localization_gain: f64,
+    /// Settings of the wandering controller (`kind = "wander"`).
+    pub wander: WanderConfig,
+}
+
+/// How the wandering controller drives (`[control.wander]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WanderConfig {
+    /// Gap the robot keeps between its body and the map's obstacles, mm (room for the error
+    /// of its estimate).
+    pub clearance_mm: f64,
+    /// Rate of the turns, deg/s.
+    pub turn_rate_deg_s: f64,
+    /// Once the way ahead is clear the robot turns on by a random angle up to this, degrees
+    /// (ours: without it a robot that stops turning at the first clear heading skims along
+    /// walls).
+    pub max_extra_turn_deg: f64,
+}
+
+impl Default for WanderConfig {
+    fn default() -> Self {
+        Self {
+            clearance_mm: 200.0,
+            turn_rate_deg_s: 90.0,
+            max_extra_turn_deg: 60.0,
+        }
+    }
 }
 
 impl Default for ControlSpec {
@@ -80,6 +115,7 @@ impl Default for ControlSpec {
             avoidance: AvoidanceConfig::default(),
             pose_source: PoseSource::Odometry,
             localization_gain: 0.3,
+            wander: WanderConfig::default(),
         }
     }
 }
@@ -99,6 +135,9 @@ pub struct VisionSpec {
     pub localization: LocalizationConfig,
     /// Heading from a luminance circle (Kim, Kim and Kwon, Sect. 3).
     pub luminance_heading: LuminanceConfig,
+    /// Conical omnistereo: range, trilateration, visual compass and interframe motion
+    /// (Spacek and Burbridge).
+    pub omnistereo: OmnistereoConfig,
 }
 
 /// The goal point, reached through optional waypoints (`[goal]`), in the world (field) frame.
@@ -190,6 +229,51 @@ pub struct BodySpec {
     pub angular_accel_limit_rad_s2: f64,
 }
 
+/// A landmark of the robot's map: an upright cylinder of one colour.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapLandmark {
+    /// Centre, world frame, mm.
+    pub centre_mm: Point2<f64>,
+    /// Radius, mm.
+    pub radius_mm: f64,
+    /// Its colour.
+    pub rgb: [u8; 3],
+}
+
+/// A straight obstacle of the robot's map (a wall, a board, a side of a box).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapSegment {
+    /// One end of its centre line, world frame, mm.
+    pub from_mm: Point2<f64>,
+    /// The other end.
+    pub to_mm: Point2<f64>,
+    /// Half its thickness, mm.
+    pub half_thickness_mm: f64,
+}
+
+/// What the robot is told of its surroundings (E4's "map of the arena programmed into the
+/// robot"): where the landmarks stand and where the obstacles are. Not its own pose.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct WorldMap {
+    /// Landmarks, with the colours vision names them by.
+    pub landmarks: Vec<MapLandmark>,
+    /// Straight obstacles.
+    pub segments: Vec<MapSegment>,
+}
+
+/// The design of a conical omnistereo rig (two coaxial 90-degree cones), as built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StereoRig {
+    /// Mirror radius R, mm.
+    pub mirror_radius_mm: f64,
+    /// Lens to cone tip d, mm.
+    pub tip_distance_mm: f64,
+    /// Distance between the mirrors s, mm.
+    pub separation_mm: f64,
+    /// Where the mirrors' axis stands in the robot frame, mm.
+    pub mount_mm: [f64; 2],
+}
+
 /// Everything the robot's software is built from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotConfig {
@@ -209,6 +293,12 @@ pub struct RobotConfig {
     pub control: ControlSpec,
     /// Where to go, if anywhere.
     pub goal: Option<GoalSpec>,
+    /// Its map, when it is given one.
+    pub map: WorldMap,
+    /// Its omnistereo rig's design, when it has one.
+    pub stereo: Option<StereoRig>,
+    /// Seed of the software's own random choices (the wandering's turns).
+    pub seed: u64,
 }
 
 impl RobotConfig {
@@ -228,6 +318,11 @@ impl RobotConfig {
     /// Whether the robot runs the free-space stage.
     pub fn detects_freespace(&self) -> bool {
         self.control.kind.uses_freespace()
+    }
+
+    /// Whether the robot runs the omnistereo stage.
+    pub fn uses_omnistereo(&self) -> bool {
+        self.control.pose_source == PoseSource::Omnistereo
     }
 
     /// Whether the robot runs floor-region self-localization.

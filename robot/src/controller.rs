@@ -4,6 +4,7 @@ use crate::RobotError;
 use crate::boundary::BodyCommand;
 use crate::config::{ControllerKind, RobotConfig};
 use crate::near_field::{NearField, NearSpace};
+use crate::wander::Wander;
 use nalgebra::{Isometry2, Vector2};
 use omniloop_control::{
     AccelLimitedDrive, GoalDirection, SpeedChoice, Surroundings, VelocityAware,
@@ -19,6 +20,8 @@ pub struct Situation<'a> {
     pub target_body_mm: Option<Vector2<f64>>,
     /// The measured body velocity.
     pub velocity_body_mm_s: Vector2<f64>,
+    /// The pose estimate (world frame), when the robot has one.
+    pub pose: Option<Isometry2<f64>>,
     /// The dead-reckoned pose in the odometry frame.
     pub odometry_pose: Isometry2<f64>,
     /// Time of the cycle, s.
@@ -55,6 +58,7 @@ pub fn build(config: &RobotConfig) -> Result<Box<dyn Controller>, RobotError> {
                 config.control_period_s,
             )?,
         }),
+        ControllerKind::Wander => Box::new(Wander::new(config)?),
     })
 }
 

@@ -69,6 +69,31 @@ pub struct NotFound {
     pub reason: String,
 }
 
+/// A landmark of the map the robot identified and measured this cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LandmarkSighting {
+    /// Its index in the map.
+    pub landmark: usize,
+    /// Range from the camera axis to its near face, mm.
+    pub range_mm: f64,
+    /// Bearing (robot frame), rad.
+    pub bearing_rad: f64,
+}
+
+/// The robot's motion since the previous frame as its vision read it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionReading {
+    /// The rotation the visual compass read, counter-clockwise positive, rad.
+    pub rotation_rad: f64,
+    /// The translation, in the previous frame's axes, mm; `None` when no feature was seen in
+    /// both frames.
+    pub translation_mm: Option<Vector2<f64>>,
+    /// Features seen in both frames.
+    pub features: usize,
+    /// Of which the clustering kept.
+    pub inliers: usize,
+}
+
 /// What the robot believes after one cycle.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Estimates {
@@ -86,6 +111,10 @@ pub struct Estimates {
     pub not_found: Vec<NotFound>,
     /// Index of the target (waypoints, then the goal) the robot is heading for, with a goal.
     pub target: Option<usize>,
+    /// Landmarks of the map identified and ranged this cycle.
+    pub landmarks: Vec<LandmarkSighting>,
+    /// The motion since the previous frame, as vision read it.
+    pub motion: Option<MotionReading>,
 }
 
 impl Estimates {

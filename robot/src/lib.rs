@@ -24,14 +24,18 @@ pub mod mission;
 pub mod near_field;
 pub mod perception;
 pub mod robot;
+pub mod wander;
 
 pub use boundary::{
     ActuatorCommand, ActuatorState, BodyCommand, Frame, Observation, OdometryReading, Outputs,
 };
 pub use config::{
-    BodySpec, ControlSpec, ControllerKind, GoalSpec, PoseSource, RobotConfig, VisionSpec,
+    BodySpec, ControlSpec, ControllerKind, GoalSpec, MapLandmark, MapSegment, PoseSource,
+    RobotConfig, StereoRig, VisionSpec, WanderConfig, WorldMap,
 };
-pub use estimates::{Estimates, Fix, FixOutcome, Measurement, NotFound};
+pub use estimates::{
+    Estimates, Fix, FixOutcome, LandmarkSighting, Measurement, MotionReading, NotFound,
+};
 pub use estimator::PoseEstimator;
 pub use mission::Mission;
 pub use robot::Robot;

@@ -106,6 +106,7 @@ impl Robot {
             freespace: percepts.freespace.as_ref(),
             target_body_mm,
             velocity_body_mm_s,
+            pose,
             odometry_pose: self.estimator.odometry_pose(),
             t_s: obs.t_s,
         });
@@ -121,6 +122,8 @@ impl Robot {
                 fixes,
                 not_found: percepts.not_found,
                 target: self.mission.as_ref().map(Mission::index),
+                landmarks: percepts.landmarks,
+                motion: percepts.motion,
             },
         })
     }

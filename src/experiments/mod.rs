@@ -10,6 +10,7 @@
 pub mod corner;
 pub mod heading;
 pub mod localization_map;
+pub mod omnistereo;
 pub mod places;
 
 use crate::load::parse_scenario;
@@ -66,7 +67,7 @@ struct Drive;
 impl Experiment for Drive {}
 
 /// The experiment a scenario belongs to (`[experiment.corner]`, `[experiment.places]`,
-/// `[experiment.localization_map]`, `[experiment.heading]`).
+/// `[experiment.localization_map]`, `[experiment.heading]`, `[experiment.omnistereo]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExperimentSpec {
@@ -78,6 +79,8 @@ pub enum ExperimentSpec {
     LocalizationMap(localization_map::MapSpec),
     /// E3: heading error from a luminance circle at a checkpoint.
     Heading(heading::HeadingSpec),
+    /// E4: conical omnistereo range, trilateration, compass and interframe motion.
+    Omnistereo(omnistereo::OmnistereoSpec),
 }
 
 impl ExperimentSpec {
@@ -88,6 +91,7 @@ impl ExperimentSpec {
             Self::Places(spec) => spec.validate(s, c),
             Self::LocalizationMap(spec) => spec.validate(s, c),
             Self::Heading(spec) => spec.validate(s, c),
+            Self::Omnistereo(spec) => spec.validate(s, c),
         }
     }
 
@@ -95,7 +99,8 @@ impl ExperimentSpec {
     pub(crate) fn prepare(&self, s: &mut Scenario) {
         match self {
             Self::Corner(spec) => spec.prepare(s),
-            Self::Places(_) | Self::LocalizationMap(_) | Self::Heading(_) => {}
+            Self::Places(_) | Self::LocalizationMap(_) | Self::Heading(_) | Self::Omnistereo(_) => {
+            }
         }
     }
 
@@ -112,6 +117,7 @@ impl ExperimentSpec {
             Self::Places(_) => Some(places::places_table(summary)),
             Self::LocalizationMap(_) => Some(localization_map::map_table(summary)),
             Self::Heading(_) => Some(heading::heading_table(summary)),
+            Self::Omnistereo(_) => Some(omnistereo::omnistereo_table(summary)),
         }
     }
 }
@@ -130,6 +136,7 @@ pub fn procedure(s: &Scenario) -> Box<dyn Experiment> {
         Some(ExperimentSpec::Heading(spec)) => {
             Box::new(heading::Heading::new(spec, &s.vision.luminance_heading))
         }
+        Some(ExperimentSpec::Omnistereo(spec)) => Box::new(omnistereo::Omnistereo::new(spec, s)),
     }
 }
 
@@ -144,7 +151,12 @@ pub struct Replay {
 }
 
 /// Every replay, in the order `omniloop replay --list` shows them.
-pub const REPLAYS: &[Replay] = &[corner::REPLAY, places::REPLAY, heading::REPLAY];
+pub const REPLAYS: &[Replay] = &[
+    corner::REPLAY,
+    places::REPLAY,
+    heading::REPLAY,
+    omnistereo::REPLAY,
+];
 
 /// The replay called `name`.
 pub fn replay(name: &str) -> Option<&'static Replay> {

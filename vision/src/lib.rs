@@ -9,6 +9,7 @@ pub mod freespace;
 pub mod geometry;
 pub mod luminance_heading;
 pub mod mask;
+pub mod omnistereo;
 
 pub use calibration::{HyperbolicFit, RadialCalibration};
 pub use floor_localization::{
@@ -42,4 +43,7 @@ pub enum VisionError {
         /// The rule it breaks.
         rule: &'static str,
     },
+    /// The image does not show what the method looks for (a degenerate or empty image).
+    #[error("not found: {0}")]
+    NotFound(String),
 }

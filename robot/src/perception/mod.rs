@@ -4,15 +4,17 @@
 mod floor_localization;
 mod freespace;
 mod luminance_heading;
+mod omnistereo;
 
 pub use floor_localization::FloorLocalizationStage;
 pub use freespace::FreeSpaceStage;
 pub use luminance_heading::LuminanceHeadingStage;
+pub use omnistereo::OmnistereoStage;
 
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::RobotConfig;
-use crate::estimates::{Measurement, NotFound};
+use crate::estimates::{LandmarkSighting, Measurement, MotionReading, NotFound};
 use image::RgbaImage;
 use nalgebra::Isometry2;
 use omniloop_vision::{FreeSpace, LocalizationQuality, RadialCalibration};
@@ -26,6 +28,10 @@ pub struct Percepts {
     pub fixes: Vec<Sighting>,
     /// Stages that found nothing, and why.
     pub not_found: Vec<NotFound>,
+    /// Landmarks of the map identified and ranged.
+    pub landmarks: Vec<LandmarkSighting>,
+    /// The motion since the previous frame, as vision read it.
+    pub motion: Option<MotionReading>,
 }
 
 /// A measurement, the stage that made it and how good that stage judged it.
@@ -66,6 +72,16 @@ pub trait Stage: Send {
 /// The stages a configuration asks for, in the order they run.
 pub fn build(config: &RobotConfig) -> Result<Vec<Box<dyn Stage>>, RobotError> {
     let mut stages: Vec<Box<dyn Stage>> = Vec::new();
+    if config.uses_omnistereo() {
+        let rig = config.stereo.ok_or_else(|| {
+            RobotError::Config("pose_source \"omnistereo\" needs the robot's two cones".into())
+        })?;
+        stages.push(Box::new(OmnistereoStage::new(
+            config.vision.omnistereo.clone(),
+            rig,
+            &config.map.landmarks,
+        )?));
+    }
     if !(config.detects_freespace() || config.localizes() || !config.checkpoints().is_empty()) {
         return Ok(stages);
     }

@@ -1,0 +1,132 @@
+//! E4 end to end: conical omnistereo in the pillar arena (Spacek and Burbridge): the 450-frame
+//! wander on the robot's own estimates, the rim calibration of eq. (2) and the visual compass
+//! on rendered frames, and the saved frame set.
+
+mod common;
+
+use common::{cpu, omniloop, scenario, scenario_path, tmp};
+use nalgebra::{Isometry2, Vector2};
+use omniloop::run_scenario;
+use omniloop_sim::optics::Optics;
+use omniloop_sim::{Renderer, Scene, SensorNoise, World};
+use omniloop_vision::omnistereo::{AngularProfile, CompassConfig, MirrorRim};
+
+/// The experiment's metric `key`'s statistic `q` (median, p95, n).
+fn stat(m: &omniloop::record::Summary, key: &str, q: &str) -> f64 {
+    m.experiment
+        .get(key)
+        .and_then(|v| v.get(q))
+        .and_then(serde_json::Value::as_f64)
+        .unwrap_or_else(|| panic!("{key}.{q} missing: {:?}", m.experiment))
+}
+
+#[test]
+fn e4_wander_of_450_frames_meets_the_targets() {
+    let s = scenario("omnistereo_arena.toml");
+    let out = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
+    let m = &out.summary;
+    eprintln!("{}", omniloop::experiments::omnistereo::omnistereo_table(m));
+    assert_eq!(m.experiment["frames"], 450);
+    assert_eq!(m.wall_contacts, 0);
+    // It wandered: several legs, and every frame ranged pillars.
+    assert!(m.path_length_mm > 4000.0, "{}", m.path_length_mm);
+    assert!(stat(m, "range_error_pct", "n") > 3.0 * 450.0);
+    assert!(stat(m, "range_error_pct", "median") <= 1.0);
+    assert!(stat(m, "range_error_pct", "p95") <= 3.0);
+    assert!(stat(m, "trilateration_error_mm", "n") >= 400.0);
+    assert!(stat(m, "trilateration_error_mm", "median") <= 40.0);
+    assert!(stat(m, "trilateration_error_mm", "p95") <= 100.0);
+    assert_eq!(stat(m, "compass_error_deg", "n"), 449.0);
+    assert!(stat(m, "compass_error_deg", "median") <= 0.3);
+    assert!(stat(m, "interframe_translation_error_mm", "n") >= 400.0);
+    assert!(stat(m, "interframe_translation_error_mm", "median") <= 10.0);
+    // The robot drove on its estimate: it stayed well inside the 200 mm clearance the wander
+    // keeps from the map's obstacles.
+    let worst = out
+        .trajectory
+        .iter()
+        .filter_map(|r| Some((r.est_x_mm? - r.x_mm).hypot(r.est_y_mm? - r.y_mm)))
+        .fold(0.0, f64::max);
+    assert!(worst < 100.0, "estimate {worst:.1} mm off the truth");
+}
+
+/// Renders sensor `index` of the arena scenario with the robot at `pose`, with noise.
+fn frame(index: usize, pose: Isometry2<f64>, seed: u64) -> image::RgbaImage {
+    let s = scenario("omnistereo_arena.toml");
+    let mut bodies = s.robot_bodies();
+    bodies[0].start = pose;
+    let world = World::new(&s.world, &bodies, 0.002).unwrap();
+    let sensor = s.robot.sensors[index].build().unwrap();
+    let mut noise = SensorNoise::new(seed);
+    Renderer::cpu()
+        .render(&Scene::of_world(&world), &sensor, &pose, Some(&mut noise))
+        .unwrap()
+}
+
+#[test]
+fn the_rim_calibrates_v_by_eq_2() {
+    let s = scenario("omnistereo_arena.toml");
+    let Optics::Conical(cone) = s.robot.sensors[0].build().unwrap().optics else {
+        panic!("the arena's sensors are cones");
+    };
+    let img = frame(0, Isometry2::new(Vector2::new(-600.0, 100.0), 0.3), 1);
+    let rim = MirrorRim::measure(&img).unwrap();
+    // Eq. (2): v = (d / R + 1) r_m; the robot never reads focal_px, the test compares with it.
+    let v = (cone.tip_distance_mm / cone.radius_mm + 1.0) * rim.radius_px;
+    assert!(
+        (v / cone.focal_px - 1.0).abs() < 1e-3,
+        "v = {v:.2} px from r_m = {:.3} px; focal {}",
+        rim.radius_px,
+        cone.focal_px
+    );
+}
+
+#[test]
+fn the_compass_recovers_known_rotations_of_rendered_frames() {
+    let cfg = CompassConfig::default();
+    let at = Vector2::new(700.0, -300.0);
+    let profile = |deg: f64, seed: u64| {
+        let pose = Isometry2::new(at, (25.0 + deg).to_radians());
+        let (lo, up) = (frame(0, pose, seed), frame(1, pose, seed + 1));
+        let (rl, ru) = (MirrorRim::measure(&lo).unwrap(), MirrorRim::measure(&up).unwrap());
+        AngularProfile::capture(&[(&lo, &rl), (&up, &ru)], &cfg)
+    };
+    let before = profile(0.0, 10);
+    for deg in [0.0, 0.4, -1.7, 4.5, -8.0] {
+        let r = profile(deg, 20).rotation_from(&before, &cfg).unwrap();
+        let got = r.rotation_rad.to_degrees();
+        eprintln!("turned {deg:+.2} deg: read {got:+.3} deg (peak {:.3})", r.peak);
+        assert!((got - deg).abs() < 0.1, "turned {deg}: read {got}");
+    }
+}
+
+#[test]
+fn save_frames_keeps_every_frame_of_both_cameras() {
+    // The arena scenario cut to ten frames.
+    let text = std::fs::read_to_string(scenario_path("omnistereo_arena.toml")).unwrap();
+    let text = text.replace("duration_s = 22.5", "duration_s = 0.5");
+    let dir = tmp("omnistereo_frames");
+    let file = dir.join("arena10.toml");
+    std::fs::write(&file, text).unwrap();
+    let out = dir.join("run");
+    omniloop([
+        "run".as_ref(),
+        file.as_os_str(),
+        "--renderer".as_ref(),
+        "cpu".as_ref(),
+        "--save-frames".as_ref(),
+        "--quiet".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    let rows = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    // Ten cycles and the final state.
+    assert_eq!(rows.lines().count(), 1 + 11);
+    for k in 0..10 {
+        for cam in ["lower", "upper"] {
+            let f = out.join("frames").join(format!("{cam}_{k:06}.png"));
+            assert!(f.exists(), "{} missing", f.display());
+        }
+    }
+    assert!(!out.join("frames").join("lower_000010.png").exists());
+}

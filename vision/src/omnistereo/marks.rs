@@ -1,0 +1,350 @@
+//! Coloured marks (the arena's pillars) in a conical mirror's image.
+//!
+//! A 90-degree cone images an upright pillar as a radial stripe from the image centre (the
+//! height of the cone's tip) out to the image of the pillar's top edge (Sect. 2, Fig. 1). Each
+//! pillar has a colour of its own, so a stripe is found and named by colour: every pixel inside
+//! the rim is tested for saturation and its chromaticity compared with the palette (the map's
+//! colours), which the shading of a surface leaves alone.
+//!
+//! Per colour the stripe's bearing is the mean azimuth of its pixels around the densest
+//! direction (pixels at radius `h` weigh `h`, as their number does). Its outer end, the top
+//! edge, is measured on the stripe's central half only (the top rim of a cylinder curves down
+//! toward the stripe's sides: over the central half the edge's range stays within 4% of the
+//! pillar's radius of the near face's): the edge lies between the outermost pixel of the colour
+//! and the nearest pixel beyond it that is not, on the stripe's axis; we take the midpoint.
+//! Pixels are sampled at their centres, so without more columns the edge is known to within the
+//! pixel spacing along the axis.
+
+use super::{MirrorRim, positive, wrap};
+use crate::VisionError;
+use image::RgbaImage;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Settings of the colour detection (`[vision.omnistereo.marks]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MarkConfig {
+    /// A pixel may belong to a mark when `(max - min) / max` of its channels reaches this
+    /// (walls and floors are greys or pale tints; the marks are saturated).
+    pub min_saturation: f64,
+    /// ... and its chromaticity `(r, g) / (r + g + b)` is within this of the mark's colour.
+    pub max_chroma_distance: f64,
+    /// ... and its brightest channel reaches this, of 255 (the black beyond the rim, with the
+    /// sensor's noise, has any saturation and chromaticity).
+    pub min_value: u8,
+    /// A colour is a mark when at least this many pixels have it.
+    pub min_pixels: usize,
+    /// Pixels nearer the image centre than this have no usable azimuth, px.
+    pub min_radius_px: f64,
+    /// A stripe reaching this close to the rim has its top beyond the mirror's view, px.
+    pub rim_margin_px: f64,
+}
+
+impl Default for MarkConfig {
+    fn default() -> Self {
+        Self {
+            min_saturation: 0.5,
+            max_chroma_distance: 0.08,
+            min_value: 48,
+            min_pixels: 4,
+            min_radius_px: 4.0,
+            rim_margin_px: 1.5,
+        }
+    }
+}
+
+impl MarkConfig {
+    /// Checks the settings.
+    pub fn validate(&self) -> Result<(), VisionError> {
+        positive("marks.min_saturation", self.min_saturation)?;
+        positive("marks.max_chroma_distance", self.max_chroma_distance)?;
+        positive("marks.min_radius_px", self.min_radius_px)?;
+        positive("marks.rim_margin_px", self.rim_margin_px)?;
+        if self.min_saturation >= 1.0 {
+            return Err(VisionError::InvalidParameter {
+                name: "marks.min_saturation",
+                value: self.min_saturation,
+                rule: "must be below 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A mark found in one image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourMark {
+    /// Index of its colour in the palette.
+    pub label: usize,
+    /// Bearing of the stripe's axis (robot frame, counter-clockwise from x), rad.
+    pub bearing_rad: f64,
+    /// Half the stripe's angular width, rad.
+    pub half_width_rad: f64,
+    /// Image radius of the top edge on the axis, px; `None` when the stripe runs to the rim
+    /// (the top is beyond the mirror's view).
+    pub top_px: Option<f64>,
+    /// Pixels of the colour.
+    pub pixels: usize,
+}
+
+/// Palette chromaticities.
+fn chroma(rgb: [u8; 3]) -> [f64; 2] {
+    let s = (rgb[0] as f64 + rgb[1] as f64 + rgb[2] as f64).max(1.0);
+    [rgb[0] as f64 / s, rgb[1] as f64 / s]
+}
+
+/// The palette colour a pixel has, if any.
+fn classify(p: [u8; 3], palette: &[[f64; 2]], cfg: &MarkConfig) -> Option<usize> {
+    let mx = p[0].max(p[1]).max(p[2]);
+    let mn = p[0].min(p[1]).min(p[2]) as f64;
+    if mx < cfg.min_value.max(1) || mx as f64 - mn < cfg.min_saturation * mx as f64 {
+        return None;
+    }
+    let c = chroma(p);
+    let (k, d) = palette
+        .iter()
+        .enumerate()
+        .map(|(k, q)| (k, (c[0] - q[0]).hypot(c[1] - q[1])))
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    (d <= cfg.max_chroma_distance).then_some(k)
+}
+
+/// Finds the marks of `palette`'s colours in `img`, whose mirror rim is `rim`: at most one a
+/// colour (the densest direction of it).
+pub fn detect_marks(
+    img: &RgbaImage,
+    rim: &MirrorRim,
+    palette: &[[u8; 3]],
+    cfg: &MarkConfig,
+) -> Vec<ColourMark> {
+    let chromas: Vec<[f64; 2]> = palette.iter().map(|c| chroma(*c)).collect();
+    let pixels = coloured_pixels(img, rim, &chromas, cfg);
+    let mut marks = Vec::new();
+    for (label, pts) in pixels.iter().enumerate() {
+        if pts.len() < cfg.min_pixels {
+            continue;
+        }
+        if let Some(m) = stripe(label, pts, img, rim, &chromas, cfg) {
+            marks.push(m);
+        }
+    }
+    marks
+}
+
+/// Image coordinates `(X, Y)` of the pixels of each palette colour inside the rim.
+fn coloured_pixels(
+    img: &RgbaImage,
+    rim: &MirrorRim,
+    chromas: &[[f64; 2]],
+    cfg: &MarkConfig,
+) -> Vec<Vec<[f64; 2]>> {
+    let mut out = vec![Vec::new(); chromas.len()];
+    let (w, h) = img.dimensions();
+    let [cx, cy] = rim.centre_px;
+    let r = rim.radius_px;
+    let v0 = (cy - r).floor().max(0.0) as u32;
+    let v1 = ((cy + r).ceil() as u32).min(h);
+    let raw = img.as_raw();
+    for v in v0..v1 {
+        let dy = v as f64 + 0.5 - cy;
+        let half = (r * r - dy * dy).max(0.0).sqrt();
+        let u0 = (cx - half).floor().max(0.0) as u32;
+        let u1 = ((cx + half).ceil() as u32).min(w);
+        for u in u0..u1 {
+            let i = 4 * (v as usize * w as usize + u as usize);
+            let p = [raw[i], raw[i + 1], raw[i + 2]];
+            // Fast reject of the greys before any floating point.
+            let (mx, mn) = (p[0].max(p[1]).max(p[2]), p[0].min(p[1]).min(p[2]));
+            if mx < cfg.min_value.max(1) || ((mx - mn) as f64) < cfg.min_saturation * mx as f64 {
+                continue;
+            }
+            if let Some(k) = classify(p, chromas, cfg) {
+                let (x, y) = rim.image_coords(u as f64, v as f64);
+                out[k].push([x, y]);
+            }
+        }
+    }
+    out
+}
+
+/// The stripe of one colour: its densest direction, bearing, width and top edge.
+fn stripe(
+    label: usize,
+    pts: &[[f64; 2]],
+    img: &RgbaImage,
+    rim: &MirrorRim,
+    chromas: &[[f64; 2]],
+    cfg: &MarkConfig,
+) -> Option<ColourMark> {
+    let usable: Vec<(f64, f64, [f64; 2])> = pts
+        .iter()
+        .map(|p| (p[1].atan2(p[0]), p[0].hypot(p[1]), *p))
+        .filter(|(_, h, _)| *h >= cfg.min_radius_px)
+        .collect();
+    if usable.len() < cfg.min_pixels {
+        return None;
+    }
+    // Densest direction: a histogram of 2-degree bins, the peak and its neighbours.
+    const BINS: usize = 180;
+    let bin = |a: f64| (((a + PI) / (2.0 * PI) * BINS as f64) as usize).min(BINS - 1);
+    let mut hist = [0usize; BINS];
+    usable.iter().for_each(|(a, _, _)| hist[bin(*a)] += 1);
+    let peak = (0..BINS)
+        .max_by_key(|&k| hist[k] + hist[(k + 1) % BINS] + hist[(k + BINS - 1) % BINS])?;
+    let peak_rad = (peak as f64 + 0.5) / BINS as f64 * 2.0 * PI - PI;
+    let near: Vec<(f64, f64, [f64; 2])> = usable
+        .iter()
+        .map(|&(a, h, p)| (wrap(a - peak_rad), h, p))
+        .filter(|(d, _, _)| d.abs() <= 6f64.to_radians())
+        .collect();
+    if near.len() < cfg.min_pixels {
+        return None;
+    }
+    let mean = near.iter().map(|(d, _, _)| d).sum::<f64>() / near.len() as f64;
+    let bearing = wrap(peak_rad + mean);
+    let half_width = near
+        .iter()
+        .map(|(d, _, _)| (d - mean).abs())
+        .fold(0.0, f64::max)
+        .max(0.25 / near.iter().map(|(_, h, _)| *h).fold(1.0, f64::max));
+    let axis = [bearing.cos(), bearing.sin()];
+    let top = top_edge(label, &near, axis, half_width, img, rim, chromas, cfg);
+    Some(ColourMark {
+        label,
+        bearing_rad: bearing,
+        half_width_rad: half_width,
+        top_px: top,
+        pixels: pts.len(),
+    })
+}
+
+/// Projection of `p` on the axis and its offset across it.
+fn along_across(p: [f64; 2], axis: [f64; 2]) -> (f64, f64) {
+    (
+        p[0] * axis[0] + p[1] * axis[1],
+        -p[0] * axis[1] + p[1] * axis[0],
+    )
+}
+
+/// The top edge on the stripe's axis: the midpoint between the outermost pixel of the colour
+/// in the central band and the nearest pixel beyond it, on the band, that is not of it.
+#[allow(clippy::too_many_arguments)]
+fn top_edge(
+    label: usize,
+    near: &[(f64, f64, [f64; 2])],
+    axis: [f64; 2],
+    half_width_rad: f64,
+    img: &RgbaImage,
+    rim: &MirrorRim,
+    chromas: &[[f64; 2]],
+    cfg: &MarkConfig,
+) -> Option<f64> {
+    let outer = near
+        .iter()
+        .map(|(_, _, p)| along_across(*p, axis).0)
+        .fold(0.0, f64::max);
+    if outer >= rim.radius_px - cfg.rim_margin_px {
+        return None;
+    }
+    // The central half of the stripe, and never narrower than a pixel's half-diagonal.
+    let band = (0.5 * half_width_rad * outer).max(0.71);
+    let lo = near
+        .iter()
+        .map(|(_, _, p)| along_across(*p, axis))
+        .filter(|(a, c)| c.abs() <= band && *a >= outer - 4.0)
+        .map(|(a, _)| a)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !lo.is_finite() {
+        return Some(outer + 0.5);
+    }
+    // Pixels of another colour on the band's centre line just beyond `lo`.
+    let centre = [axis[0] * lo, axis[1] * lo];
+    let [cx, cy] = rim.centre_px;
+    let (w, h) = img.dimensions();
+    let mut hi = f64::INFINITY;
+    let reach = 3i64;
+    let (u0, v0) = (
+        (cx + centre[0]).floor() as i64,
+        (cy - centre[1]).floor() as i64,
+    );
+    for v in v0 - reach..=v0 + reach {
+        for u in u0 - reach..=u0 + reach {
+            if u < 0 || v < 0 || u >= w as i64 || v >= h as i64 {
+                continue;
+            }
+            let p = rim.image_coords(u as f64, v as f64);
+            let (a, c) = along_across([p.0, p.1], axis);
+            if a <= lo || c.abs() > band.min(0.71) {
+                continue;
+            }
+            let px = img.get_pixel(u as u32, v as u32).0;
+            if classify([px[0], px[1], px[2]], chromas, cfg) != Some(label) {
+                hi = hi.min(a);
+            }
+        }
+    }
+    let spacing = 1.0 / axis[0].abs().max(axis[1].abs());
+    Some(if hi.is_finite() && hi - lo <= 2.0 * spacing {
+        0.5 * (lo + hi)
+    } else {
+        lo + 0.5 * spacing
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use image::Rgba;
+
+    /// A rim of radius 200 about the centre of a 512 image, grey inside, with a red wedge of
+    /// half-width `hw` at `bearing` out to radius `top`.
+    fn wedge(bearing: f64, hw: f64, top: f64) -> (RgbaImage, MirrorRim) {
+        let rim = MirrorRim {
+            centre_px: [256.0, 256.0],
+            radius_px: 200.0,
+            points: 0,
+        };
+        let img = RgbaImage::from_fn(512, 512, |u, v| {
+            let (x, y) = rim.image_coords(u as f64, v as f64);
+            let (h, a) = (x.hypot(y), y.atan2(x));
+            if h >= 200.0 {
+                Rgba([0, 0, 0, 255])
+            } else if h < top && wrap(a - bearing).abs() < hw {
+                Rgba([200, 30, 25, 255])
+            } else {
+                Rgba([180, 175, 160, 255])
+            }
+        });
+        (img, rim)
+    }
+
+    #[test]
+    fn finds_the_bearing_and_top_of_a_wedge() {
+        let palette = [[30, 200, 40], [220, 30, 30]];
+        for (bearing, hw, top) in [(0.3, 0.05, 120.0), (-2.0, 0.02, 61.3), (3.1, 0.1, 150.7)] {
+            let (img, rim) = wedge(bearing, hw, top);
+            let marks = detect_marks(&img, &rim, &palette, &MarkConfig::default());
+            assert_eq!(marks.len(), 1, "{marks:?}");
+            let m = &marks[0];
+            assert_eq!(m.label, 1);
+            assert!(wrap(m.bearing_rad - bearing).abs() < 0.005, "{m:?}");
+            let t = m.top_px.unwrap();
+            assert!((t - top).abs() < 0.8, "top {t} vs {top}");
+        }
+    }
+
+    #[test]
+    fn a_wedge_to_the_rim_has_no_top() {
+        let (img, rim) = wedge(1.0, 0.05, 300.0);
+        let marks = detect_marks(&img, &rim, &[[220, 30, 30]], &MarkConfig::default());
+        assert_eq!(marks.len(), 1);
+        assert_eq!(marks[0].top_px, None);
+    }
+
+    #[test]
+    fn greys_are_no_marks() {
+        let (img, rim) = wedge(1.0, 0.0, 0.0);
+        assert!(detect_marks(&img, &rim, &[[220, 30, 30]], &MarkConfig::default()).is_empty());
+    }
+}
