@@ -298,7 +298,11 @@ impl Scenario {
             .walls
             .iter()
             .map(|x| seg(x.from_mm, x.to_mm, x.thickness_mm))
-            .chain(w.boards.iter().map(|b| seg(b.from_mm, b.to_mm, b.thickness_mm)))
+            .chain(
+                w.boards
+                    .iter()
+                    .map(|b| seg(b.from_mm, b.to_mm, b.thickness_mm)),
+            )
             .collect();
         for cube in &w.cubes {
             let (h, a) = (0.5 * cube.size_mm, cube.angle_deg.to_radians());
@@ -306,7 +310,12 @@ impl Scenario {
                 let v = Rotation2::new(a) * Vector2::new(sx * h, sy * h);
                 [cube.center_mm[0] + v.x, cube.center_mm[1] + v.y]
             };
-            let c = [corner(-1.0, -1.0), corner(1.0, -1.0), corner(1.0, 1.0), corner(-1.0, 1.0)];
+            let c = [
+                corner(-1.0, -1.0),
+                corner(1.0, -1.0),
+                corner(1.0, 1.0),
+                corner(-1.0, 1.0),
+            ];
             segments.extend((0..4).map(|k| seg(c[k], c[(k + 1) % 4], 0.0)));
         }
         WorldMap {
@@ -335,7 +344,10 @@ impl Scenario {
                 .find(|s| s.name == name)
                 .ok_or_else(|| (field.clone(), format!("the robot has no sensor {name:?}")))?;
             let m = s.conical.as_ref().ok_or_else(|| {
-                (field.clone(), format!("sensor {name:?} is not a conical mirror"))
+                (
+                    field.clone(),
+                    format!("sensor {name:?} is not a conical mirror"),
+                )
             })?;
             if (m.apex_angle_deg - 90.0).abs() > 1e-9 {
                 return Err((
@@ -352,7 +364,10 @@ impl Scenario {
         let (us, upper) = cone("upper_sensor", &o.upper_sensor)?;
         let field = || "vision.omnistereo.upper_sensor".to_string();
         if ls.mount_mm != us.mount_mm {
-            return Err((field(), "the two cones must be coaxial (the same mount_mm)".into()));
+            return Err((
+                field(),
+                "the two cones must be coaxial (the same mount_mm)".into(),
+            ));
         }
         if lower.radius_mm != upper.radius_mm || lower.tip_distance_mm != upper.tip_distance_mm {
             return Err((

@@ -292,7 +292,10 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         }
     }
     check_vision_and_control(&mut c, s);
-    if !matches!(s.control.kind, ControllerKind::Idle | ControllerKind::Wander) && s.goal.is_none()
+    if !matches!(
+        s.control.kind,
+        ControllerKind::Idle | ControllerKind::Wander
+    ) && s.goal.is_none()
     {
         c.fail(
             "control.kind",

@@ -25,7 +25,10 @@ const STEP_MM: f64 = 10.0;
 enum State {
     Forward,
     /// Turning in place: direction (+1 left), and the extra angle still to turn once clear.
-    Turn { dir: f64, extra_rad: f64 },
+    Turn {
+        dir: f64,
+        extra_rad: f64,
+    },
 }
 
 /// The wandering controller.
@@ -49,7 +52,9 @@ impl Wander {
             ("control.wander.turn_rate_deg_s", w.turn_rate_deg_s),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(RobotError::Config(format!("{name} = {v}: must be positive")));
+                return Err(RobotError::Config(format!(
+                    "{name} = {v}: must be positive"
+                )));
             }
         }
         if config.map.landmarks.is_empty() && config.map.segments.is_empty() {
@@ -123,7 +128,8 @@ impl Controller for Wander {
                 if extra_rad > 0.0 {
                     State::Turn {
                         dir,
-                        extra_rad: extra_rad - self.config.turn_rate_deg_s.to_radians() * self.period_s,
+                        extra_rad: extra_rad
+                            - self.config.turn_rate_deg_s.to_radians() * self.period_s,
                     }
                 } else {
                     State::Forward

@@ -70,7 +70,9 @@ impl Omnistereo {
                 .iter()
                 .map(|p| (Point2::from(p.center_mm), p.radius_mm))
                 .collect(),
-            mount: s.stereo_rig().map_or(Vector2::zeros(), |r| r.mount_mm.into()),
+            mount: s
+                .stereo_rig()
+                .map_or(Vector2::zeros(), |r| r.mount_mm.into()),
         }
     }
 }
@@ -130,8 +132,7 @@ impl Omnistereo {
                     landmark: l.landmark,
                     true_mm: local.coords.norm() - radius,
                     est_mm: l.range_mm,
-                    bearing_error_deg: wrap_pi(l.bearing_rad - local.y.atan2(local.x))
-                        .to_degrees(),
+                    bearing_error_deg: wrap_pi(l.bearing_rad - local.y.atan2(local.x)).to_degrees(),
                 });
             }
             if let Some(Measurement::Pose { pose, .. }) =
@@ -224,8 +225,7 @@ impl Experiment for Omnistereo {
 }
 
 fn ranges_csv(s: &Scores) -> String {
-    let mut out =
-        String::from("frame,pillar,true_range_mm,range_mm,error_pct,bearing_error_deg\n");
+    let mut out = String::from("frame,pillar,true_range_mm,range_mm,error_pct,bearing_error_deg\n");
     for r in &s.ranges {
         let _ = writeln!(
             out,
@@ -266,9 +266,7 @@ fn frames_csv(s: &Scores) -> String {
 fn figure(e: &Omnistereo, s: &Scores) -> Result<Vec<u8>, crate::topview::FigureError> {
     let frames = s.frames.max(1) as f64;
     let per_frame = |v: &[(usize, f64)]| v.iter().map(|&(k, x)| (k as f64, x)).collect();
-    let top = |v: &[(usize, f64)], floor: f64| {
-        1.1 * v.iter().map(|x| x.1).fold(floor, f64::max)
-    };
+    let top = |v: &[(usize, f64)], floor: f64| 1.1 * v.iter().map(|x| x.1).fold(floor, f64::max);
     let band: Vec<(f64, f64)> = e
         .in_band(s)
         .map(|r| (r.true_mm / 1000.0, r.error_pct()))
@@ -339,7 +337,10 @@ fn figure(e: &Omnistereo, s: &Scores) -> Result<Vec<u8>, crate::topview::FigureE
 /// E4 as a Markdown table with the targets.
 pub fn omnistereo_table(m: &Summary) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "# E4: conical omnistereo, trilateration and interframe motion\n");
+    let _ = writeln!(
+        s,
+        "# E4: conical omnistereo, trilateration and interframe motion\n"
+    );
     let get = |key: &str, q: &str| {
         m.experiment
             .get(key)

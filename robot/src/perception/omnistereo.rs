@@ -191,8 +191,7 @@ impl Stage for OmnistereoStage {
         let marks = &self.config.marks;
         let lo = detect_marks(lower, &cal.lower, &self.palette, marks);
         let up = detect_marks(upper, &cal.upper, &self.palette, marks);
-        let (ranged, _unranged) =
-            range_marks(&cal.geometry, &lo, &up, self.config.radius_sigma_px);
+        let (ranged, _unranged) = range_marks(&cal.geometry, &lo, &up, self.config.radius_sigma_px);
         out.landmarks = ranged
             .iter()
             .map(|m| LandmarkSighting {

@@ -7,8 +7,7 @@
 //! its own parallax, small for a 15 mm step and of opposite signs on the two sides. So the
 //! rotation is the angular shift that best aligns the two frames' angular intensity profiles.
 //! Each image gives `rings` circles between `inner_fraction` and `outer_fraction` of the rim's
-//! radius; on each, the luminance at `samples` azimuths (bilinear, averaged over three radii a
-//! pixel apart), less its mean. The shift maximises the circular cross-correlation summed over
+//! radius; on each, the luminance at `samples` azimuths (bilinear), less its mean. The shift maximises the circular cross-correlation summed over
 //! every ring of both frames, `C(l) = sum_rings sum_k a[k + l] b[k]`, searched over
 //! `|l| <= max_rotation_deg`; a parabola through the peak and its neighbours gives the
 //! fraction of a sample. Rings of stronger contrast weigh more (the profiles are not scaled).
@@ -38,10 +37,10 @@ pub struct CompassConfig {
 impl Default for CompassConfig {
     fn default() -> Self {
         Self {
-            rings: 6,
+            rings: 4,
             inner_fraction: 0.25,
             outer_fraction: 0.95,
-            samples: 720,
+            samples: 512,
             max_rotation_deg: 10.0,
         }
     }
@@ -96,24 +95,25 @@ pub struct Rotation {
 }
 
 /// Luminance (Rec. 601) at continuous image position `(x, y)` (pixel units, pixel `(u, v)`'s
-/// centre at `(u + 0.5, v + 0.5)`), bilinear.
-fn luminance(img: &RgbaImage, x: f64, y: f64) -> f32 {
-    let (w, h) = img.dimensions();
+/// centre at `(u + 0.5, v + 0.5)`), bilinear; `None` where the four pixels are not all inside
+/// the image.
+fn luminance(raw: &[u8], w: usize, h: usize, x: f64, y: f64) -> Option<f32> {
     let (fx, fy) = (x - 0.5, y - 0.5);
-    let (u0, v0) = (fx.floor(), fy.floor());
-    let (tx, ty) = ((fx - u0) as f32, (fy - v0) as f32);
-    let raw = img.as_raw();
-    let at = |u: f64, v: f64| -> f32 {
-        let (u, v) = (
-            u.clamp(0.0, w as f64 - 1.0) as usize,
-            v.clamp(0.0, h as f64 - 1.0) as usize,
-        );
-        let i = 4 * (v * w as usize + u);
-        0.299 * raw[i] as f32 + 0.587 * raw[i + 1] as f32 + 0.114 * raw[i + 2] as f32
-    };
-    let top = at(u0, v0) * (1.0 - tx) + at(u0 + 1.0, v0) * tx;
-    let bottom = at(u0, v0 + 1.0) * (1.0 - tx) + at(u0 + 1.0, v0 + 1.0) * tx;
-    top * (1.0 - ty) + bottom * ty
+    if !(fx >= 0.0 && fy >= 0.0) {
+        return None;
+    }
+    let (u0, v0) = (fx as usize, fy as usize);
+    if u0 + 1 >= w || v0 + 1 >= h {
+        return None;
+    }
+    let (tx, ty) = ((fx - u0 as f64) as f32, (fy - v0 as f64) as f32);
+    let luma =
+        |i: usize| 0.299 * raw[i] as f32 + 0.587 * raw[i + 1] as f32 + 0.114 * raw[i + 2] as f32;
+    let i = 4 * (v0 * w + u0);
+    let j = i + 4 * w;
+    let top = luma(i) * (1.0 - tx) + luma(i + 4) * tx;
+    let bottom = luma(j) * (1.0 - tx) + luma(j + 4) * tx;
+    Some(top * (1.0 - ty) + bottom * ty)
 }
 
 impl AngularProfile {
@@ -137,17 +137,18 @@ impl AngularProfile {
                             / (cfg.rings - 1) as f64
                 };
                 let h = f * rim.radius_px;
+                let (w, ht) = (img.width() as usize, img.height() as usize);
+                let raw = img.as_raw();
+                let [cx, cy] = rim.centre_px;
+                // Outside the image (a rim cut by the frame's edge) a sample repeats the last.
+                let mut last = 0.0;
                 let mut ring: Vec<f32> = trig
                     .iter()
                     .map(|(c, s)| {
-                        [-1.0, 0.0, 1.0]
-                            .iter()
-                            .map(|dh| {
-                                let r = h + dh;
-                                luminance(img, rim.centre_px[0] + r * c, rim.centre_px[1] - r * s)
-                            })
-                            .sum::<f32>()
-                            / 3.0
+                        if let Some(l) = luminance(raw, w, ht, cx + h * c, cy - h * s) {
+                            last = l;
+                        }
+                        last
                     })
                     .collect();
                 let mean = ring.iter().sum::<f32>() / n as f32;
@@ -193,11 +194,17 @@ impl AngularProfile {
                 "the images are uniform on every ring: no angular structure to align".into(),
             ));
         }
-        let k = (0..corr.len()).max_by(|&i, &j| corr[i].total_cmp(&corr[j])).unwrap_or(0);
+        let k = (0..corr.len())
+            .max_by(|&i, &j| corr[i].total_cmp(&corr[j]))
+            .unwrap_or(0);
         let frac = if k > 0 && k + 1 < corr.len() {
             let (y0, y1, y2) = (corr[k - 1], corr[k], corr[k + 1]);
             let den = y0 - 2.0 * y1 + y2;
-            if den < 0.0 { 0.5 * (y0 - y2) / den } else { 0.0 }
+            if den < 0.0 {
+                0.5 * (y0 - y2) / den
+            } else {
+                0.0
+            }
         } else {
             0.0
         };

@@ -24,7 +24,9 @@ pub mod rim;
 pub mod trilateration;
 
 pub use compass::{AngularProfile, CompassConfig, Rotation};
-pub use interframe::{Candidate, FeaturePair, Translation, densest_cluster, translation_candidates};
+pub use interframe::{
+    Candidate, FeaturePair, Translation, densest_cluster, translation_candidates,
+};
 pub use marks::{ColourMark, MarkConfig, detect_marks};
 pub use range::{RangedMark, StereoGeometry, range_marks};
 pub use rim::MirrorRim;

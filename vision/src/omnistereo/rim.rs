@@ -108,7 +108,7 @@ fn fit_circle(pts: &[[f64; 2]]) -> Result<MirrorRim, VisionError> {
     })?;
     let (cx, cy) = (-sol[0] / 2.0, -sol[1] / 2.0);
     let r2 = cx * cx + cy * cy - sol[2];
-    if !(r2 > 0.0) {
+    if r2.is_nan() || r2 <= 0.0 {
         return Err(VisionError::NotFound(
             "the boundary points do not lie on a circle".into(),
         ));

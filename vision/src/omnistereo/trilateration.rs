@@ -102,7 +102,7 @@ fn gauss_newton_step(used: &[LandmarkRange], p: Point2<f64>) -> Result<Point2<f6
 fn solve(a: Matrix2<f64>, b: Vector2<f64>) -> Result<Vector2<f64>, VisionError> {
     // Conditioning: the landmarks seen must not lie on one line through the robot.
     let (tr, det) = (a.trace(), a.determinant());
-    if !(det > 1e-9 * tr * tr) {
+    if det.is_nan() || det <= 1e-9 * tr * tr {
         return Err(VisionError::NotFound(
             "the ranged landmarks are (nearly) on one line: the position is not determined".into(),
         ));
@@ -150,9 +150,16 @@ mod tests {
     #[test]
     fn exact_ranges_give_the_pose_back() {
         let mut rng = StdRng::seed_from_u64(1);
-        for (x, y, h) in [(0.0, 0.0, 0.3), (-1200.0, 700.0, -2.5), (1500.0, -900.0, 3.0)] {
+        for (x, y, h) in [
+            (0.0, 0.0, 0.3),
+            (-1200.0, 700.0, -2.5),
+            (1500.0, -900.0, 3.0),
+        ] {
             let pose = Isometry2::new(Vector2::new(x, y), h);
-            for mode in [TrilaterationMode::Nearest3, TrilaterationMode::AllLeastSquares] {
+            for mode in [
+                TrilaterationMode::Nearest3,
+                TrilaterationMode::AllLeastSquares,
+            ] {
                 let est = trilaterate(&seen(pose, 0.0, &mut rng), mode).unwrap();
                 assert!((est.translation.vector - pose.translation.vector).norm() < 1e-6);
                 let dh = (est.rotation.angle() - h + 3.0 * std::f64::consts::PI)
@@ -177,7 +184,10 @@ mod tests {
             }
             let mean = sum / 200.0;
             // Of the order of the range error, and growing with it, never a jump.
-            assert!(mean < 2.5 * noise && mean > last, "noise {noise}: mean error {mean}");
+            assert!(
+                mean < 2.5 * noise && mean > last,
+                "noise {noise}: mean error {mean}"
+            );
             last = mean;
         }
     }
@@ -190,9 +200,9 @@ mod tests {
         assert!(trilaterate(two, TrilaterationMode::Nearest3).is_err());
         let line: Vec<LandmarkRange> = [-2000.0, 0.0, 2000.0]
             .iter()
-            .map(|&x| LandmarkRange {
+            .map(|&x: &f64| LandmarkRange {
                 centre_mm: Point2::new(x, 0.0),
-                range_mm: (x as f64).abs().max(1.0),
+                range_mm: f64::abs(x).max(1.0),
                 bearing_rad: 0.0,
                 sigma_mm: 10.0,
             })
