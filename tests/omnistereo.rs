@@ -137,3 +137,19 @@ fn save_frames_keeps_every_frame_of_both_cameras() {
     }
     assert!(!out.join("frames").join("lower_000010.png").exists());
 }
+
+#[test]
+fn a_rig_that_is_not_two_cones_is_a_scenario_error() {
+    let text = std::fs::read_to_string(scenario_path("omnistereo_arena.toml")).unwrap();
+    let text = text.replace("upper_sensor = \"upper\"", "upper_sensor = \"top\"");
+    let dir = tmp("omnistereo_broken");
+    let file = dir.join("broken.toml");
+    std::fs::write(&file, text).unwrap();
+    let out = common::bin().arg("check").arg(&file).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("vision.omnistereo.upper_sensor") && err.contains("no sensor \"top\""),
+        "{err}"
+    );
+}
