@@ -12,7 +12,7 @@
 //! `|l| <= max_rotation_deg`; a parabola through the peak and its neighbours gives the
 //! fraction of a sample. Rings of stronger contrast weigh more (the profiles are not scaled).
 
-use super::{MirrorRim, positive};
+use super::{MirrorRim, below, positive};
 use crate::VisionError;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
@@ -67,14 +67,12 @@ impl CompassConfig {
                 rule: "need 0 < inner_fraction <= outer_fraction < 1",
             });
         }
-        if self.max_rotation_deg >= 180.0 {
-            return Err(VisionError::InvalidParameter {
-                name: "compass.max_rotation_deg",
-                value: self.max_rotation_deg,
-                rule: "must be below 180",
-            });
-        }
-        Ok(())
+        below(
+            "compass.max_rotation_deg",
+            self.max_rotation_deg,
+            180.0,
+            "must be below 180",
+        )
     }
 }
 

@@ -15,7 +15,7 @@
 //! Pixels are sampled at their centres, so without more columns the edge is known to within the
 //! pixel spacing along the axis.
 
-use super::{MirrorRim, positive, wrap};
+use super::{MirrorRim, below, positive, wrap};
 use crate::VisionError;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
@@ -66,14 +66,12 @@ impl MarkConfig {
         positive("marks.min_radius_px", self.min_radius_px)?;
         positive("marks.rim_margin_px", self.rim_margin_px)?;
         positive("marks.seed_fraction", self.seed_fraction)?;
-        if self.min_saturation >= 1.0 {
-            return Err(VisionError::InvalidParameter {
-                name: "marks.min_saturation",
-                value: self.min_saturation,
-                rule: "must be below 1",
-            });
-        }
-        Ok(())
+        below(
+            "marks.min_saturation",
+            self.min_saturation,
+            1.0,
+            "must be below 1",
+        )
     }
 }
 

@@ -95,6 +95,20 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<(), VisionError
     }
 }
 
+/// `value` must be below `limit` (`rule` says so in words).
+pub(crate) fn below(
+    name: &'static str,
+    value: f64,
+    limit: f64,
+    rule: &'static str,
+) -> Result<(), VisionError> {
+    if value < limit {
+        Ok(())
+    } else {
+        Err(VisionError::InvalidParameter { name, value, rule })
+    }
+}
+
 /// Wraps an angle into (-pi, pi].
 pub(crate) fn wrap(a: f64) -> f64 {
     use std::f64::consts::PI;
