@@ -176,12 +176,12 @@ impl AngularProfile {
         for (a, b) in earlier.rings.iter().zip(&self.rings) {
             ea += a.iter().map(|x| (x * x) as f64).sum::<f64>();
             eb += b.iter().map(|x| (x * x) as f64).sum::<f64>();
-            // a, twice over, so that a[k + l] needs no modulo.
-            let aa: Vec<f32> = a.iter().chain(a.iter()).copied().collect();
             for (c, &l) in corr.iter_mut().zip(&lags) {
+                // sum_k a[(k + l) mod n] b[k], in two runs that need no modulo.
                 let off = (l.rem_euclid(n as i64)) as usize;
-                let s: f32 = aa[off..off + n].iter().zip(b).map(|(x, y)| x * y).sum();
-                *c += s as f64;
+                let head: f32 = a[off..].iter().zip(b).map(|(x, y)| x * y).sum();
+                let tail: f32 = a[..off].iter().zip(&b[n - off..]).map(|(x, y)| x * y).sum();
+                *c += (head + tail) as f64;
             }
         }
         let norm = (ea * eb).sqrt();
@@ -215,28 +215,20 @@ impl AngularProfile {
 
 #[cfg(test)]
 mod tests {
+    use super::super::rim::synthetic_disc;
     use super::*;
     use image::Rgba;
 
-    /// A disc of radius 200 with a pattern of sectors that depends on azimuth and radius,
-    /// turned by `turn` (the robot's rotation: features appear at azimuth - turn).
+    /// A disc with a pattern of sectors that depends on azimuth and radius, turned by `turn`
+    /// (the robot's rotation: features appear at azimuth - turn).
     fn scene(turn: f64) -> (RgbaImage, MirrorRim) {
-        let rim = MirrorRim {
-            centre_px: [256.0, 256.0],
-            radius_px: 200.0,
-            points: 0,
-        };
-        let img = RgbaImage::from_fn(512, 512, |u, v| {
-            let (x, y) = rim.image_coords(u as f64, v as f64);
-            let (h, a) = (x.hypot(y), y.atan2(x) + turn);
-            if h >= 200.0 {
-                return Rgba([0, 0, 0, 255]);
-            }
-            let g = 120.0 + 60.0 * (3.0 * a).sin() + 40.0 * (7.0 * a + h / 40.0).cos();
+        synthetic_disc(|h, a| {
+            let g = 120.0
+                + 60.0 * (3.0 * (a + turn)).sin()
+                + 40.0 * (7.0 * (a + turn) + h / 40.0).cos();
             let g = g.clamp(0.0, 255.0) as u8;
             Rgba([g, g, g, 255])
-        });
-        (img, rim)
+        })
     }
 
     #[test]

@@ -458,29 +458,20 @@ fn top_edge(
 
 #[cfg(test)]
 mod tests {
+    use super::super::rim::synthetic_disc;
     use super::*;
     use image::Rgba;
 
-    /// A rim of radius 200 about the centre of a 512 image, grey inside, with a red wedge of
-    /// half-width `hw` at `bearing` out to radius `top`.
+    /// A disc, grey inside, with a red wedge of half-width `hw` at `bearing` out to radius
+    /// `top`.
     fn wedge(bearing: f64, hw: f64, top: f64) -> (RgbaImage, MirrorRim) {
-        let rim = MirrorRim {
-            centre_px: [256.0, 256.0],
-            radius_px: 200.0,
-            points: 0,
-        };
-        let img = RgbaImage::from_fn(512, 512, |u, v| {
-            let (x, y) = rim.image_coords(u as f64, v as f64);
-            let (h, a) = (x.hypot(y), y.atan2(x));
-            if h >= 200.0 {
-                Rgba([0, 0, 0, 255])
-            } else if h < top && wrap(a - bearing).abs() < hw {
+        synthetic_disc(|h, a| {
+            if h < top && wrap(a - bearing).abs() < hw {
                 Rgba([200, 30, 25, 255])
             } else {
                 Rgba([180, 175, 160, 255])
             }
-        });
-        (img, rim)
+        })
     }
 
     #[test]

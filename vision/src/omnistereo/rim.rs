@@ -120,6 +120,29 @@ fn fit_circle(pts: &[[f64; 2]]) -> Result<MirrorRim, VisionError> {
     })
 }
 
+/// A 512 x 512 test image: a mirror disc of radius 200 about the centre, black outside,
+/// inside painted by `paint(radius_px, azimuth_rad)` (image coordinates, Y up).
+#[cfg(test)]
+pub(crate) fn synthetic_disc(
+    paint: impl Fn(f64, f64) -> image::Rgba<u8>,
+) -> (RgbaImage, MirrorRim) {
+    let rim = MirrorRim {
+        centre_px: [256.0, 256.0],
+        radius_px: 200.0,
+        points: 0,
+    };
+    let img = RgbaImage::from_fn(512, 512, |u, v| {
+        let (x, y) = rim.image_coords(u as f64, v as f64);
+        let h = x.hypot(y);
+        if h >= 200.0 {
+            image::Rgba([0, 0, 0, 255])
+        } else {
+            paint(h, y.atan2(x))
+        }
+    });
+    (img, rim)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
