@@ -23,7 +23,7 @@ fn summary(mut t: Vec<f64>) -> (f64, f64) {
 
 fn main() {
     let s = load_scenario(&common::scenario_path("omnistereo_arena.toml")).expect("scenario");
-    let config = s.robot_config(Vec::new());
+    let config = s.robot_config(Vec::new(), Vec::new());
     let rig = config.stereo.expect("the arena's robot has two cones");
     let sensors: Vec<_> = s
         .robot
@@ -61,6 +61,7 @@ fn main() {
     let belief = Belief {
         pose: None,
         fixed: false,
+        odometry_pose: Isometry2::identity(),
     };
     let mut run = |imgs: &[image::RgbaImage]| {
         let f = [

@@ -73,7 +73,8 @@ struct Camera {
 pub struct Cameras {
     renderer: Renderer,
     cameras: Vec<Camera>,
-    images: Vec<RgbaImage>,
+    /// The last capture, one entry a camera (`None`: not rendered).
+    images: Vec<Option<RgbaImage>>,
 }
 
 impl Cameras {
@@ -117,13 +118,29 @@ impl Cameras {
 
     /// Renders every live camera at robot 0's true pose, with its noise.
     pub fn capture(&mut self, world: &World) -> Result<(), RunError> {
+        self.capture_some(world, None)
+    }
+
+    /// Renders the live cameras named in `wanted` (all live ones with `None`) at robot 0's
+    /// true pose, with their noise; the others give no frame this cycle.
+    pub fn capture_some(
+        &mut self,
+        world: &World,
+        wanted: Option<&[String]>,
+    ) -> Result<(), RunError> {
         let pose = world.robot_state(0).pose;
         let scene = Scene::of_world(world);
         self.images.clear();
-        for c in self.cameras.iter_mut().filter(|c| c.live) {
-            let img = self
-                .renderer
-                .render(&scene, &c.sensor, &pose, Some(&mut c.noise))?;
+        for c in &mut self.cameras {
+            let take = c.live && wanted.is_none_or(|w| w.contains(&c.sensor.name));
+            let img = if take {
+                Some(
+                    self.renderer
+                        .render(&scene, &c.sensor, &pose, Some(&mut c.noise))?,
+                )
+            } else {
+                None
+            };
             self.images.push(img);
         }
         Ok(())
@@ -133,24 +150,24 @@ impl Cameras {
     pub fn frames(&self, t_s: f64) -> Vec<Frame<'_>> {
         self.cameras
             .iter()
-            .filter(|c| c.live)
             .zip(&self.images)
-            .map(|(c, image)| Frame {
-                sensor: &c.sensor.name,
-                t_s,
-                image,
+            .filter_map(|(c, image)| {
+                image.as_ref().map(|image| Frame {
+                    sensor: &c.sensor.name,
+                    t_s,
+                    image,
+                })
             })
             .collect()
     }
 
-    /// The last capture of camera `name`, if it is rendered.
+    /// The last capture of camera `name`, if it was rendered.
     pub fn image(&self, name: &str) -> Option<&RgbaImage> {
         self.cameras
             .iter()
-            .filter(|c| c.live)
             .zip(&self.images)
             .find(|(c, _)| c.sensor.name == name)
-            .map(|(_, image)| image)
+            .and_then(|(_, image)| image.as_ref())
     }
 
     /// The state of the pan units.
@@ -202,7 +219,8 @@ impl Cameras {
 
     /// Writes the last capture to `dir` as `<camera>_<cycle>.png`.
     pub fn save(&self, dir: &std::path::Path, cycle: u64) -> Result<(), RunError> {
-        for (c, img) in self.cameras.iter().filter(|c| c.live).zip(&self.images) {
+        for (c, img) in self.cameras.iter().zip(&self.images) {
+            let Some(img) = img else { continue };
             let path = dir.join(format!("{}_{:06}.png", c.sensor.name, cycle));
             img.save(&path)
                 .map_err(|source| RunError::Frame { path, source })?;

@@ -12,6 +12,7 @@
 pub mod calibrate;
 pub mod cameras;
 pub mod charts;
+pub mod column_calibration;
 pub mod experiments;
 pub mod load;
 pub mod odometry;

@@ -7,11 +7,12 @@ use crate::experiments::ExperimentSpec;
 use crate::odometry::OdometrySpec;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_robot::{
-    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapSegment, RobotConfig, StereoRig, VisionSpec,
-    WorldMap,
+    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StereoRig,
+    VisionSpec, WorldMap,
 };
 use omniloop_sim::{Layout, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
+use omniloop_vision::resection::{ColumnCalibration, StripePattern};
 use serde::{Deserialize, Serialize};
 
 /// A complete scenario: the world, the robot, what it should do and for how long.
@@ -262,7 +263,11 @@ impl Scenario {
 
     /// The configuration of the robot's software: what it is told of its start, its body and
     /// cameras, with the image-to-floor calibrations of the cameras vision uses.
-    pub fn robot_config(&self, calibrations: Vec<RadialCalibration>) -> RobotConfig {
+    pub fn robot_config(
+        &self,
+        calibrations: Vec<RadialCalibration>,
+        columns: Vec<ColumnCalibration>,
+    ) -> RobotConfig {
         let r = &self.robot;
         RobotConfig {
             start: self.start().isometry(),
@@ -275,6 +280,7 @@ impl Scenario {
             control_period_s: self.run.control_period_s,
             cameras: r.sensors.iter().map(|s| s.name.clone()).collect(),
             calibrations,
+            columns,
             vision: self.vision.clone(),
             control: self.control.clone(),
             goal: self.goal.clone(),
@@ -329,6 +335,21 @@ impl Scenario {
                 })
                 .collect(),
             segments,
+            marks: w
+                .boards
+                .iter()
+                .filter_map(|b| {
+                    let name = b.name.as_ref()?;
+                    let c = [
+                        0.5 * (b.from_mm[0] + b.to_mm[0]),
+                        0.5 * (b.from_mm[1] + b.to_mm[1]),
+                    ];
+                    Some(MapMark {
+                        centre_mm: p(c),
+                        pattern: StripePattern::new(name, &b.stripes),
+                    })
+                })
+                .collect(),
         }
     }
 
@@ -393,9 +414,23 @@ impl Scenario {
         })
     }
 
+    /// Whether the robot's software resects from a pinhole camera's columns (which it
+    /// calibrates first).
+    pub fn needs_columns(&self) -> bool {
+        self.resects()
+            && self
+                .sensor(self.vision.sensor.as_deref())
+                .is_ok_and(|s| s.pinhole.is_some())
+    }
+
+    fn resects(&self) -> bool {
+        self.control.pose_source == omniloop_robot::PoseSource::Resection
+    }
+
     /// Whether the robot's software uses a mirror camera's image-to-floor map.
     pub fn needs_calibration(&self) -> bool {
-        self.control.kind.uses_freespace()
+        (self.resects() && !self.needs_columns())
+            || self.control.kind.uses_freespace()
             || self.control.pose_source == omniloop_robot::PoseSource::Localization
             || self.experiment_takes_frames()
             || self

@@ -4,6 +4,7 @@
 
 use crate::calibrate::calibrate_sensor;
 use crate::cameras::Cameras;
+use crate::column_calibration::calibrate_columns;
 use crate::experiments;
 use crate::odometry::WheelOdometry;
 use crate::pilot::Pilot;
@@ -14,6 +15,7 @@ use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
 use omniloop_robot::{ControllerKind, Estimates, Observation, Robot, RobotError};
 use omniloop_sim::{RenderError, Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
+use omniloop_vision::resection::ColumnCalibration;
 use omniloop_vision::{RadialCalibration, VisionError};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -106,6 +108,19 @@ fn calibrations(scenario: &Scenario) -> Result<Vec<RadialCalibration>, RunError>
     Ok(vec![cal])
 }
 
+/// The column calibrations of the pinhole camera the robot resects with, measured from images
+/// of the calibration target.
+fn columns(scenario: &Scenario) -> Result<Vec<ColumnCalibration>, RunError> {
+    if !scenario.needs_columns() {
+        return Ok(Vec::new());
+    }
+    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
+    Ok(vec![calibrate_columns(
+        &scenario.robot.sensors[index],
+        scenario.seed,
+    )?])
+}
+
 /// A scenario being run, one control cycle at a time.
 pub struct Simulation {
     scenario: Scenario,
@@ -138,7 +153,7 @@ impl Simulation {
             scenario.run.physics_step_s,
         )?;
         let calibrations = calibrations(scenario)?;
-        let robot = Robot::new(&scenario.robot_config(calibrations.clone()))?;
+        let robot = Robot::new(&scenario.robot_config(calibrations.clone(), columns(scenario)?))?;
         let r = &scenario.robot;
         let pilot = match (&scenario.goal, scenario.control.kind) {
             (Some(g), ControllerKind::GoToGoalTruth) => Some(Pilot::new(
@@ -212,6 +227,13 @@ impl Simulation {
         self.estimates.last()
     }
 
+    /// The true pose of the robot under test when the last cycle's frames were taken.
+    pub fn last_truth_pose(&self) -> Option<Isometry2<f64>> {
+        self.trajectory
+            .last()
+            .map(|r| Isometry2::new(Vector2::new(r.x_mm, r.y_mm), r.theta_rad))
+    }
+
     /// Whether the run is over: time is up, or the goal is reached and the run stops there.
     pub fn finished(&self) -> bool {
         self.cycle >= self.scenario.max_cycles()
@@ -248,7 +270,10 @@ impl Simulation {
         let t = self.world.time_s();
         let out = match &mut self.cameras {
             Some(c) => {
-                c.capture(&self.world)?;
+                // Saving frames renders every camera; otherwise those the robot reads now.
+                let wanted = self.robot.cameras_now();
+                let saving = self.options.save_frames_every.is_some();
+                c.capture_some(&self.world, (!saving).then_some(wanted.as_slice()))?;
                 if let (Some(every), Some(dir)) =
                     (self.options.save_frames_every, &self.options.frames_dir)
                     && every > 0

@@ -294,7 +294,7 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
     check_vision_and_control(&mut c, s);
     if !matches!(
         s.control.kind,
-        ControllerKind::Idle | ControllerKind::Wander
+        ControllerKind::Idle | ControllerKind::Wander | ControllerKind::Observe
     ) && s.goal.is_none()
     {
         c.fail(
@@ -403,6 +403,7 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
     }
     check_localization(c, s);
     check_omnistereo(c, s);
+    check_resection(c, s);
     let o = &s.odometry;
     for (key, v) in [
         ("speed_noise_frac", o.speed_noise_frac),
@@ -587,6 +588,73 @@ fn check_omnistereo(c: &mut Checker, s: &Scenario) {
     }
 }
 
+/// The named boards (the robot's striped marks) and, with `pose_source = "resection"`, the
+/// three marks, the camera and the search.
+fn check_resection(c: &mut Checker, s: &Scenario) {
+    let mut names: Vec<&str> = Vec::new();
+    for (i, b) in s.world.boards.iter().enumerate() {
+        let Some(name) = &b.name else { continue };
+        if names.contains(&name.as_str()) {
+            c.fail(
+                format!("world.boards[{i}].name"),
+                format!("{name:?} names two boards"),
+            );
+        }
+        names.push(name);
+        let pattern = omniloop_vision::resection::StripePattern::new(name, &b.stripes);
+        if let Err(e) = pattern.validate() {
+            c.fail(
+                format!("world.boards[{i}].stripes"),
+                format!("mark {name:?}: {e}"),
+            );
+        }
+    }
+    if s.control.pose_source != PoseSource::Resection {
+        return;
+    }
+    if let Err(e) = s.vision.resection.validate() {
+        c.fail("vision.resection", e.to_string());
+    }
+    let r = &s.control.resection;
+    c.positive("control.resection.pan_rate_deg_s", r.pan_rate_deg_s);
+    c.positive("control.resection.move_mm", r.move_mm);
+    if !(r.central_fraction > 0.0 && r.central_fraction <= 1.0) {
+        c.fail(
+            "control.resection.central_fraction",
+            format!("must be in (0, 1] (got {})", r.central_fraction),
+        );
+    }
+    if names.len() != 3 {
+        c.fail(
+            "control.pose_source",
+            format!(
+                "resection needs exactly three marks: name three [[world.boards]] (found {})",
+                names.len()
+            ),
+        );
+    }
+    match s.vision_sensor_index() {
+        Err(e) => c.fail(
+            "vision.sensor",
+            format!("resection sees through a camera: {e}"),
+        ),
+        Ok(i) => {
+            if let Some(cam) = &s.robot.sensors[i].pinhole
+                && cam.tilt_deg != 0.0
+            {
+                c.fail(
+                    format!("robot.sensors[{i}].pinhole.tilt_deg"),
+                    format!(
+                        "resection reads bearings from a level camera (Sect. 3.2): must be 0 \
+                         (got {})",
+                        cam.tilt_deg
+                    ),
+                );
+            }
+        }
+    }
+}
+
 fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
     if s.name.trim().is_empty() {
         c.fail(format!("{p}.name"), "must not be empty");
@@ -612,6 +680,12 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
         c.fail(
             format!("{p}.noise_sigma"),
             format!("must be >= 0 (got {})", s.noise_sigma),
+        );
+    }
+    if let Some(n) = s.grey_levels.filter(|n| !(2..=256).contains(n)) {
+        c.fail(
+            format!("{p}.grey_levels"),
+            format!("must be 2..=256 (got {n})"),
         );
     }
     let present = s.optics_present();

@@ -5,6 +5,7 @@ use nalgebra::{Isometry2, Point2};
 use omniloop_control::AvoidanceConfig;
 use omniloop_vision::luminance_heading::LuminanceConfig;
 use omniloop_vision::omnistereo::OmnistereoConfig;
+use omniloop_vision::resection::{ColumnCalibration, ResectionConfig, StripePattern};
 use omniloop_vision::{FreeSpaceConfig, LocalizationConfig, RadialCalibration};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -28,6 +29,9 @@ pub enum ControllerKind {
     /// Random wandering on the map (E4, Spacek and Burbridge, Sect. 2.1): forward until the
     /// map says a pillar or a wall is near, then a random turn left or right.
     Wander,
+    /// Stand still while the cameras search, and drive to the observation points perception
+    /// asks for (E5's "change the observation point by making a move", Fig. 4).
+    Observe,
 }
 
 impl ControllerKind {
@@ -44,6 +48,7 @@ impl ControllerKind {
             Self::GoalDirection => "goal_direction",
             Self::VelocityAware => "velocity_aware",
             Self::Wander => "wander",
+            Self::Observe => "observe",
         }
     }
 }
@@ -64,6 +69,9 @@ pub enum PoseSource {
     /// Odometry corrected by trilateration from the conical omnistereo ranges to the map's
     /// landmarks (Spacek and Burbridge), every cycle that gives a fix.
     Omnistereo,
+    /// Resection from three striped marks (Ishikawa, Kikuchi and Kato): a panning search for
+    /// the marks while the pose is unknown, one fix when all three are found.
+    Resection,
 }
 
 /// How the robot chooses its velocity (`[control]`).
@@ -81,6 +89,35 @@ pub struct ControlSpec {
     pub localization_gain: f64,
     /// Settings of the wandering controller (`kind = "wander"`).
     pub wander: WanderConfig,
+    /// The search for the marks (`pose_source = "resection"`).
+    pub resection: SearchConfig,
+}
+
+/// How the robot searches for the three marks (`[control.resection]`, Fig. 4 of the resection
+/// paper).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SearchConfig {
+    /// Rate of the pan from right to left, deg/s (the pan unit clips it to its limit).
+    pub pan_rate_deg_s: f64,
+    /// Sightings count toward a mark's bearing when its centre is within this fraction of the
+    /// half-width of the image from the optical axis (ours: the calibration is best there).
+    pub central_fraction: f64,
+    /// Length of the move to another observation point when a mark was not found, mm.
+    pub move_mm: f64,
+    /// Moves before the robot gives up.
+    pub max_moves: u32,
+}
+
+impl Default for SearchConfig {
+    fn default() -> Self {
+        Self {
+            pan_rate_deg_s: 60.0,
+            central_fraction: 0.5,
+            move_mm: 300.0,
+            max_moves: 3,
+        }
+    }
 }
 
 /// How the wandering controller drives (`[control.wander]`).
@@ -116,6 +153,7 @@ impl Default for ControlSpec {
             pose_source: PoseSource::Odometry,
             localization_gain: 0.3,
             wander: WanderConfig::default(),
+            resection: SearchConfig::default(),
         }
     }
 }
@@ -138,6 +176,8 @@ pub struct VisionSpec {
     /// Conical omnistereo: range, trilateration, visual compass and interframe motion
     /// (Spacek and Burbridge).
     pub omnistereo: OmnistereoConfig,
+    /// Striped-mark recognition for resection (Ishikawa, Kikuchi and Kato).
+    pub resection: ResectionConfig,
 }
 
 /// The goal point, reached through optional waypoints (`[goal]`), in the world (field) frame.
@@ -251,6 +291,15 @@ pub struct MapSegment {
     pub half_thickness_mm: f64,
 }
 
+/// A striped mark of the robot's map (a named board).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapMark {
+    /// Where its centre stands, world frame, mm.
+    pub centre_mm: Point2<f64>,
+    /// Its stripes, named.
+    pub pattern: StripePattern,
+}
+
 /// What the robot is told of its surroundings (E4's "map of the arena programmed into the
 /// robot"): where the landmarks stand and where the obstacles are. Not its own pose.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -259,6 +308,8 @@ pub struct WorldMap {
     pub landmarks: Vec<MapLandmark>,
     /// Straight obstacles.
     pub segments: Vec<MapSegment>,
+    /// Striped marks.
+    pub marks: Vec<MapMark>,
 }
 
 /// The design of a conical omnistereo rig (two coaxial 90-degree cones), as built.
@@ -287,6 +338,8 @@ pub struct RobotConfig {
     pub cameras: Vec<String>,
     /// Image-to-floor calibrations of the mirror cameras vision uses (each names its sensor).
     pub calibrations: Vec<RadialCalibration>,
+    /// Column-to-bearing calibrations of the pinhole cameras vision uses.
+    pub columns: Vec<ColumnCalibration>,
     /// Image processing.
     pub vision: VisionSpec,
     /// Controller and estimator.
@@ -323,6 +376,16 @@ impl RobotConfig {
     /// Whether the robot runs the omnistereo stage.
     pub fn uses_omnistereo(&self) -> bool {
         self.control.pose_source == PoseSource::Omnistereo
+    }
+
+    /// Whether the robot runs the resection stage.
+    pub fn resects(&self) -> bool {
+        self.control.pose_source == PoseSource::Resection
+    }
+
+    /// The column calibration of camera `sensor`.
+    pub fn columns(&self, sensor: &str) -> Option<&ColumnCalibration> {
+        self.columns.iter().find(|c| c.sensor == sensor)
     }
 
     /// Whether the robot runs floor-region self-localization.

@@ -5,7 +5,7 @@ use crate::boundary::BodyCommand;
 use crate::config::{ControllerKind, RobotConfig};
 use crate::near_field::{NearField, NearSpace};
 use crate::wander::Wander;
-use nalgebra::{Isometry2, Vector2};
+use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::{
     AccelLimitedDrive, GoalDirection, SpeedChoice, Surroundings, VelocityAware,
 };
@@ -24,6 +24,8 @@ pub struct Situation<'a> {
     pub pose: Option<Isometry2<f64>>,
     /// The dead-reckoned pose in the odometry frame.
     pub odometry_pose: Isometry2<f64>,
+    /// A point perception asks the robot to drive to (odometry frame).
+    pub observation_point: Option<Point2<f64>>,
     /// Time of the cycle, s.
     pub t_s: f64,
 }
@@ -59,7 +61,39 @@ pub fn build(config: &RobotConfig) -> Result<Box<dyn Controller>, RobotError> {
             )?,
         }),
         ControllerKind::Wander => Box::new(Wander::new(config)?),
+        ControllerKind::Observe => Box::new(Observe {
+            max_speed_mm_s: b.max_speed_mm_s,
+            accel_limit_mm_s2: b.accel_limit_mm_s2,
+            period_s: config.control_period_s,
+        }),
     })
+}
+
+/// Stands still, or drives straight to the observation point perception asks for, arriving at
+/// rest: the speed is the one from which the acceleration limit stops the robot over the
+/// distance left (less one period's travel), capped at the top speed.
+struct Observe {
+    max_speed_mm_s: f64,
+    accel_limit_mm_s2: f64,
+    period_s: f64,
+}
+
+impl Controller for Observe {
+    fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
+        let Some(target) = s.observation_point else {
+            return BodyCommand::STOP;
+        };
+        let to = s.odometry_pose.inverse_transform_point(&target).coords;
+        let d = to.norm();
+        if d < 1.0 {
+            return BodyCommand::STOP;
+        }
+        let a = self.accel_limit_mm_s2;
+        let t = self.period_s;
+        // v with v t + v^2 / (2 a) = d: the robot can still stop in what is left after a cycle.
+        let v = (-a * t + ((a * t).powi(2) + 2.0 * a * d).sqrt()).min(self.max_speed_mm_s);
+        BodyCommand::translate(to * (v / d))
+    }
 }
 
 /// Stands still.

@@ -30,8 +30,8 @@ pub use boundary::{
     ActuatorCommand, ActuatorState, BodyCommand, Frame, Observation, OdometryReading, Outputs,
 };
 pub use config::{
-    BodySpec, ControlSpec, ControllerKind, GoalSpec, MapLandmark, MapSegment, PoseSource,
-    RobotConfig, StereoRig, VisionSpec, WanderConfig, WorldMap,
+    BodySpec, ControlSpec, ControllerKind, GoalSpec, MapLandmark, MapMark, MapSegment, PoseSource,
+    RobotConfig, SearchConfig, StereoRig, VisionSpec, WanderConfig, WorldMap,
 };
 pub use estimates::{
     Estimates, Fix, FixOutcome, LandmarkSighting, Measurement, MotionReading, NotFound,

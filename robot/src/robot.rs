@@ -48,6 +48,23 @@ impl Robot {
         &self.cameras
     }
 
+    /// The cameras whose frames the stack reads this cycle (a stage that is not looking, e.g.
+    /// while the robot drives to another observation point, needs none).
+    pub fn cameras_now(&self) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for c in self
+            .stages
+            .iter()
+            .filter(|s| s.wants_frames())
+            .flat_map(|s| s.cameras())
+        {
+            if !out.iter().any(|k| k == c) {
+                out.push(c.to_string());
+            }
+        }
+        out
+    }
+
     /// The names of the perception stages, in the order they run.
     pub fn stages(&self) -> Vec<&'static str> {
         self.stages.iter().map(|s| s.name()).collect()
@@ -61,6 +78,9 @@ impl Robot {
     /// The robot was carried to a place it is not told: its pose is unknown until a fix.
     pub fn forget_pose(&mut self) {
         self.estimator.forget();
+        for stage in &mut self.stages {
+            stage.carried();
+        }
     }
 
     /// The current pose estimate (world frame).
@@ -78,6 +98,7 @@ impl Robot {
         let belief = Belief {
             pose: self.estimator.estimate(),
             fixed: self.estimator.has_fix(),
+            odometry_pose: self.estimator.odometry_pose(),
         };
         let mut percepts = Percepts::default();
         for stage in &mut self.stages {
@@ -108,12 +129,13 @@ impl Robot {
             velocity_body_mm_s,
             pose,
             odometry_pose: self.estimator.odometry_pose(),
+            observation_point: percepts.observation_point,
             t_s: obs.t_s,
         });
         self.estimator.end_cycle();
         Ok(Outputs {
             command,
-            actuators: Vec::new(),
+            actuators: percepts.actuators,
             estimates: Estimates {
                 t_s: obs.t_s,
                 pose,

@@ -166,12 +166,14 @@ mod tests {
             control_period_s: 0.05,
             cameras: Vec::new(),
             calibrations: Vec::new(),
+            columns: Vec::new(),
             vision: VisionSpec::default(),
             control: ControlSpec::default(),
             goal: None,
             map: WorldMap {
                 landmarks: Vec::new(),
                 segments: vec![seg([1000.0, -1000.0], [1000.0, 1000.0])],
+                marks: Vec::new(),
             },
             stereo: None,
             seed: 3,
@@ -185,6 +187,7 @@ mod tests {
             velocity_body_mm_s: Vector2::zeros(),
             pose: Some(pose),
             odometry_pose: Isometry2::identity(),
+            observation_point: None,
             t_s: 0.0,
         }
     }

@@ -259,6 +259,9 @@ pub struct Pillar {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Board {
+    /// What the board is called (the mark's name, `P`), if anything.
+    #[serde(default)]
+    pub name: Option<String>,
     /// One end of the board.
     pub from_mm: [f64; 2],
     /// The other end.

@@ -24,6 +24,11 @@ pub struct SensorSpec {
     /// of 255.
     #[serde(default = "default_noise")]
     pub noise_sigma: f64,
+    /// Grey levels the camera delivers (e.g. 16 for the resection paper's digitizer): the image
+    /// becomes grey, its luminance quantised to this many levels spread over 0..255, after the
+    /// noise. Default: colour, 256 levels a channel.
+    #[serde(default)]
+    pub grey_levels: Option<u32>,
     /// Position of the sensor's axis on the robot (x forward, y left).
     #[serde(default)]
     pub mount_mm: [f64; 2],
@@ -60,6 +65,7 @@ impl SensorSpec {
             height_px: 220,
             principal_point_px: None,
             noise_sigma: 4.0,
+            grey_levels: None,
             mount_mm: [0.0, 0.0],
             hyperbolic: Some(HyperbolicMirror::corner_paper()),
             conical: None,
@@ -122,6 +128,7 @@ impl SensorSpec {
             cx_px: cx,
             cy_px: cy,
             noise_sigma: self.noise_sigma,
+            grey_levels: self.grey_levels,
             mount_mm: self.mount_mm,
             optics,
         })
@@ -143,6 +150,8 @@ pub struct Sensor {
     pub cy_px: f64,
     /// Noise sigma in levels.
     pub noise_sigma: f64,
+    /// Grey levels, when the camera is a quantised grey one.
+    pub grey_levels: Option<u32>,
     /// Axis position on the robot.
     pub mount_mm: [f64; 2],
     /// Optics.

@@ -12,6 +12,7 @@ pub mod heading;
 pub mod localization_map;
 pub mod omnistereo;
 pub mod places;
+pub mod resection;
 
 use crate::load::parse_scenario;
 use crate::output::write_run;
@@ -67,7 +68,8 @@ struct Drive;
 impl Experiment for Drive {}
 
 /// The experiment a scenario belongs to (`[experiment.corner]`, `[experiment.places]`,
-/// `[experiment.localization_map]`, `[experiment.heading]`, `[experiment.omnistereo]`).
+/// `[experiment.localization_map]`, `[experiment.heading]`, `[experiment.omnistereo]`,
+/// `[experiment.resection]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExperimentSpec {
@@ -81,6 +83,8 @@ pub enum ExperimentSpec {
     Heading(heading::HeadingSpec),
     /// E4: conical omnistereo range, trilateration, compass and interframe motion.
     Omnistereo(omnistereo::OmnistereoSpec),
+    /// E5: three-mark resection at places.
+    Resection(resection::ResectionSpec),
 }
 
 impl ExperimentSpec {
@@ -92,6 +96,7 @@ impl ExperimentSpec {
             Self::LocalizationMap(spec) => spec.validate(s, c),
             Self::Heading(spec) => spec.validate(s, c),
             Self::Omnistereo(spec) => spec.validate(s, c),
+            Self::Resection(spec) => spec.validate(s, c),
         }
     }
 
@@ -99,8 +104,11 @@ impl ExperimentSpec {
     pub(crate) fn prepare(&self, s: &mut Scenario) {
         match self {
             Self::Corner(spec) => spec.prepare(s),
-            Self::Places(_) | Self::LocalizationMap(_) | Self::Heading(_) | Self::Omnistereo(_) => {
-            }
+            Self::Places(_)
+            | Self::LocalizationMap(_)
+            | Self::Heading(_)
+            | Self::Omnistereo(_)
+            | Self::Resection(_) => {}
         }
     }
 
@@ -118,6 +126,7 @@ impl ExperimentSpec {
             Self::LocalizationMap(_) => Some(localization_map::map_table(summary)),
             Self::Heading(_) => Some(heading::heading_table(summary)),
             Self::Omnistereo(_) => Some(omnistereo::omnistereo_table(summary)),
+            Self::Resection(_) => Some(resection::resection_table(&[summary])),
         }
     }
 }
@@ -137,6 +146,7 @@ pub fn procedure(s: &Scenario) -> Box<dyn Experiment> {
             Box::new(heading::Heading::new(spec, &s.vision.luminance_heading))
         }
         Some(ExperimentSpec::Omnistereo(spec)) => Box::new(omnistereo::Omnistereo::new(spec, s)),
+        Some(ExperimentSpec::Resection(spec)) => Box::new(resection::Resection::new(spec, s)),
     }
 }
 
@@ -156,6 +166,7 @@ pub const REPLAYS: &[Replay] = &[
     places::REPLAY,
     heading::REPLAY,
     omnistereo::REPLAY,
+    resection::REPLAY,
 ];
 
 /// The replay called `name`.
@@ -204,11 +215,27 @@ impl ReplayContext<'_> {
 
     /// Runs the built-in scenario `text` (from `file`) with the replay's seed, writing nothing.
     pub fn simulate(&mut self, name: &str, file: &str, text: &str) -> anyhow::Result<ReplayRun> {
+        self.simulate_edited(name, file, text, |_| Ok(()))
+    }
+
+    /// Runs the built-in scenario `text` (from `file`) as changed by `edit` (a variant of it:
+    /// another camera), with the replay's seed, writing nothing. The variant is validated again.
+    pub fn simulate_edited(
+        &mut self,
+        name: &str,
+        file: &str,
+        text: &str,
+        edit: impl FnOnce(&mut Scenario) -> anyhow::Result<()>,
+    ) -> anyhow::Result<ReplayRun> {
         let path = Path::new(file);
         let stem = path
             .file_stem()
             .map_or(String::new(), |s| s.to_string_lossy().into_owned());
         let mut scenario = parse_scenario(text, path, &stem)?;
+        edit(&mut scenario)?;
+        if let Some(v) = crate::validate::validate(&scenario).first() {
+            anyhow::bail!("{file} ({name}): field `{}`: {}", v.path, v.message);
+        }
         if let Some(seed) = self.seed {
             scenario.seed = seed;
         }

@@ -10,6 +10,7 @@ pub mod geometry;
 pub mod luminance_heading;
 pub mod mask;
 pub mod omnistereo;
+pub mod resection;
 
 pub use calibration::{HyperbolicFit, RadialCalibration};
 pub use floor_localization::{
@@ -46,4 +47,17 @@ pub enum VisionError {
     /// The image does not show what the method looks for (a degenerate or empty image).
     #[error("not found: {0}")]
     NotFound(String),
+}
+
+/// `value` must be a positive finite number.
+pub(crate) fn positive(name: &'static str, value: f64) -> Result<(), VisionError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(VisionError::InvalidParameter {
+            name,
+            value,
+            rule: "must be positive",
+        })
+    }
 }

@@ -5,18 +5,20 @@ mod floor_localization;
 mod freespace;
 mod luminance_heading;
 mod omnistereo;
+pub mod resection;
 
 pub use floor_localization::FloorLocalizationStage;
 pub use freespace::FreeSpaceStage;
 pub use luminance_heading::LuminanceHeadingStage;
 pub use omnistereo::OmnistereoStage;
+pub use resection::ResectionStage;
 
 use crate::RobotError;
-use crate::boundary::Observation;
+use crate::boundary::{ActuatorCommand, Observation};
 use crate::config::RobotConfig;
 use crate::estimates::{LandmarkSighting, Measurement, MotionReading, NotFound};
 use image::RgbaImage;
-use nalgebra::Isometry2;
+use nalgebra::{Isometry2, Point2};
 use omniloop_vision::{FreeSpace, LocalizationQuality, RadialCalibration};
 
 /// What the stages of one cycle found.
@@ -32,6 +34,10 @@ pub struct Percepts {
     pub landmarks: Vec<LandmarkSighting>,
     /// The motion since the previous frame, as vision read it.
     pub motion: Option<MotionReading>,
+    /// Commands to the actuators (a stage steering its camera).
+    pub actuators: Vec<ActuatorCommand>,
+    /// A point to drive to (odometry frame), when a stage needs another view.
+    pub observation_point: Option<Point2<f64>>,
 }
 
 /// A measurement, the stage that made it and how good that stage judged it.
@@ -52,6 +58,8 @@ pub struct Belief {
     pub pose: Option<Isometry2<f64>>,
     /// Whether a fix has set it (not only the start pose and odometry).
     pub fixed: bool,
+    /// The dead-reckoned pose in the odometry frame.
+    pub odometry_pose: Isometry2<f64>,
 }
 
 /// One perception stage.
@@ -60,6 +68,13 @@ pub trait Stage: Send {
     fn name(&self) -> &'static str;
     /// The cameras whose frames it reads.
     fn cameras(&self) -> Vec<&str>;
+    /// The robot was carried to a place it is not told: a stage that keeps state starts
+    /// afresh.
+    fn carried(&mut self) {}
+    /// Whether it reads its cameras' frames next cycle.
+    fn wants_frames(&self) -> bool {
+        true
+    }
     /// Processes the cycle's frames, knowing what the estimator predicts.
     fn run(
         &mut self,
@@ -81,6 +96,9 @@ pub fn build(config: &RobotConfig) -> Result<Vec<Box<dyn Stage>>, RobotError> {
             rig,
             &config.map.landmarks,
         )?));
+    }
+    if config.resects() {
+        stages.push(Box::new(resection_stage(config)?));
     }
     if !(config.detects_freespace() || config.localizes() || !config.checkpoints().is_empty()) {
         return Ok(stages);
@@ -121,6 +139,30 @@ pub fn build(config: &RobotConfig) -> Result<Vec<Box<dyn Stage>>, RobotError> {
         )?));
     }
     Ok(stages)
+}
+
+/// The resection stage on vision's camera: panning with a pinhole's column calibration, or
+/// from one image of a mirror camera.
+fn resection_stage(config: &RobotConfig) -> Result<ResectionStage, RobotError> {
+    let camera = config.vision_camera().ok_or_else(|| {
+        RobotError::Config("resection needs a camera and the robot has none".into())
+    })?;
+    let view = match (config.columns(camera), config.calibration(camera)) {
+        (Some(c), _) => resection::View::Pan(c.clone()),
+        (None, Some(c)) => resection::View::Ring(c.clone()),
+        (None, None) => {
+            return Err(RobotError::Config(format!(
+                "no column or mirror calibration for camera {camera:?}"
+            )));
+        }
+    };
+    ResectionStage::new(
+        camera,
+        view,
+        config.vision.resection.clone(),
+        config.control.resection.clone(),
+        &config.map.marks,
+    )
 }
 
 fn calibration<'a>(

@@ -172,6 +172,38 @@ impl Renderer {
                 }
             }
         }
+        if let Some(levels) = sensor.grey_levels {
+            quantise_grey(&mut img, levels);
+        }
         Ok(img)
+    }
+}
+
+/// Turns `img` grey with its Rec. 601 luminance quantised to `levels` levels spread over 0..255
+/// (level `k` is `round(255 k / (levels - 1))`), as a digitizer of that many grey levels gives.
+pub fn quantise_grey(img: &mut RgbaImage, levels: u32) {
+    let top = (levels.clamp(2, 256) - 1) as f32;
+    for px in img.chunks_exact_mut(4) {
+        let y = 0.299 * px[0] as f32 + 0.587 * px[1] as f32 + 0.114 * px[2] as f32;
+        let k = (y / 255.0 * top).round();
+        let g = (k * 255.0 / top).round() as u8;
+        px[..3].fill(g);
+    }
+}
+
+#[cfg(test)]
+mod grey_tests {
+    use super::*;
+
+    #[test]
+    fn sixteen_grey_levels() {
+        let mut img =
+            RgbaImage::from_fn(256, 1, |u, _| image::Rgba([u as u8, u as u8, u as u8, 255]));
+        quantise_grey(&mut img, 16);
+        let mut levels: Vec<u8> = img.pixels().map(|p| p.0[0]).collect();
+        assert!(img.pixels().all(|p| p.0[0] == p.0[1] && p.0[1] == p.0[2]));
+        levels.dedup();
+        assert_eq!(levels.len(), 16, "{levels:?}");
+        assert!(levels.iter().all(|l| l % 17 == 0));
     }
 }

@@ -82,18 +82,7 @@ impl OmnistereoConfig {
     }
 }
 
-/// `value` must be a positive finite number.
-pub(crate) fn positive(name: &'static str, value: f64) -> Result<(), VisionError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(VisionError::InvalidParameter {
-            name,
-            value,
-            rule: "must be positive",
-        })
-    }
-}
+pub(crate) use crate::positive;
 
 /// `value` must be below `limit` (`rule` says so in words).
 pub(crate) fn below(

@@ -1,0 +1,419 @@
+//! E5, three-mark resection (Ishikawa, Kikuchi and Kato, Sect. 3-4, Table 1): the robot is
+//! carried to each place and told nothing; it pans its camera from right to left until it has
+//! found the three striped marks, computes where it is, and moves to look again if a mark is
+//! hidden. Each place is scored by the distance of that one fix from the true position at the
+//! moment of the fix. Its replay, `resection`, runs the ten places of Table 1 and a place
+//! behind a cabinet with the panning camera, then again with an omnidirectional camera.
+
+use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
+use crate::output::write_run;
+use crate::record::Summary;
+use crate::scenario::{PoseSpec, Scenario};
+use crate::simulation::{OutputFile, RunError, RunOutput, Simulation};
+use crate::topview::{Mark, Marker, Panel, Spots, panels_png};
+use crate::validate::Checker;
+use nalgebra::Point2;
+use omniloop_control::wrap_pi;
+use omniloop_robot::perception::resection::{GAVE_UP, NAME};
+use omniloop_robot::{Measurement, PoseSource};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+/// The places (`[experiment.resection]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ResectionSpec {
+    /// The places the robot is carried to (world frame).
+    pub places: Vec<PoseSpec>,
+    /// The longest the robot may take at one place, s.
+    #[serde(default = "default_timeout")]
+    pub timeout_s: f64,
+}
+
+fn default_timeout() -> f64 {
+    120.0
+}
+
+impl ResectionSpec {
+    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+        if self.places.is_empty() {
+            c.fail("experiment.resection.places", "needs at least one place");
+        }
+        c.positive("experiment.resection.timeout_s", self.timeout_s);
+        for (i, p) in self.places.iter().enumerate() {
+            c.pose_in_world(
+                &format!("experiment.resection.places[{i}]"),
+                p,
+                s.robot.radius_mm,
+                &s.world,
+            );
+        }
+        if s.control.pose_source != PoseSource::Resection {
+            c.fail(
+                "control.pose_source",
+                "experiment.resection scores the resection stage: set pose_source = \
+                 \"resection\"",
+            );
+        }
+    }
+}
+
+/// Self-location at one place (`summary.json`: `places`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlaceResult {
+    /// Where the robot was carried to, cm.
+    pub place_cm: [f64; 2],
+    /// Where it truly was when it located itself (the place, unless it moved), cm.
+    pub true_cm: [f64; 2],
+    /// Where it computed it was, cm; `None` when it did not locate itself.
+    pub estimate_cm: Option<[f64; 2]>,
+    /// Distance of the estimate from the truth, cm.
+    pub error_cm: Option<f64>,
+    /// Heading error, degrees.
+    pub heading_error_deg: Option<f64>,
+    /// Time from being set down to the fix (turning the camera to its stop, the pans and any
+    /// moves), s.
+    pub pan_search_s: f64,
+    /// Whether it moved to another observation point.
+    pub moved: bool,
+    /// Why it did not locate itself, if it did not.
+    pub failure: Option<String>,
+}
+
+/// The procedure and metrics of E5.
+pub struct Resection {
+    spec: ResectionSpec,
+    camera: String,
+    results: Vec<PlaceResult>,
+}
+
+impl Resection {
+    /// E5 at the places of `spec`, seen by vision's camera of `s`.
+    pub fn new(spec: &ResectionSpec, s: &Scenario) -> Self {
+        Self {
+            spec: spec.clone(),
+            camera: s
+                .sensor(s.vision.sensor.as_deref())
+                .map_or_else(|_| "-".into(), |c| c.name.clone()),
+            results: Vec::new(),
+        }
+    }
+
+    /// Carries the robot to `place` and runs cycles until it locates itself, gives up, or the
+    /// time is up.
+    fn locate(
+        sim: &mut Simulation,
+        place: &PoseSpec,
+        timeout_s: f64,
+    ) -> Result<PlaceResult, RunError> {
+        let truth = place.isometry();
+        sim.place_robot(truth);
+        sim.robot_mut().forget_pose();
+        let period = sim.scenario().run.control_period_s;
+        let max = (timeout_s / period).ceil() as u64;
+        let cm = |p: Point2<f64>| [p.x / 10.0, p.y / 10.0];
+        for k in 1..=max {
+            sim.step()?;
+            let est = sim.last_estimates().expect("a cycle records its estimates");
+            let fix = est.pose_fix(NAME).map(|f| f.measurement);
+            let gave_up = est.not_found(NAME).filter(|r| r.contains(GAVE_UP));
+            if fix.is_none() && gave_up.is_none() && k < max {
+                continue;
+            }
+            // The fix is of the image taken at the start of the cycle, before the world moved.
+            let now = sim.last_truth_pose().unwrap_or(truth);
+            let mut r = PlaceResult {
+                place_cm: cm(truth.translation.vector.into()),
+                true_cm: cm(now.translation.vector.into()),
+                estimate_cm: None,
+                error_cm: None,
+                heading_error_deg: None,
+                pan_search_s: k as f64 * period,
+                moved: (now.translation.vector - truth.translation.vector).norm() > 10.0,
+                failure: gave_up.map(str::to_string),
+            };
+            if let Some(Measurement::Pose { pose, .. }) = fix {
+                let e = pose.translation.vector - now.translation.vector;
+                r.estimate_cm = Some(cm(pose.translation.vector.into()));
+                r.error_cm = Some(e.norm() / 10.0);
+                r.heading_error_deg =
+                    Some(wrap_pi(pose.rotation.angle() - now.rotation.angle()).to_degrees());
+            } else if r.failure.is_none() {
+                r.failure = Some(format!("not located within {timeout_s} s"));
+            }
+            return Ok(r);
+        }
+        unreachable!("the last cycle returns")
+    }
+}
+
+impl Experiment for Resection {
+    fn run(
+        &mut self,
+        sim: &mut Simulation,
+        progress: &mut dyn FnMut(u64, u64),
+    ) -> Result<(), RunError> {
+        let n = self.spec.places.len() as u64;
+        for (k, place) in self.spec.places.iter().enumerate() {
+            self.results
+                .push(Self::locate(sim, place, self.spec.timeout_s)?);
+            progress(k as u64 + 1, n);
+        }
+        Ok(())
+    }
+
+    fn metrics(&self, _out: &RunOutput) -> Metrics {
+        let mut keys = Metrics::new();
+        keys.insert("camera".into(), self.camera.clone().into());
+        keys.insert(
+            "places".into(),
+            serde_json::to_value(&self.results).unwrap_or_default(),
+        );
+        let max = self
+            .results
+            .iter()
+            .filter_map(|r| r.error_cm)
+            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
+        keys.insert("max_error_cm".into(), max.into());
+        keys.insert(
+            "located".into(),
+            self.results
+                .iter()
+                .filter(|r| r.error_cm.is_some())
+                .count()
+                .into(),
+        );
+        keys
+    }
+
+    fn files(&self, scenario: &Scenario, _out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
+        let bytes = figure(scenario, &self.camera, &self.results)
+            .map_err(|e| RunError::Sim(omniloop_sim::SimError::Invalid(e.to_string())))?;
+        Ok(vec![OutputFile {
+            name: "resection.png".into(),
+            bytes,
+        }])
+    }
+}
+
+/// The per-place results of a summary (`places`).
+pub fn place_results(m: &Summary) -> Vec<PlaceResult> {
+    m.experiment
+        .get("places")
+        .and_then(|v| serde_json::from_value(v.clone()).ok())
+        .unwrap_or_default()
+}
+
+/// The top view of the lab: the marks, each place with the robot's outline and its error, and
+/// where the robot computed it was.
+fn figure(
+    s: &Scenario,
+    camera: &str,
+    results: &[PlaceResult],
+) -> Result<Vec<u8>, crate::topview::FigureError> {
+    let mm = |c: [f64; 2]| Point2::new(c[0] * 10.0, c[1] * 10.0);
+    let markers = results
+        .iter()
+        .enumerate()
+        .map(|(k, r)| Marker {
+            at: mm(r.true_cm),
+            radius_mm: s.robot.radius_mm,
+            rgb: [20, 20, 20],
+            label: match r.error_cm {
+                Some(e) => format!(
+                    "{}: {e:.1} cm{}",
+                    k + 1,
+                    if r.moved { " (moved)" } else { "" }
+                ),
+                None => format!("{}: not located", k + 1),
+            },
+        })
+        .collect();
+    let map = s.robot_map();
+    let marks: Vec<Point2<f64>> = map.marks.iter().map(|m| m.centre_mm).collect();
+    let estimates: Vec<Point2<f64>> = results
+        .iter()
+        .filter_map(|r| r.estimate_cm.map(mm))
+        .collect();
+    let moves: Vec<Point2<f64>> = results
+        .iter()
+        .filter(|r| r.moved)
+        .map(|r| mm(r.place_cm))
+        .collect();
+    let panel = Panel {
+        title: format!("{}: three-mark resection with camera {camera:?}", s.name),
+        layout: &s.world,
+        paths: Vec::new(),
+        markers,
+        spots: vec![
+            Spots {
+                label: "marks O, P, Q".into(),
+                rgb: [200, 30, 30],
+                points: marks,
+                mark: Mark::Disc,
+                size_px: 7,
+            },
+            Spots {
+                label: "set down here, moved".into(),
+                rgb: [240, 150, 0],
+                points: moves,
+                mark: Mark::Cross,
+                size_px: 6,
+            },
+            Spots {
+                label: "estimates".into(),
+                rgb: [30, 80, 230],
+                points: estimates,
+                mark: Mark::Cross,
+                size_px: 5,
+            },
+        ],
+    };
+    panels_png("resection.png", &[panel], 1000)
+}
+
+/// Table 1 of the paper: the true places and the positions the real robot computed, cm.
+pub const TABLE_1: [([f64; 2], [f64; 2]); 10] = [
+    ([91.0, 61.0], [93.0, 60.0]),
+    ([164.0, 245.0], [168.0, 238.0]),
+    ([164.0, 138.0], [166.0, 135.0]),
+    ([164.0, 61.0], [165.0, 56.0]),
+    ([256.0, 245.0], [260.0, 243.0]),
+    ([256.0, 138.0], [252.0, 129.0]),
+    ([256.0, 61.0], [257.0, 61.0]),
+    ([340.0, 245.0], [342.0, 244.0]),
+    ([340.0, 138.0], [347.0, 140.0]),
+    ([340.0, 61.0], [344.0, 72.0]),
+];
+
+/// The paper's observed position at place `p` (cm), when `p` is one of Table 1's.
+fn paper_observed(p: [f64; 2]) -> Option<[f64; 2]> {
+    TABLE_1
+        .iter()
+        .find(|(t, _)| (t[0] - p[0]).abs() < 0.5 && (t[1] - p[1]).abs() < 0.5)
+        .map(|(_, o)| *o)
+}
+
+/// E5 as a Markdown table: Table 1 side by side with each run in `runs` (the panning camera,
+/// then the omnidirectional one), places beyond Table 1 after it.
+pub fn resection_table(runs: &[&Summary]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# E5: three-mark resection (Table 1)\n");
+    let Some(first) = runs.first() else {
+        return s;
+    };
+    let camera = |m: &Summary| {
+        m.experiment
+            .get("camera")
+            .and_then(|v| v.as_str())
+            .unwrap_or("-")
+            .to_string()
+    };
+    let _ = writeln!(
+        s,
+        "Renderer: {}. Seed {}. Cameras: {}. Positions in cm; error = distance from the true \
+         position at the moment of the fix. Paper: the real robot, errors up to 11 cm.\n",
+        first.renderer.clone().unwrap_or_else(|| "-".into()),
+        first.seed,
+        runs.iter()
+            .map(|m| camera(m))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let mut head = "| place | true | paper observed | paper error |".to_string();
+    let mut rule = "|---:|---|---|---:|".to_string();
+    for m in runs {
+        let c = camera(m);
+        let _ = write!(head, " {c}: ours | {c}: error | {c}: search (s) |");
+        rule.push_str("---|---:|---:|");
+    }
+    let _ = writeln!(s, "{head}\n{rule}");
+    let results: Vec<Vec<PlaceResult>> = runs.iter().map(|m| place_results(m)).collect();
+    let n = results.iter().map(Vec::len).max().unwrap_or(0);
+    let pt = |p: [f64; 2]| format!("({:.0}, {:.0})", p[0], p[1]);
+    for k in 0..n {
+        let Some(place) = results.iter().find_map(|r| r.get(k)).map(|r| r.place_cm) else {
+            continue;
+        };
+        let (obs, err) = match paper_observed(place) {
+            Some(o) => (
+                pt(o),
+                format!("{:.1}", (o[0] - place[0]).hypot(o[1] - place[1])),
+            ),
+            None => ("-".into(), "-".into()),
+        };
+        let _ = write!(s, "| {} | {} | {obs} | {err} |", k + 1, pt(place));
+        for r in &results {
+            match r.get(k) {
+                Some(r) => {
+                    let ours = r.estimate_cm.map_or("not located".into(), |e| {
+                        format!(
+                            "({:.1}, {:.1}){}",
+                            e[0],
+                            e[1],
+                            if r.moved { " moved" } else { "" }
+                        )
+                    });
+                    let err = r.error_cm.map_or("-".into(), |e| format!("{e:.2}"));
+                    let _ = write!(s, " {ours} | {err} | {:.1} |", r.pan_search_s);
+                }
+                None => s.push_str(" - | - | - |"),
+            }
+        }
+        s.push('\n');
+    }
+    s.push('\n');
+    for m in runs {
+        let max = m
+            .experiment
+            .get("max_error_cm")
+            .and_then(|v| v.as_f64())
+            .map_or("-".into(), |e| format!("{e:.2} cm"));
+        let located = m
+            .experiment
+            .get("located")
+            .and_then(|v| v.as_u64())
+            .unwrap_or(0);
+        let _ = writeln!(
+            s,
+            "- {}: located at {located} of {} places, largest error {max}.",
+            camera(m),
+            place_results(m).len()
+        );
+    }
+    s
+}
+
+/// `omniloop replay resection`.
+pub const REPLAY: Replay = Replay {
+    name: "resection",
+    title: "E5: three-mark resection with a panning camera at the places of Table 1, and with \
+            an omnidirectional camera",
+    run: replay,
+};
+
+/// The E5 scenario file, built into the binary.
+pub const SCENARIO: (&str, &str) = (
+    "scenarios/resection_lab.toml",
+    include_str!("../../scenarios/resection_lab.toml"),
+);
+
+/// The omnidirectional camera of the E5 scenario.
+pub const OMNI_CAMERA: &str = "omni";
+
+/// Runs E5 with the panning camera into `out/` (with `resection.png`), again with the
+/// omnidirectional camera into `out/omni/`, and writes both beside Table 1 into
+/// `resection.md`.
+fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
+    let out = ctx.out.to_path_buf();
+    let pan = ctx.run("resection_lab", SCENARIO.0, SCENARIO.1, &out)?;
+    let omni = ctx.simulate_edited("resection_omni", SCENARIO.0, SCENARIO.1, |s| {
+        s.vision.sensor = Some(OMNI_CAMERA.into());
+        s.name = "resection_omni".into();
+        Ok(())
+    })?;
+    write_run(&out.join("omni"), &omni.scenario, &omni.output)?;
+    let md = resection_table(&[&pan.output.summary, &omni.output.summary]);
+    write_text(&out.join("resection.md"), &md)?;
+    Ok(md)
+}

@@ -1,0 +1,97 @@
+//! E5 end to end: three-mark resection (Ishikawa, Kikuchi and Kato) at the ten places of
+//! Table 1 with the panning camera (16 grey levels, sensor noise) and, beyond the paper, with
+//! one omnidirectional image; a place where a cabinet hides a mark; scenario errors.
+
+mod common;
+
+use common::{omniloop, scenario_path, tmp};
+use serde_json::Value;
+
+/// The places of a run's `summary.json`.
+fn places(dir: &std::path::Path) -> (Value, Vec<Value>) {
+    let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
+    let m: Value = serde_json::from_str(&text).unwrap();
+    let places = m["places"].as_array().cloned().unwrap_or_default();
+    (m, places)
+}
+
+#[test]
+fn e5_replay_locates_every_place_of_table_1_within_2_cm_and_past_a_hidden_mark() {
+    let dir = tmp("e5_replay");
+    let out = dir.display().to_string();
+    let md = omniloop([
+        "replay",
+        "resection",
+        "--renderer",
+        "cpu",
+        "--out",
+        out.as_str(),
+    ]);
+    eprintln!("{md}");
+    let (m, pan) = places(&dir);
+    assert_eq!(m["camera"], "pan");
+    assert_eq!(pan.len(), 11, "{m}");
+    for (k, p) in pan.iter().enumerate() {
+        for key in [
+            "true_cm",
+            "estimate_cm",
+            "error_cm",
+            "pan_search_s",
+            "moved",
+        ] {
+            assert!(p.get(key).is_some(), "place {}: no {key}: {p}", k + 1);
+        }
+        let err = p["error_cm"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("place {} not located: {p}", k + 1));
+        assert!(err <= 2.0, "place {}: {err} cm", k + 1);
+    }
+    // Table 1's places are seen from where the robot was set down...
+    assert!(pan[..10].iter().all(|p| p["moved"] == false), "{pan:?}");
+    // ...and at the eleventh the cabinet hides O: the robot moves, then locates itself.
+    assert_eq!(pan[10]["moved"], true, "{}", pan[10]);
+    assert!(m["max_error_cm"].as_f64().unwrap() <= 2.0);
+    // The omnidirectional variant, in the same places, is reported beside them.
+    let (omni, omni_places) = places(&dir.join("omni"));
+    assert_eq!(omni["camera"], "omni");
+    assert_eq!(omni_places.len(), 11);
+    assert!(md.contains("omni: error"), "{md}");
+    let table = std::fs::read_to_string(dir.join("resection.md")).unwrap();
+    assert!(
+        md.contains(table.trim()),
+        "resection.md is the printed table"
+    );
+    assert!(dir.join("resection.png").is_file());
+}
+
+/// Writes the lab scenario with `from` replaced by `to` and returns `omniloop check`'s status
+/// and standard error.
+fn check_variant(name: &str, from: &str, to: &str) -> (Option<i32>, String) {
+    let text = std::fs::read_to_string(scenario_path("resection_lab.toml")).unwrap();
+    assert!(text.contains(from), "{from}");
+    let dir = tmp(name);
+    let file = dir.join("broken.toml");
+    std::fs::write(&file, text.replacen(from, to, 1)).unwrap();
+    let out = common::bin().arg("check").arg(&file).output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_tilted_camera_or_a_missing_mark_is_a_scenario_error_naming_the_field() {
+    let (code, err) = check_variant("e5_tilted", "tilt_deg = 0.0", "tilt_deg = -10.0");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("robot.sensors[0].pinhole.tilt_deg"), "{err}");
+    let (code, err) = check_variant("e5_two_marks", "name = \"Q\"\n", "");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("exactly three marks"), "{err}");
+    let (code, err) = check_variant(
+        "e5_even_stripes",
+        "stripes = [5.0, 2.0, 5.0, 2.0, 5.0]",
+        "stripes = [5.0, 2.0, 5.0, 2.0]",
+    );
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("world.boards[1].stripes"), "{err}");
+}
