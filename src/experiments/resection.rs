@@ -112,38 +112,40 @@ impl Resection {
         let period = sim.scenario().run.control_period_s;
         let max = (timeout_s / period).ceil() as u64;
         let cm = |p: Point2<f64>| [p.x / 10.0, p.y / 10.0];
-        for k in 1..=max {
+        let (mut k, mut fix, mut gave_up) = (0, None, None);
+        while fix.is_none() && gave_up.is_none() && k < max.max(1) {
             sim.step()?;
-            let est = sim.last_estimates().expect("a cycle records its estimates");
-            let fix = est.pose_fix(NAME).map(|f| f.measurement);
-            let gave_up = est.not_found(NAME).filter(|r| r.contains(GAVE_UP));
-            if fix.is_none() && gave_up.is_none() && k < max {
-                continue;
+            k += 1;
+            if let Some(est) = sim.last_estimates() {
+                fix = est.pose_fix(NAME).map(|f| f.measurement);
+                gave_up = est
+                    .not_found(NAME)
+                    .filter(|r| r.contains(GAVE_UP))
+                    .map(str::to_string);
             }
-            // The fix is of the image taken at the start of the cycle, before the world moved.
-            let now = sim.last_truth_pose().unwrap_or(truth);
-            let mut r = PlaceResult {
-                place_cm: cm(truth.translation.vector.into()),
-                true_cm: cm(now.translation.vector.into()),
-                estimate_cm: None,
-                error_cm: None,
-                heading_error_deg: None,
-                pan_search_s: k as f64 * period,
-                moved: (now.translation.vector - truth.translation.vector).norm() > 10.0,
-                failure: gave_up.map(str::to_string),
-            };
-            if let Some(Measurement::Pose { pose, .. }) = fix {
-                let e = pose.translation.vector - now.translation.vector;
-                r.estimate_cm = Some(cm(pose.translation.vector.into()));
-                r.error_cm = Some(e.norm() / 10.0);
-                r.heading_error_deg =
-                    Some(wrap_pi(pose.rotation.angle() - now.rotation.angle()).to_degrees());
-            } else if r.failure.is_none() {
-                r.failure = Some(format!("not located within {timeout_s} s"));
-            }
-            return Ok(r);
         }
-        unreachable!("the last cycle returns")
+        // The fix is of the image taken at the start of the cycle, before the world moved.
+        let now = sim.last_truth_pose().unwrap_or(truth);
+        let mut r = PlaceResult {
+            place_cm: cm(truth.translation.vector.into()),
+            true_cm: cm(now.translation.vector.into()),
+            estimate_cm: None,
+            error_cm: None,
+            heading_error_deg: None,
+            pan_search_s: k as f64 * period,
+            moved: (now.translation.vector - truth.translation.vector).norm() > 10.0,
+            failure: gave_up,
+        };
+        if let Some(Measurement::Pose { pose, .. }) = fix {
+            let e = pose.translation.vector - now.translation.vector;
+            r.estimate_cm = Some(cm(pose.translation.vector.into()));
+            r.error_cm = Some(e.norm() / 10.0);
+            r.heading_error_deg =
+                Some(wrap_pi(pose.rotation.angle() - now.rotation.angle()).to_degrees());
+        } else if r.failure.is_none() {
+            r.failure = Some(format!("not located within {timeout_s} s"));
+        }
+        Ok(r)
     }
 }
 

@@ -25,7 +25,8 @@ use crate::estimates::{Measurement, NotFound};
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::resection::{
-    ColumnCalibration, MarkBearing, ResectionConfig, StripePattern, find_marks, ring_bearing_rad,
+    ColumnCalibration, MarkBearing, ResectionConfig, StripePattern, find_marks, find_marks_ring,
+    resect, ring_bearing_rad,
 };
 use std::f64::consts::{PI, TAU};
 
@@ -182,9 +183,7 @@ impl ResectionStage {
         cal: &RadialCalibration,
     ) -> Result<Vec<Option<f64>>, RobotError> {
         let img = image(obs, &self.camera, NAME)?;
-        let seen =
-            omniloop_vision::resection::find_marks_ring(img, cal, &self.patterns, &self.config)
-                .unwrap_or_default();
+        let seen = find_marks_ring(img, cal, &self.patterns, &self.config).unwrap_or_default();
         let n = self.config.ring_samples;
         Ok((0..self.marks.len())
             .map(|k| {
@@ -209,7 +208,7 @@ impl ResectionStage {
                 position: self.marks[k].centre_mm,
                 bearing_rad: bearings[k].unwrap_or_default(),
             };
-            match omniloop_vision::resection::resect(&mb(0), &mb(1), &mb(2)) {
+            match resect(&mb(0), &mb(1), &mb(2)) {
                 Ok(r) => {
                     // The bearings are the camera axis's; the robot's centre is off it by the
                     // mount.
