@@ -6,6 +6,7 @@
 use crate::experiments::ExperimentSpec;
 use crate::odometry::OdometrySpec;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
+use omniloop_control::DifferentialDrive;
 use omniloop_robot::{
     BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StereoRig,
     VisionSpec, WorldMap,
@@ -142,6 +143,31 @@ pub struct RobotSpec {
     /// Cameras on the robot (`[[robot.sensors]]`).
     #[serde(default)]
     pub sensors: Vec<SensorSpec>,
+    /// A differential drive (`[robot.differential]`): the robot moves along its heading and
+    /// turns on the spot; without it the robot is omnidirectional.
+    #[serde(default)]
+    pub differential: Option<DifferentialSpec>,
+}
+
+/// A two-wheeled differential drive (`[robot.differential]`). Its top wheel speed is
+/// `robot.max_speed_mm_s`; its accelerations are `robot.accel_limit_mm_s2` and
+/// `robot.angular_accel_limit_rad_s2`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DifferentialSpec {
+    /// Distance between the wheels.
+    pub track_mm: f64,
+    /// Fastest turn.
+    pub max_turn_rate_deg_s: f64,
+}
+
+impl Default for DifferentialSpec {
+    fn default() -> Self {
+        Self {
+            track_mm: 100.0,
+            max_turn_rate_deg_s: 90.0,
+        }
+    }
 }
 
 fn default_radius() -> f64 {
@@ -214,6 +240,7 @@ impl Scenario {
             accel_limit_mm_s2: self.robot.accel_limit_mm_s2,
             angular_accel_limit_rad_s2: self.robot.angular_accel_limit_rad_s2,
             rgb: self.robot.rgb,
+            differential: self.differential_drive(),
         }];
         for o in &self.other_robots {
             out.push(omniloop_sim::RobotBodySpec {
@@ -223,9 +250,24 @@ impl Scenario {
                 accel_limit_mm_s2: o.accel_limit_mm_s2,
                 angular_accel_limit_rad_s2: default_angular_accel(),
                 rgb: o.rgb,
+                differential: None,
             });
         }
         out
+    }
+
+    /// The drive of a differential robot (validation makes sure its numbers are good).
+    pub fn differential_drive(&self) -> Option<DifferentialDrive> {
+        let r = &self.robot;
+        let d = r.differential.as_ref()?;
+        DifferentialDrive::new(
+            d.track_mm,
+            r.max_speed_mm_s,
+            d.max_turn_rate_deg_s.to_radians(),
+            r.accel_limit_mm_s2,
+            r.angular_accel_limit_rad_s2,
+        )
+        .ok()
     }
 
     /// The index of the robot's sensor called `name`, or of its first sensor when `name` is

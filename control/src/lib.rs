@@ -7,6 +7,7 @@
 
 pub mod angle;
 pub mod avoidance;
+pub mod differential;
 pub mod drive;
 pub mod go_to_goal;
 pub mod odometry;
@@ -16,6 +17,7 @@ pub mod velocity_aware;
 
 pub use angle::{angle_diff, wrap_pi};
 pub use avoidance::{AvoidanceConfig, Decision, GoalDirection, SpeedChoice, Surroundings};
+pub use differential::DifferentialDrive;
 pub use drive::{AccelLimitedDrive, VelocityCommand};
 pub use go_to_goal::GoToGoal;
 pub use odometry::DeadReckoning;

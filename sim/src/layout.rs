@@ -3,6 +3,7 @@
 //! one list of solid shapes that both the physics world and the renderer use.
 
 use crate::corridor::Corridor;
+use crate::floor_marks::{FloorMark, MarkScatter};
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Point2, Vector2};
 use serde::{Deserialize, Serialize};
@@ -334,6 +335,10 @@ pub struct Layout {
     pub pillars: Vec<Pillar>,
     /// Striped boards (landmarks).
     pub boards: Vec<Board>,
+    /// Marks painted on the floor.
+    pub floor_marks: Vec<FloorMark>,
+    /// Marks scattered at random over a rectangle of the floor.
+    pub mark_scatter: Option<MarkScatter>,
 }
 
 impl Default for Layout {
@@ -349,11 +354,20 @@ impl Default for Layout {
             cubes: Vec::new(),
             pillars: Vec::new(),
             boards: Vec::new(),
+            floor_marks: Vec::new(),
+            mark_scatter: None,
         }
     }
 }
 
 impl Layout {
+    /// Every mark painted on the floor: those given one by one, then the scattered ones.
+    pub fn all_floor_marks(&self) -> Vec<FloorMark> {
+        let mut marks = self.floor_marks.clone();
+        marks.extend(self.mark_scatter.iter().flat_map(MarkScatter::marks));
+        marks
+    }
+
     /// Every floor-coloured rectangle: the field's, the corridors' legs and the extra ones.
     pub fn all_floor_rects(&self) -> Vec<FloorRect> {
         let mut rects: Vec<FloorRect> = self.field.iter().flat_map(|f| f.floor_rects()).collect();

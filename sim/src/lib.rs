@@ -4,6 +4,7 @@
 
 pub mod calibration;
 pub mod corridor;
+pub mod floor_marks;
 pub mod layout;
 pub mod optics;
 pub mod render;
@@ -12,6 +13,7 @@ pub mod shapes;
 pub mod world;
 
 pub use corridor::Corridor;
+pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use layout::{Board, Cube, FieldSpec, FloorRect, Layout, Pillar, Rgb, Wall};
 pub use render::{RenderError, Renderer, RendererChoice, Scene, SensorNoise};
 pub use sensor::{Sensor, SensorSpec};

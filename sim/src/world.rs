@@ -2,7 +2,9 @@
 //!
 //! Robots are dynamic discs whose velocity is set every physics step by the drive model of
 //! eq. (8) ([`AccelLimitedDrive`]), starting from the velocity the body actually has, so that a
-//! robot pushed back by a wall accelerates again at the limit. Obstacles are fixed colliders, so
+//! robot pushed back by a wall accelerates again at the limit. A differential-drive robot
+//! ([`DifferentialDrive`]) moves only along its heading: at every step its velocity is set
+//! along its current heading from its forward speed, so it never slides sideways. Obstacles are fixed colliders, so
 //! a robot never passes through them, whatever it is commanded. Contacts are counted from the
 //! engine's collision events, confirmed by the contact manifold's distance (rapier also reports
 //! speculative contacts a few millimetres before touching).
@@ -11,14 +13,14 @@ use crate::SimError;
 use crate::layout::{Layout, Rgb};
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop_control::{AccelLimitedDrive, VelocityCommand};
+use omniloop_control::{AccelLimitedDrive, DifferentialDrive, VelocityCommand};
 use rapier2d::prelude::*;
 use std::sync::mpsc::{Receiver, channel};
 
 /// Two colliders closer than this (mm) are touching.
 pub const TOUCH_TOLERANCE_MM: f64 = 0.5;
 
-/// A robot body: an omnidirectional disc.
+/// A robot body: a disc, omnidirectional unless it has a differential drive.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotBodySpec {
     /// Pose at the start: x, y in mm, rotation in rad.
@@ -33,6 +35,9 @@ pub struct RobotBodySpec {
     pub angular_accel_limit_rad_s2: f64,
     /// Body colour (for rendering).
     pub rgb: Rgb,
+    /// Its drive when it is a differential-drive robot (then it takes the forward part of its
+    /// commands and their rotation rate; the acceleration limits above are not used).
+    pub differential: Option<DifferentialDrive>,
 }
 
 /// The state of a robot as the physics engine has it.
@@ -78,6 +83,8 @@ struct Robot {
     body: RigidBodyHandle,
     collider: ColliderHandle,
     drive: AccelLimitedDrive,
+    /// The command: in the world frame, or for a differential robot (forward speed, 0) in its
+    /// body frame.
     command: VelocityCommand,
     stats: RobotStats,
     /// Colliders rapier says this robot is in contact with, and whether they actually touch.
@@ -222,14 +229,31 @@ impl World {
         self.steps as f64 * self.physics_step_s
     }
 
-    /// Sets the velocity command robot `i` follows (through its drive) from now on.
+    /// Sets the velocity command (world frame) robot `i` follows (through its drive) from now
+    /// on. A differential robot keeps the part along its present heading: it cannot move
+    /// sideways.
     pub fn set_command(&mut self, i: usize, command: VelocityCommand) {
-        self.robots[i].command = command;
+        let heading = self.robot_state(i).pose.rotation;
+        let r = &mut self.robots[i];
+        r.command = match r.spec.differential {
+            None => command,
+            Some(_) => VelocityCommand {
+                v_mm_s: Vector2::new((heading.inverse() * command.v_mm_s).x, 0.0),
+                omega_rad_s: command.omega_rad_s,
+            },
+        };
     }
 
-    /// The command robot `i` follows.
+    /// The command robot `i` follows (world frame).
     pub fn command(&self, i: usize) -> VelocityCommand {
-        self.robots[i].command
+        let r = &self.robots[i];
+        match r.spec.differential {
+            None => r.command,
+            Some(_) => VelocityCommand {
+                v_mm_s: self.robot_state(i).pose.rotation * r.command.v_mm_s,
+                omega_rad_s: r.command.omega_rad_s,
+            },
+        }
     }
 
     /// Puts robot `i` at `pose`, at rest, with its command cleared (an experimenter carrying
@@ -348,10 +372,24 @@ impl World {
             let body = &mut self.physics.bodies[r.body];
             let v = body.linvel();
             let v = Vector2::new(v.x as f64, v.y as f64);
-            let v_new = r.drive.step(v, r.command.v_mm_s, dt);
-            let w_new = r
-                .drive
-                .step_angular(body.angvel() as f64, r.command.omega_rad_s, dt);
+            let (v_new, w_new) = match &r.spec.differential {
+                None => (
+                    r.drive.step(v, r.command.v_mm_s, dt),
+                    r.drive
+                        .step_angular(body.angvel() as f64, r.command.omega_rad_s, dt),
+                ),
+                Some(d) => {
+                    let a = body.rotation().angle() as f64;
+                    let along = Vector2::new(a.cos(), a.sin());
+                    let (s, w) = d.step(
+                        v.dot(&along),
+                        body.angvel() as f64,
+                        (r.command.v_mm_s.x, r.command.omega_rad_s),
+                        dt,
+                    );
+                    (along * s, w)
+                }
+            };
             body.set_linvel(vec(v_new), true);
             body.set_angvel(w_new as Real, true);
             let t = body.translation();
@@ -422,6 +460,7 @@ mod tests {
             accel_limit_mm_s2: 300.0,
             angular_accel_limit_rad_s2: 10.0,
             rgb: Rgb([20, 20, 20]),
+            differential: None,
         }
     }
 
@@ -492,6 +531,43 @@ mod tests {
         assert_eq!(s.velocity_mm_s, Vector2::zeros());
         w.advance(0.1);
         assert!((w.robot_state(0).pose.translation.x + 400.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_differential_robot_moves_along_its_heading_and_turns_on_the_spot() {
+        let mut spec = robot_at(0.0, 0.0);
+        spec.start = Isometry2::new(Vector2::zeros(), std::f64::consts::FRAC_PI_2);
+        spec.differential =
+            Some(DifferentialDrive::new(100.0, 200.0, 90f64.to_radians(), 1000.0, 20.0).unwrap());
+        let mut w = World::new(&Layout::default(), &[spec], 0.002).unwrap();
+        // Asked to go sideways (world +x while facing +y): it stays where it is.
+        w.set_command(0, VelocityCommand::translate(Vector2::new(150.0, 0.0)));
+        w.advance(0.5);
+        assert!(w.robot_state(0).pose.translation.vector.norm() < 1e-3);
+        // Forward at 150 mm/s for 1 s: 0.15 s of acceleration, then steady.
+        w.set_command(0, VelocityCommand::translate(Vector2::new(0.0, 150.0)));
+        w.advance(1.0);
+        let s = w.robot_state(0);
+        assert!(
+            (s.pose.translation.y - (150.0 - 0.5 * 150.0 * 0.15)).abs() < 1.0,
+            "{s:?}"
+        );
+        assert!(s.pose.translation.x.abs() < 1e-3);
+        // Turning on the spot at the 90 deg/s limit while stopping: no drift sideways.
+        w.set_command(
+            0,
+            VelocityCommand {
+                v_mm_s: Vector2::zeros(),
+                omega_rad_s: 3.0,
+            },
+        );
+        let before = w.robot_state(0);
+        w.advance(1.0);
+        let after = w.robot_state(0);
+        assert!((after.omega_rad_s - 90f64.to_radians()).abs() < 1e-3);
+        let moved = after.pose.translation.vector - before.pose.translation.vector;
+        // It stops within v^2 / (2 a) = 11.25 mm, along its heading as it turns.
+        assert!(moved.norm() < 12.0, "{moved:?}");
     }
 
     #[test]

@@ -5,6 +5,7 @@
 
 pub mod calibration;
 pub mod floor_localization;
+pub mod forward;
 pub mod freespace;
 pub mod geometry;
 pub mod luminance_heading;

@@ -249,7 +249,7 @@ impl GpuRenderer {
         let cylinders = Storage::new(&device, "cylinders", 16 * 32, STORAGE_RW);
         let boards = Storage::new(&device, "boards", 4 * 48, STORAGE_RW);
         let stripes = Storage::new(&device, "stripes", 64 * 4, STORAGE_RW);
-        let rects = Storage::new(&device, "rects", 8 * 32, STORAGE_RW);
+        let rects = Storage::new(&device, "rects", 8 * 48, STORAGE_RW);
         let quads = Storage::new(&device, "quads", 16 * 64, STORAGE_RW);
         let (pixels, readback) = Self::pixel_buffers(&device, 256 * 256 * 4);
         Ok(Self {

@@ -4,6 +4,7 @@
 //!
 //! Both tracers, the WGSL one and the CPU reference, read exactly these arrays.
 
+use crate::floor_marks::MarkShape;
 use crate::layout::{Layout, Rgb};
 use crate::shapes::{Solid, SolidShape};
 use crate::world::World;
@@ -70,15 +71,24 @@ pub struct BoardPrim {
     pub color_b: [f32; 4],
 }
 
-/// A floor-region rectangle.
+/// A floor-region rectangle, or a mark painted on the floor (a square or a disc).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct FloorRectPrim {
-    /// centre x, centre y, half size x, half size y.
+    /// centre x, centre y, half size x (a disc's radius), half size y.
     pub geom: [f32; 4],
-    /// cos(angle), sin(angle), unused, unused.
+    /// cos(angle), sin(angle), kind ([`FLOOR_REGION`], [`SQUARE_MARK`], [`DISC_MARK`]), unused.
     pub frame: [f32; 4],
+    /// A mark's colour r, g, b (0..1), unused.
+    pub color: [f32; 4],
 }
+
+/// `FloorRectPrim::frame[2]` of a floor-region rectangle.
+pub const FLOOR_REGION: f32 = 0.0;
+/// `FloorRectPrim::frame[2]` of a square (or rectangular) mark.
+pub const SQUARE_MARK: f32 = 1.0;
+/// `FloorRectPrim::frame[2]` of a disc mark.
+pub const DISC_MARK: f32 = 2.0;
 
 /// Everything about the scene that is not a list.
 #[repr(C)]
@@ -88,7 +98,7 @@ pub struct SceneGlobals {
     pub field: [f32; 4],
     /// field present (0/1), any floor region (0/1), box count, cylinder count.
     pub flags: [u32; 4],
-    /// floor rectangle count, board count, quad count, unused.
+    /// floor rectangle and mark count, board count, quad count, unused.
     pub counts: [u32; 4],
     /// Floor region colour.
     pub floor_rgb: [f32; 4],
@@ -121,6 +131,11 @@ pub struct Scene {
     pub stripe_edges: Vec<f32>,
     /// Floor-region rectangles.
     pub floor_rects: Vec<FloorRectPrim>,
+}
+
+fn unit_frame(angle_deg: f64, kind: f32) -> [f32; 4] {
+    let a = angle_deg.to_radians();
+    [a.cos() as f32, a.sin() as f32, kind, 0.0]
 }
 
 fn rgb4(c: Rgb, w: f32) -> [f32; 4] {
@@ -206,22 +221,33 @@ impl Scene {
             });
             stripe_edges.extend(edges.iter().map(|&e| e as f32));
         }
-        let floor_rects: Vec<FloorRectPrim> = layout
-            .all_floor_rects()
+        let regions = layout.all_floor_rects();
+        let any_region = !regions.is_empty();
+        let mut floor_rects: Vec<FloorRectPrim> = regions
             .iter()
-            .map(|r| {
-                let a = r.angle_deg.to_radians();
-                FloorRectPrim {
-                    geom: [
-                        r.center_mm[0] as f32,
-                        r.center_mm[1] as f32,
-                        (r.size_mm[0] / 2.0) as f32,
-                        (r.size_mm[1] / 2.0) as f32,
-                    ],
-                    frame: [a.cos() as f32, a.sin() as f32, 0.0, 0.0],
-                }
+            .map(|r| FloorRectPrim {
+                geom: [
+                    r.center_mm[0] as f32,
+                    r.center_mm[1] as f32,
+                    (r.size_mm[0] / 2.0) as f32,
+                    (r.size_mm[1] / 2.0) as f32,
+                ],
+                frame: unit_frame(r.angle_deg, FLOOR_REGION),
+                color: [0.0; 4],
             })
             .collect();
+        floor_rects.extend(layout.all_floor_marks().iter().map(|m| {
+            let h = (m.size_mm / 2.0) as f32;
+            let kind = match m.shape {
+                MarkShape::Square => SQUARE_MARK,
+                MarkShape::Disc => DISC_MARK,
+            };
+            FloorRectPrim {
+                geom: [m.center_mm[0] as f32, m.center_mm[1] as f32, h, h],
+                frame: unit_frame(m.angle_deg, kind),
+                color: rgb4(m.rgb, 0.0),
+            }
+        }));
         let n = (LIGHT_DIR[0] * LIGHT_DIR[0]
             + LIGHT_DIR[1] * LIGHT_DIR[1]
             + LIGHT_DIR[2] * LIGHT_DIR[2])
@@ -239,7 +265,7 @@ impl Scene {
             }),
             flags: [
                 field.is_some() as u32,
-                (!floor_rects.is_empty()) as u32,
+                any_region as u32,
                 boxes.len() as u32,
                 cylinders.len() as u32,
             ],

@@ -2,7 +2,7 @@
 //! operation: floor colouring, box, quad, cylinder and floor intersections, stripe lookup, shading
 //! and packing. The CPU renderer calls these; the GPU runs the WGSL twin.
 
-use super::scene::{BoxPrim, CylinderPrim, QuadPrim, Scene};
+use super::scene::{BoxPrim, CylinderPrim, FLOOR_REGION, QuadPrim, SQUARE_MARK, Scene};
 
 /// A 3-vector in `f32`.
 pub type V3 = [f32; 3];
@@ -25,18 +25,30 @@ pub struct Hit {
     pub rgb: V3,
 }
 
-/// Colour of the floor at `(x, y)`: floor region, field lines or outside.
+/// Colour of the floor at `(x, y)`: a mark painted on it (the last that covers the point),
+/// floor region, field lines or outside.
 pub fn floor_color(s: &Scene, x: f32, y: f32) -> V3 {
     let g = &s.globals;
     let mut inside = g.flags[1] == 0;
+    let mut mark = None;
     for r in &s.floor_rects {
         let dx = x - r.geom[0];
         let dy = y - r.geom[1];
         let lx = r.frame[0] * dx + r.frame[1] * dy;
         let ly = -r.frame[1] * dx + r.frame[0] * dy;
-        if lx.abs() <= r.geom[2] && ly.abs() <= r.geom[3] {
-            inside = true;
+        let in_rect = lx.abs() <= r.geom[2] && ly.abs() <= r.geom[3];
+        if r.frame[2] == FLOOR_REGION {
+            inside |= in_rect;
+        } else if r.frame[2] == SQUARE_MARK {
+            if in_rect {
+                mark = Some(r);
+            }
+        } else if lx * lx + ly * ly <= r.geom[2] * r.geom[2] {
+            mark = Some(r);
         }
+    }
+    if let Some(m) = mark {
+        return [m.color[0], m.color[1], m.color[2]];
     }
     if !inside {
         return [g.outside_rgb[0], g.outside_rgb[1], g.outside_rgb[2]];

@@ -28,7 +28,7 @@ struct SensorParams {
 struct BoxPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
 struct CylinderPrim { geom: vec4<f32>, color: vec4<f32> };
 struct BoardPrim { range: vec4<u32>, color_a: vec4<f32>, color_b: vec4<f32> };
-struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32> };
+struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
 struct QuadPrim { c01: vec4<f32>, c23: vec4<f32>, z: vec4<f32>, color: vec4<f32> };
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -129,14 +129,23 @@ fn scene_ray(x: f32, y: f32) -> Ray {
 
 fn floor_color(x: f32, y: f32) -> vec3<f32> {
     var inside = g.flags.y == 0u;
+    var mark = -1;
     for (var i = 0u; i < g.counts.x; i = i + 1u) {
         let r = floor_rects[i];
         let dx = x - r.geom.x;
         let dy = y - r.geom.y;
         let lx = r.frame.x * dx + r.frame.y * dy;
         let ly = -r.frame.y * dx + r.frame.x * dy;
-        if (abs(lx) <= r.geom.z && abs(ly) <= r.geom.w) { inside = true; }
+        let in_rect = abs(lx) <= r.geom.z && abs(ly) <= r.geom.w;
+        if (r.frame.z == 0.0) {
+            if (in_rect) { inside = true; }
+        } else if (r.frame.z == 1.0) {
+            if (in_rect) { mark = i32(i); }
+        } else if (lx * lx + ly * ly <= r.geom.z * r.geom.z) {
+            mark = i32(i);
+        }
     }
+    if (mark >= 0) { return floor_rects[mark].color.xyz; }
     if (!inside) { return g.outside_rgb.xyz; }
     if (g.flags.x != 0u) {
         let ax = abs(x);

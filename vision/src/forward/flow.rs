@@ -1,0 +1,233 @@
+//! Optical flow by Horn and Schunck, and the balance of its magnitudes between the left and
+//! the right of the image (Sect. 2.1.2, eqs. (1)-(2)).
+//!
+//! The derivatives `E_x`, `E_y`, `E_t` are Horn and Schunck's own: first differences averaged
+//! over the 2x2x2 cube of two frames; the local averages `u_bar`, `v_bar` use their 3x3 kernel
+//! (1/6 at the sides, 1/12 at the corners). Each iteration applies eqs. (1)-(2) everywhere.
+
+use super::Grey;
+use imageproc::kernel::Kernel;
+use serde::{Deserialize, Serialize};
+
+/// Settings of the flow and of the flow-balance avoidance (`[vision.forward.flow]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FlowConfig {
+    /// The weighting factor `alpha` of eqs. (1)-(2), grey levels per pixel.
+    pub alpha: f32,
+    /// Iterations of eqs. (1)-(2).
+    pub iterations: u32,
+    /// The images are reduced by this factor (averaging blocks) before the flow (1: not).
+    pub downsample: u32,
+    /// Rows from the top of the image left out (far away: little flow, the horizon's clutter),
+    /// as a fraction of the height.
+    pub skip_top: f64,
+    /// Mean flow magnitude over both halves (px a frame, full resolution) past which an
+    /// obstacle is taken to be in front.
+    pub threshold_px: f32,
+}
+
+impl Default for FlowConfig {
+    fn default() -> Self {
+        Self {
+            alpha: 15.0,
+            iterations: 60,
+            downsample: 2,
+            skip_top: 0.25,
+            threshold_px: 0.6,
+        }
+    }
+}
+
+/// A flow field: `u` (right) and `v` (down) in pixels a frame, row by row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowField {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Horizontal flow.
+    pub u: Vec<f32>,
+    /// Vertical flow.
+    pub v: Vec<f32>,
+}
+
+impl FlowField {
+    /// The mean of `u` and of `v` over the field.
+    pub fn mean(&self) -> (f32, f32) {
+        let n = self.u.len().max(1) as f32;
+        (
+            self.u.iter().sum::<f32>() / n,
+            self.v.iter().sum::<f32>() / n,
+        )
+    }
+}
+
+/// The mean flow magnitude over the left and the right half of the image (below `skip_top`),
+/// in pixels a frame at full resolution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlowBalance {
+    /// Left half.
+    pub left_px: f32,
+    /// Right half.
+    pub right_px: f32,
+}
+
+impl FlowBalance {
+    /// The balance of `field` (computed on images reduced by `scale`).
+    pub fn of(field: &FlowField, skip_top: f64, scale: u32) -> Self {
+        let (w, h) = (field.width as usize, field.height as usize);
+        let top = ((skip_top * h as f64).round() as usize).min(h.saturating_sub(1));
+        let half = w / 2;
+        let (mut l, mut r) = (0.0f32, 0.0f32);
+        for y in top..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let m = field.u[i].hypot(field.v[i]);
+                if x < half {
+                    l += m;
+                } else {
+                    r += m;
+                }
+            }
+        }
+        let rows = (h - top).max(1) as f32;
+        let s = scale as f32;
+        Self {
+            left_px: s * l / (rows * half.max(1) as f32),
+            right_px: s * r / (rows * (w - half).max(1) as f32),
+        }
+    }
+
+    /// The mean over both halves.
+    pub fn total_px(&self) -> f32 {
+        0.5 * (self.left_px + self.right_px)
+    }
+}
+
+/// `img` reduced by `k`: each output pixel the mean of a `k x k` block.
+pub fn reduce(img: &Grey, k: u32) -> Grey {
+    if k <= 1 {
+        return img.clone();
+    }
+    let (w, h) = (img.width() / k, img.height() / k);
+    Grey::from_fn(w.max(1), h.max(1), |x, y| {
+        let mut s = 0.0;
+        for dy in 0..k {
+            for dx in 0..k {
+                s += img
+                    .get_pixel(
+                        (x * k + dx).min(img.width() - 1),
+                        (y * k + dy).min(img.height() - 1),
+                    )
+                    .0[0];
+            }
+        }
+        image::Luma([s / (k * k) as f32])
+    })
+}
+
+/// Horn-Schunck flow from `a` to `b` (equal sizes) by `iterations` of eqs. (1)-(2) from zero.
+pub fn horn_schunck(a: &Grey, b: &Grey, alpha: f32, iterations: u32) -> FlowField {
+    let (w, h) = a.dimensions();
+    let (wu, hu) = (w as usize, h as usize);
+    let at = |img: &Grey, x: usize, y: usize| {
+        img.get_pixel(x.min(wu - 1) as u32, y.min(hu - 1) as u32).0[0]
+    };
+    let n = wu * hu;
+    let (mut ex, mut ey, mut et) = (vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]);
+    for y in 0..hu {
+        for x in 0..wu {
+            let c = [
+                at(a, x, y),
+                at(a, x + 1, y),
+                at(a, x, y + 1),
+                at(a, x + 1, y + 1),
+                at(b, x, y),
+                at(b, x + 1, y),
+                at(b, x, y + 1),
+                at(b, x + 1, y + 1),
+            ];
+            let i = y * wu + x;
+            ex[i] = 0.25 * ((c[1] - c[0]) + (c[3] - c[2]) + (c[5] - c[4]) + (c[7] - c[6]));
+            ey[i] = 0.25 * ((c[2] - c[0]) + (c[3] - c[1]) + (c[6] - c[4]) + (c[7] - c[5]));
+            et[i] = 0.25 * ((c[4] - c[0]) + (c[5] - c[1]) + (c[6] - c[2]) + (c[7] - c[3]));
+        }
+    }
+    let a2 = alpha * alpha;
+    let mut u = Grey::new(w, h);
+    let mut v = Grey::new(w, h);
+    const K: [f32; 9] = [
+        1.0 / 12.0,
+        1.0 / 6.0,
+        1.0 / 12.0,
+        1.0 / 6.0,
+        0.0,
+        1.0 / 6.0,
+        1.0 / 12.0,
+        1.0 / 6.0,
+        1.0 / 12.0,
+    ];
+    let kernel = Kernel::new(&K, 3, 3);
+    for _ in 0..iterations {
+        let ub: Grey = imageproc::filter::filter(&u, kernel, |p| p);
+        let vb: Grey = imageproc::filter::filter(&v, kernel, |p| p);
+        for i in 0..n {
+            let (x, y) = ((i % wu) as u32, (i / wu) as u32);
+            let (uu, vv) = (ub.get_pixel(x, y).0[0], vb.get_pixel(x, y).0[0]);
+            // Eqs. (1)-(2).
+            let r = (ex[i] * uu + ey[i] * vv + et[i]) / (a2 + ex[i] * ex[i] + ey[i] * ey[i]);
+            u.put_pixel(x, y, image::Luma([uu - ex[i] * r]));
+            v.put_pixel(x, y, image::Luma([vv - ey[i] * r]));
+        }
+    }
+    FlowField {
+        width: w,
+        height: h,
+        u: u.into_raw(),
+        v: v.into_raw(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::texture;
+    use super::*;
+
+    #[test]
+    fn a_known_translation_of_a_texture_is_recovered() {
+        for (dx, dy) in [(0.5f64, 0.0f64), (0.0, -0.4), (0.6, 0.3)] {
+            let a = texture(96, 72, 0.0, 0.0);
+            let b = texture(96, 72, dx, dy);
+            let f = horn_schunck(&a, &b, 10.0, 200);
+            // Away from the borders, where the one-sided differences bias the flow.
+            let (mut su, mut sv, mut k) = (0.0, 0.0, 0.0);
+            for y in 8..64 {
+                for x in 8..88 {
+                    su += f.u[y * 96 + x] as f64;
+                    sv += f.v[y * 96 + x] as f64;
+                    k += 1.0;
+                }
+            }
+            let (u, v) = (su / k, sv / k);
+            assert!(
+                (u - dx).abs() < 0.08 && (v - dy).abs() < 0.08,
+                "({dx},{dy}) -> ({u},{v})"
+            );
+        }
+    }
+
+    #[test]
+    fn the_balance_leans_to_the_side_that_moves() {
+        let field = FlowField {
+            width: 4,
+            height: 2,
+            u: vec![0.0, 0.0, 1.0, 3.0, 0.0, 0.0, 1.0, 3.0],
+            v: vec![0.0; 8],
+        };
+        let b = FlowBalance::of(&field, 0.0, 2);
+        assert_eq!(b.left_px, 0.0);
+        assert_eq!(b.right_px, 4.0);
+        assert_eq!(b.total_px(), 2.0);
+    }
+}

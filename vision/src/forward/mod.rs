@@ -1,0 +1,96 @@
+//! A forward camera tilted down at the floor on a small robot (Ahmed, Saatchi and Caparrelli,
+//! "Vision based obstacle avoidance and odometry for swarms of small size robots"): obstacle
+//! avoidance by ground segmentation (Sect. 2.1.1) and by Horn-Schunck optical flow
+//! (Sect. 2.1.2), rotation from scan-line intensity profiles (Sect. 2.2.1) and translation from
+//! Harris corners tracked by Lucas-Kanade (Sect. 2.2.2) or matched by normalised
+//! cross-correlation (Sect. 2.2.3).
+//!
+//! Images are grey [`Grey`] planes of `f32` levels (0-255); generic filters (smoothing,
+//! gradients, dilation) come from `imageproc`.
+
+pub mod camera;
+pub mod flow;
+pub mod ground;
+pub mod harris;
+pub mod lk;
+pub mod ncc;
+pub mod odometry;
+pub mod scanline;
+
+pub use camera::ForwardCamera;
+pub use flow::{FlowBalance, FlowConfig, FlowField, horn_schunck, reduce};
+pub use ground::{GroundConfig, GroundSegmenter, GroundView};
+pub use harris::{Corner, HarrisConfig, harris_corners};
+pub use lk::{LkConfig, pyramid, track_lk};
+pub use ncc::{NccConfig, NccMatch, match_ncc};
+pub use odometry::{FeatureMethod, FeatureMotion, ForwardOdometry, OdometryConfig, OdometryStep};
+pub use scanline::{ScanLine, ScanLineConfig};
+
+use image::{ImageBuffer, Luma, RgbaImage};
+
+/// A grey image of `f32` levels.
+pub type Grey = ImageBuffer<Luma<f32>, Vec<f32>>;
+
+/// The luminance of an RGBA image (ITU-R BT.601 weights), as a [`Grey`] plane.
+pub fn grey(image: &RgbaImage) -> Grey {
+    Grey::from_fn(image.width(), image.height(), |x, y| {
+        let p = image.get_pixel(x, y).0;
+        Luma([crate::resection::stripes::luminance(&p)])
+    })
+}
+
+/// The level of `img` at `(x, y)` (pixel centres at integers) by bilinear interpolation, the
+/// border pixels continued outward.
+pub fn bilinear(img: &Grey, x: f64, y: f64) -> f32 {
+    let (w, h) = (img.width() as i64, img.height() as i64);
+    let x = x.clamp(0.0, (w - 1) as f64);
+    let y = y.clamp(0.0, (h - 1) as f64);
+    let (x0, y0) = (x.floor() as i64, y.floor() as i64);
+    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+    let (fx, fy) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
+    let p = |xx: i64, yy: i64| img.get_pixel(xx as u32, yy as u32).0[0];
+    let top = p(x0, y0) * (1.0 - fx) + p(x1, y0) * fx;
+    let bottom = p(x0, y1) * (1.0 - fx) + p(x1, y1) * fx;
+    top * (1.0 - fy) + bottom * fy
+}
+
+#[cfg(test)]
+pub(crate) mod testing {
+    use super::Grey;
+    use image::Luma;
+
+    /// A smooth texture of a few sinusoids and blobs, shifted by `(dx, dy)` (its content moves
+    /// right and down by that much).
+    pub fn texture(w: u32, h: u32, dx: f64, dy: f64) -> Grey {
+        Grey::from_fn(w, h, |x, y| {
+            let (u, v) = (x as f64 - dx, y as f64 - dy);
+            let s = (u * 0.31).sin() * (v * 0.23).cos()
+                + 0.6 * (u * 0.11 + v * 0.17).sin()
+                + 0.4 * ((u - 40.0).powi(2) / 60.0 + (v - 30.0).powi(2) / 90.0).cos();
+            Luma([(128.0 + 45.0 * s) as f32])
+        })
+    }
+
+    /// Dark squares on a light ground, shifted by `(dx, dy)`, each pixel shaded by the exact
+    /// fraction of it a square covers.
+    pub fn squares(w: u32, h: u32, dx: f64, dy: f64) -> Grey {
+        let squares = [
+            (20.0, 18.0, 9.0),
+            (60.0, 40.0, 12.0),
+            (95.0, 22.0, 7.0),
+            (40.0, 70.0, 10.0),
+            (110.0, 75.0, 11.0),
+        ];
+        let overlap = |p: f64, lo: f64, hi: f64| ((p + 0.5).min(hi) - (p - 0.5).max(lo)).max(0.0);
+        Grey::from_fn(w, h, |x, y| {
+            let dark: f64 = squares
+                .iter()
+                .map(|&(cx, cy, r)| {
+                    overlap(x as f64, cx - r + dx, cx + r + dx)
+                        * overlap(y as f64, cy - r + dy, cy + r + dy)
+                })
+                .sum();
+            Luma([(210.0 - 170.0 * dark.min(1.0)) as f32])
+        })
+    }
+}
