@@ -13,6 +13,7 @@ use omniloop_robot::{
 };
 use omniloop_sim::{Layout, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
+use omniloop_vision::forward::ForwardCamera;
 use omniloop_vision::resection::{ColumnCalibration, StripePattern};
 use serde::{Deserialize, Serialize};
 
@@ -323,6 +324,7 @@ impl Scenario {
             cameras: r.sensors.iter().map(|s| s.name.clone()).collect(),
             calibrations,
             columns,
+            forward_camera: self.forward_camera(),
             vision: self.vision.clone(),
             control: self.control.clone(),
             goal: self.goal.clone(),
@@ -330,6 +332,27 @@ impl Scenario {
             stereo: self.stereo_rig().ok(),
             seed: self.seed,
         }
+    }
+
+    /// Vision's camera as the robot knows it when it is a pinhole: size, principal point,
+    /// focal length, height, tilt and mount (design constants of a forward camera).
+    pub fn forward_camera(&self) -> Option<ForwardCamera> {
+        let s = self.sensor(self.vision.sensor.as_deref()).ok()?;
+        let p = s.pinhole.as_ref()?;
+        let [cx, cy] = s
+            .principal_point_px
+            .unwrap_or([s.width_px as f64 / 2.0, s.height_px as f64 / 2.0]);
+        Some(ForwardCamera {
+            sensor: s.name.clone(),
+            width_px: s.width_px,
+            height_px: s.height_px,
+            cx_px: cx,
+            cy_px: cy,
+            focal_px: p.focal_px,
+            height_mm: p.height_mm,
+            tilt_rad: p.tilt_deg.to_radians(),
+            mount_mm: s.mount_mm,
+        })
     }
 
     /// The map the robot is given: the world's pillars (landmarks, by colour) and its walls,

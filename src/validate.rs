@@ -226,6 +226,24 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
     }
 
     let rb = &s.robot;
+    let forward = matches!(
+        s.control.kind,
+        ControllerKind::Segmentation | ControllerKind::OpticalFlow
+    ) || s.vision.forward.visual_odometry;
+    if forward && s.forward_camera().is_none() {
+        c.fail(
+            "vision.sensor",
+            "the forward camera's avoidance and visual odometry need vision's camera to be a \
+             pinhole ([robot.sensors.pinhole])",
+        );
+    }
+    if let Some(d) = &rb.differential {
+        c.positive("robot.differential.track_mm", d.track_mm);
+        c.positive(
+            "robot.differential.max_turn_rate_deg_s",
+            d.max_turn_rate_deg_s,
+        );
+    }
     c.positive("robot.radius_mm", rb.radius_mm);
     c.positive("robot.height_mm", rb.height_mm);
     c.positive("robot.max_speed_mm_s", rb.max_speed_mm_s);
@@ -294,7 +312,12 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
     check_vision_and_control(&mut c, s);
     if !matches!(
         s.control.kind,
-        ControllerKind::Idle | ControllerKind::Wander | ControllerKind::Observe
+        ControllerKind::Idle
+            | ControllerKind::Wander
+            | ControllerKind::Observe
+            | ControllerKind::Segmentation
+            | ControllerKind::OpticalFlow
+            | ControllerKind::Script
     ) && s.goal.is_none()
     {
         c.fail(

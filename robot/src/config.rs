@@ -3,6 +3,7 @@
 
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::AvoidanceConfig;
+use omniloop_vision::forward::{FlowConfig, ForwardCamera, GroundConfig, OdometryConfig};
 use omniloop_vision::luminance_heading::LuminanceConfig;
 use omniloop_vision::omnistereo::OmnistereoConfig;
 use omniloop_vision::resection::{ColumnCalibration, ResectionConfig, StripePattern};
@@ -32,6 +33,15 @@ pub enum ControllerKind {
     /// Stand still while the cameras search, and drive to the observation points perception
     /// asks for (E5's "change the observation point by making a move", Fig. 4).
     Observe,
+    /// A forward camera's ground segmentation (Ahmed et al., Sect. 2.1.1): straight while the
+    /// ground ahead reaches far enough, else turn on the spot to the clearer side.
+    Segmentation,
+    /// A forward camera's Horn-Schunck flow balance (Ahmed et al., Sect. 2.1.2): straight
+    /// until the flow is strong, then turn away from the side with more.
+    OpticalFlow,
+    /// Drive a list of moves (straight runs and turns on the spot) on dead reckoning
+    /// (`[control.script]`).
+    Script,
 }
 
 impl ControllerKind {
@@ -49,6 +59,9 @@ impl ControllerKind {
             Self::VelocityAware => "velocity_aware",
             Self::Wander => "wander",
             Self::Observe => "observe",
+            Self::Segmentation => "segmentation",
+            Self::OpticalFlow => "optical_flow",
+            Self::Script => "script",
         }
     }
 }
@@ -91,6 +104,75 @@ pub struct ControlSpec {
     pub wander: WanderConfig,
     /// The search for the marks (`pose_source = "resection"`).
     pub resection: SearchConfig,
+    /// Speeds of the forward camera's avoidance (`kind = "segmentation"`, `"optical_flow"`).
+    pub forward: ForwardDriveConfig,
+    /// The moves of `kind = "script"`.
+    pub script: ScriptConfig,
+}
+
+/// How the forward camera's avoidance drives (`[control.forward]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ForwardDriveConfig {
+    /// Speed straight ahead, mm/s.
+    pub speed_mm_s: f64,
+    /// Rate of the turns on the spot, deg/s.
+    pub turn_rate_deg_s: f64,
+    /// Segmentation: once turning, go on until this many ground pixels more than needed lie
+    /// ahead (so the robot does not stop turning at the first clear column).
+    pub hysteresis_px: u32,
+    /// Optical flow: how long one turn away from the stronger flow lasts, s.
+    pub flow_turn_s: f64,
+    /// Optical flow: frames after a turn whose flow is not read (it is the turn's own).
+    pub flow_settle_frames: u32,
+}
+
+impl Default for ForwardDriveConfig {
+    fn default() -> Self {
+        Self {
+            speed_mm_s: 150.0,
+            turn_rate_deg_s: 60.0,
+            hysteresis_px: 6,
+            flow_turn_s: 0.75,
+            flow_settle_frames: 2,
+        }
+    }
+}
+
+/// One move of a script.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Move {
+    /// Straight ahead by this much (negative: back), mm: `{ forward_mm = 914.4 }`.
+    ForwardMm(f64),
+    /// Turn on the spot by this much (counter-clockwise positive), degrees:
+    /// `{ turn_deg = -90.0 }`.
+    TurnDeg(f64),
+}
+
+/// A scripted drive (`[control.script]`), judged on dead reckoning.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ScriptConfig {
+    /// The moves, in order.
+    pub moves: Vec<Move>,
+    /// Speed of the straight runs, mm/s.
+    pub speed_mm_s: f64,
+    /// Rate of the turns, deg/s.
+    pub turn_rate_deg_s: f64,
+    /// Standstill after each move, s.
+    pub pause_s: f64,
+}
+
+impl Default for ScriptConfig {
+    fn default() -> Self {
+        Self {
+            moves: Vec::new(),
+            speed_mm_s: 150.0,
+            turn_rate_deg_s: 45.0,
+            pause_s: 0.5,
+        }
+    }
 }
 
 /// How the robot searches for the three marks (`[control.resection]`, Fig. 4 of the resection
@@ -154,6 +236,8 @@ impl Default for ControlSpec {
             localization_gain: 0.3,
             wander: WanderConfig::default(),
             resection: SearchConfig::default(),
+            forward: ForwardDriveConfig::default(),
+            script: ScriptConfig::default(),
         }
     }
 }
@@ -178,6 +262,22 @@ pub struct VisionSpec {
     pub omnistereo: OmnistereoConfig,
     /// Striped-mark recognition for resection (Ishikawa, Kikuchi and Kato).
     pub resection: ResectionConfig,
+    /// A forward camera's avoidance and visual odometry (Ahmed, Saatchi and Caparrelli).
+    pub forward: ForwardVisionConfig,
+}
+
+/// A forward camera's image processing (`[vision.forward]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct ForwardVisionConfig {
+    /// Run the visual odometry (scan-line rotation, LK and NCC translation) every frame.
+    pub visual_odometry: bool,
+    /// Ground segmentation.
+    pub ground: GroundConfig,
+    /// Horn-Schunck flow.
+    pub flow: FlowConfig,
+    /// Visual odometry.
+    pub odometry: OdometryConfig,
 }
 
 /// The goal point, reached through optional waypoints (`[goal]`), in the world (field) frame.
@@ -340,6 +440,8 @@ pub struct RobotConfig {
     pub calibrations: Vec<RadialCalibration>,
     /// Column-to-bearing calibrations of the pinhole cameras vision uses.
     pub columns: Vec<ColumnCalibration>,
+    /// Vision's camera when it is a forward pinhole (its intrinsics, height and tilt).
+    pub forward_camera: Option<ForwardCamera>,
     /// Image processing.
     pub vision: VisionSpec,
     /// Controller and estimator.
@@ -376,6 +478,14 @@ impl RobotConfig {
     /// Whether the robot runs the omnistereo stage.
     pub fn uses_omnistereo(&self) -> bool {
         self.control.pose_source == PoseSource::Omnistereo
+    }
+
+    /// Whether the robot's forward camera runs: its avoidance or its visual odometry.
+    pub fn uses_forward_camera(&self) -> bool {
+        matches!(
+            self.control.kind,
+            ControllerKind::Segmentation | ControllerKind::OpticalFlow
+        ) || self.vision.forward.visual_odometry
     }
 
     /// Whether the robot runs the resection stage.

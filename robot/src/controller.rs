@@ -3,6 +3,8 @@
 use crate::RobotError;
 use crate::boundary::BodyCommand;
 use crate::config::{ControllerKind, RobotConfig};
+use crate::estimates::GroundReading;
+use crate::forward_drive;
 use crate::near_field::{NearField, NearSpace};
 use crate::wander::Wander;
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -10,6 +12,7 @@ use omniloop_control::{
     AccelLimitedDrive, GoalDirection, SpeedChoice, Surroundings, VelocityAware,
 };
 use omniloop_vision::FreeSpace;
+use omniloop_vision::forward::FlowBalance;
 
 /// What a controller decides on.
 #[derive(Debug, Clone, Copy)]
@@ -26,6 +29,10 @@ pub struct Situation<'a> {
     pub odometry_pose: Isometry2<f64>,
     /// A point perception asks the robot to drive to (odometry frame).
     pub observation_point: Option<Point2<f64>>,
+    /// A forward camera's ground segmentation, when perceived this cycle.
+    pub ground: Option<&'a GroundReading>,
+    /// A forward camera's flow balance, when perceived this cycle.
+    pub flow: Option<FlowBalance>,
     /// Time of the cycle, s.
     pub t_s: f64,
 }
@@ -34,6 +41,10 @@ pub struct Situation<'a> {
 pub trait Controller: Send {
     /// The command for this cycle.
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand;
+    /// The move a scripted controller is at (after the cycle's decision), if it follows one.
+    fn step(&self) -> Option<usize> {
+        None
+    }
 }
 
 /// The controller a configuration names.
@@ -61,6 +72,9 @@ pub fn build(config: &RobotConfig) -> Result<Box<dyn Controller>, RobotError> {
             )?,
         }),
         ControllerKind::Wander => Box::new(Wander::new(config)?),
+        ControllerKind::Segmentation => Box::new(forward_drive::Segmentation::new(config)),
+        ControllerKind::OpticalFlow => Box::new(forward_drive::FlowAvoidance::new(config)),
+        ControllerKind::Script => Box::new(forward_drive::Script::new(config)),
         ControllerKind::Observe => Box::new(Observe {
             max_speed_mm_s: b.max_speed_mm_s,
             accel_limit_mm_s2: b.accel_limit_mm_s2,

@@ -1,6 +1,7 @@
 //! What the robot believes: the typed record it returns each cycle, written beside the truth.
 
 use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_vision::forward::{FlowBalance, OdometryStep};
 use omniloop_vision::{FreeSpace, LocalizationQuality};
 
 /// A measurement a perception stage gives the estimator.
@@ -94,6 +95,28 @@ pub struct MotionReading {
     pub inliers: usize,
 }
 
+/// What the ground segmentation of a forward camera showed this cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroundReading {
+    /// The fewest ground pixels from the bottom over the columns of the robot's path.
+    pub ahead_px: u32,
+    /// Ground pixels needed ahead to go straight.
+    pub needed_px: u32,
+    /// Mean run of ground over the left half, px.
+    pub left_px: f64,
+    /// Mean run of ground over the right half, px.
+    pub right_px: f64,
+    /// Whether the level at the bottom centre jumped (an obstacle right in front).
+    pub jumped: bool,
+}
+
+impl GroundReading {
+    /// Whether more ground pixels than needed lie ahead.
+    pub fn clear_ahead(&self) -> bool {
+        self.ahead_px > self.needed_px
+    }
+}
+
 /// What the robot believes after one cycle.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Estimates {
@@ -115,6 +138,14 @@ pub struct Estimates {
     pub landmarks: Vec<LandmarkSighting>,
     /// The motion since the previous frame, as vision read it.
     pub motion: Option<MotionReading>,
+    /// A forward camera's ground segmentation.
+    pub ground: Option<GroundReading>,
+    /// A forward camera's flow balance.
+    pub flow: Option<FlowBalance>,
+    /// A forward camera's visual odometry since the previous frame.
+    pub visual_odometry: Option<OdometryStep>,
+    /// The move a scripted drive is at (the number of moves once done).
+    pub step: Option<usize>,
 }
 
 impl Estimates {

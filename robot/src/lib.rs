@@ -20,6 +20,7 @@ pub mod config;
 pub mod controller;
 pub mod estimates;
 pub mod estimator;
+pub mod forward_drive;
 pub mod mission;
 pub mod near_field;
 pub mod perception;
@@ -30,11 +31,13 @@ pub use boundary::{
     ActuatorCommand, ActuatorState, BodyCommand, Frame, Observation, OdometryReading, Outputs,
 };
 pub use config::{
-    BodySpec, ControlSpec, ControllerKind, GoalSpec, MapLandmark, MapMark, MapSegment, PoseSource,
-    RobotConfig, SearchConfig, StereoRig, VisionSpec, WanderConfig, WorldMap,
+    BodySpec, ControlSpec, ControllerKind, ForwardDriveConfig, ForwardVisionConfig, GoalSpec,
+    MapLandmark, MapMark, MapSegment, Move, PoseSource, RobotConfig, ScriptConfig, SearchConfig,
+    StereoRig, VisionSpec, WanderConfig, WorldMap,
 };
 pub use estimates::{
-    Estimates, Fix, FixOutcome, LandmarkSighting, Measurement, MotionReading, NotFound,
+    Estimates, Fix, FixOutcome, GroundReading, LandmarkSighting, Measurement, MotionReading,
+    NotFound,
 };
 pub use estimator::PoseEstimator;
 pub use mission::Mission;

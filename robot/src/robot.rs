@@ -130,6 +130,8 @@ impl Robot {
             pose,
             odometry_pose: self.estimator.odometry_pose(),
             observation_point: percepts.observation_point,
+            ground: percepts.ground.as_ref(),
+            flow: percepts.flow,
             t_s: obs.t_s,
         });
         self.estimator.end_cycle();
@@ -146,6 +148,10 @@ impl Robot {
                 target: self.mission.as_ref().map(Mission::index),
                 landmarks: percepts.landmarks,
                 motion: percepts.motion,
+                ground: percepts.ground,
+                flow: percepts.flow,
+                visual_odometry: percepts.visual_odometry,
+                step: self.controller.step(),
             },
         })
     }

@@ -167,6 +167,7 @@ mod tests {
             cameras: Vec::new(),
             calibrations: Vec::new(),
             columns: Vec::new(),
+            forward_camera: None,
             vision: VisionSpec::default(),
             control: ControlSpec::default(),
             goal: None,
@@ -188,6 +189,8 @@ mod tests {
             pose: Some(pose),
             odometry_pose: Isometry2::identity(),
             observation_point: None,
+            ground: None,
+            flow: None,
             t_s: 0.0,
         }
     }

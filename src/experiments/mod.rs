@@ -8,6 +8,7 @@
 //! `docs/experiments.md`.
 
 pub mod corner;
+pub mod forward;
 pub mod heading;
 pub mod localization_map;
 pub mod omnistereo;
@@ -69,7 +70,7 @@ impl Experiment for Drive {}
 
 /// The experiment a scenario belongs to (`[experiment.corner]`, `[experiment.places]`,
 /// `[experiment.localization_map]`, `[experiment.heading]`, `[experiment.omnistereo]`,
-/// `[experiment.resection]`).
+/// `[experiment.resection]`, `[experiment.forward]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ExperimentSpec {
@@ -85,6 +86,8 @@ pub enum ExperimentSpec {
     Omnistereo(omnistereo::OmnistereoSpec),
     /// E5: three-mark resection at places.
     Resection(resection::ResectionSpec),
+    /// E6: a forward camera's avoidance or visual odometry.
+    Forward(forward::ForwardSpec),
 }
 
 impl ExperimentSpec {
@@ -97,6 +100,7 @@ impl ExperimentSpec {
             Self::Heading(spec) => spec.validate(s, c),
             Self::Omnistereo(spec) => spec.validate(s, c),
             Self::Resection(spec) => spec.validate(s, c),
+            Self::Forward(spec) => spec.validate(s, c),
         }
     }
 
@@ -108,7 +112,8 @@ impl ExperimentSpec {
             | Self::LocalizationMap(_)
             | Self::Heading(_)
             | Self::Omnistereo(_)
-            | Self::Resection(_) => {}
+            | Self::Resection(_)
+            | Self::Forward(_) => {}
         }
     }
 
@@ -127,6 +132,7 @@ impl ExperimentSpec {
             Self::Heading(_) => Some(heading::heading_table(summary)),
             Self::Omnistereo(_) => Some(omnistereo::omnistereo_table(summary)),
             Self::Resection(_) => Some(resection::resection_table(&[summary])),
+            Self::Forward(_) => None,
         }
     }
 }
@@ -147,6 +153,7 @@ pub fn procedure(s: &Scenario) -> Box<dyn Experiment> {
         }
         Some(ExperimentSpec::Omnistereo(spec)) => Box::new(omnistereo::Omnistereo::new(spec, s)),
         Some(ExperimentSpec::Resection(spec)) => Box::new(resection::Resection::new(spec, s)),
+        Some(ExperimentSpec::Forward(_)) => Box::new(forward::Forward::new(s)),
     }
 }
 
@@ -167,6 +174,7 @@ pub const REPLAYS: &[Replay] = &[
     heading::REPLAY,
     omnistereo::REPLAY,
     resection::REPLAY,
+    forward::REPLAY,
 ];
 
 /// The replay called `name`.

@@ -2,12 +2,14 @@
 //! estimator, or the reason it found nothing.
 
 mod floor_localization;
+mod forward;
 mod freespace;
 mod luminance_heading;
 mod omnistereo;
 pub mod resection;
 
 pub use floor_localization::FloorLocalizationStage;
+pub use forward::{FlowStage, GroundStage, VisualOdometryStage};
 pub use freespace::FreeSpaceStage;
 pub use luminance_heading::LuminanceHeadingStage;
 pub use omnistereo::OmnistereoStage;
@@ -16,9 +18,10 @@ pub use resection::ResectionStage;
 use crate::RobotError;
 use crate::boundary::{ActuatorCommand, Observation};
 use crate::config::RobotConfig;
-use crate::estimates::{LandmarkSighting, Measurement, MotionReading, NotFound};
+use crate::estimates::{GroundReading, LandmarkSighting, Measurement, MotionReading, NotFound};
 use image::RgbaImage;
 use nalgebra::{Isometry2, Point2};
+use omniloop_vision::forward::{FlowBalance, OdometryStep};
 use omniloop_vision::{FreeSpace, LocalizationQuality, RadialCalibration};
 
 /// What the stages of one cycle found.
@@ -38,6 +41,12 @@ pub struct Percepts {
     pub actuators: Vec<ActuatorCommand>,
     /// A point to drive to (odometry frame), when a stage needs another view.
     pub observation_point: Option<Point2<f64>>,
+    /// A forward camera's ground segmentation.
+    pub ground: Option<GroundReading>,
+    /// A forward camera's flow balance.
+    pub flow: Option<FlowBalance>,
+    /// A forward camera's visual odometry.
+    pub visual_odometry: Option<OdometryStep>,
 }
 
 /// A measurement, the stage that made it and how good that stage judged it.
@@ -99,6 +108,9 @@ pub fn build(config: &RobotConfig) -> Result<Vec<Box<dyn Stage>>, RobotError> {
     }
     if config.resects() {
         stages.push(Box::new(resection_stage(config)?));
+    }
+    if config.uses_forward_camera() {
+        forward::build(config, &mut stages)?;
     }
     if !(config.detects_freespace() || config.localizes() || !config.checkpoints().is_empty()) {
         return Ok(stages);

@@ -46,6 +46,15 @@ impl FeatureMethod {
 pub struct OdometryConfig {
     /// The rotation's window.
     pub scanline: ScanLineConfig,
+    /// The scan line compares each frame with a key frame until the shift passes this many
+    /// pixels (at the reference width), then the frame becomes the key (ours: 0 compares
+    /// consecutive frames, the paper's way; a key frame adds up the profile's errors once per
+    /// key instead of once per frame).
+    pub keyframe_px: f64,
+    /// Most frames a key frame is kept (forward motion slowly changes the profile).
+    pub keyframe_frames: u32,
+    /// A key frame's reading further than this from the consecutive frames' is dropped, deg.
+    pub keyframe_check_deg: f64,
     /// Top of the translation window (Fig. 3's bottom window), as a fraction of the height.
     pub window_top: f64,
     /// Corners are taken this far from the image's sides and bottom, px.
@@ -66,13 +75,16 @@ impl Default for OdometryConfig {
     fn default() -> Self {
         Self {
             scanline: ScanLineConfig::default(),
-            window_top: 0.4,
+            keyframe_px: 30.0,
+            keyframe_frames: 6,
+            keyframe_check_deg: 0.5,
+            window_top: 0.25,
             border_px: 7,
             harris: HarrisConfig::default(),
             lk: LkConfig::default(),
             ncc: NccConfig::default(),
             inlier_mm: 3.0,
-            min_features: 2,
+            min_features: 1,
         }
     }
 }
@@ -106,6 +118,14 @@ struct Previous {
     profile: Vec<f32>,
 }
 
+/// The scan line's key frame: its profile, the rotation of the last frame from it, its age.
+#[derive(Debug, Clone)]
+struct Key {
+    profile: Vec<f32>,
+    rotation_rad: f64,
+    frames: u32,
+}
+
 /// Visual odometry over successive frames of one camera.
 #[derive(Debug, Clone)]
 pub struct ForwardOdometry {
@@ -113,6 +133,7 @@ pub struct ForwardOdometry {
     scanline: ScanLine,
     config: OdometryConfig,
     previous: Option<Previous>,
+    key: Option<Key>,
 }
 
 impl ForwardOdometry {
@@ -123,6 +144,7 @@ impl ForwardOdometry {
             camera,
             config,
             previous: None,
+            key: None,
         })
     }
 
@@ -134,6 +156,36 @@ impl ForwardOdometry {
     /// Forgets the previous frame (the robot was carried).
     pub fn reset(&mut self) {
         self.previous = None;
+        self.key = None;
+    }
+
+    /// The rotation since the previous frame through the key frame, unless it disagrees with
+    /// the consecutive frames' by more than `keyframe_check_deg` (a key frame whose profile
+    /// has changed too much gives a wrong minimum): then the consecutive reading, and a new key.
+    fn rotation(&mut self, profile: &[f32], previous: Option<&[f32]>) -> Option<f64> {
+        let direct = self.scanline.rotation_rad(previous?, profile);
+        let since = self.rotation_from_key(profile)?;
+        if (since - direct).abs() > self.config.keyframe_check_deg.to_radians() {
+            self.key = None;
+            return Some(direct);
+        }
+        Some(since)
+    }
+
+    fn rotation_from_key(&mut self, profile: &[f32]) -> Option<f64> {
+        let c = &self.config;
+        let scale = self.camera.width_px as f64 / c.scanline.reference_width_px;
+        let limit =
+            c.keyframe_px * scale * self.scanline.alpha_rad() * c.scanline.oversample.max(1) as f64;
+        let key = self.key.as_mut()?;
+        let from_key = self.scanline.rotation_rad(&key.profile, profile);
+        let since = from_key - key.rotation_rad;
+        key.rotation_rad = from_key;
+        key.frames += 1;
+        if from_key.abs() >= limit || key.frames >= c.keyframe_frames {
+            self.key = None;
+        }
+        Some(since)
     }
 
     /// Takes the next frame: the motion since the previous one (`None` for the first).
@@ -142,15 +194,27 @@ impl ForwardOdometry {
             pyramid: pyramid(img, self.config.lk.levels, self.config.lk.smooth_sigma_px),
             profile: self.scanline.profile(img),
         };
-        let out = self.previous.as_ref().map(|prev| {
-            let rotation_rad = self.scanline.rotation_rad(&prev.profile, &now.profile);
-            let (lk, ncc) = self.translations(prev, &now, rotation_rad);
-            OdometryStep {
-                rotation_rad,
-                lk,
-                ncc,
-            }
-        });
+        let previous = self.previous.as_ref().map(|p| p.profile.clone());
+        let rotation = self.rotation(&now.profile, previous.as_deref());
+        if self.key.is_none() {
+            self.key = Some(Key {
+                profile: now.profile.clone(),
+                rotation_rad: 0.0,
+                frames: 0,
+            });
+        }
+        let out = self
+            .previous
+            .as_ref()
+            .zip(rotation)
+            .map(|(prev, rotation_rad)| {
+                let (lk, ncc) = self.translations(prev, &now, rotation_rad);
+                OdometryStep {
+                    rotation_rad,
+                    lk,
+                    ncc,
+                }
+            });
         self.previous = Some(now);
         out
     }
