@@ -40,7 +40,10 @@ fn main() {
     // Twenty frames 6 mm apart (150 mm/s at 25 frames a second).
     let frames: Vec<_> = (0..20)
         .map(|k| {
-            let pose = Isometry2::new(Vector2::new(-700.0, -600.0 + 6.0 * k as f64), 1.5708);
+            let pose = Isometry2::new(
+                Vector2::new(-700.0, -600.0 + 6.0 * k as f64),
+                std::f64::consts::FRAC_PI_2,
+            );
             let img = renderer
                 .render(&scene, &sensor, &pose, Some(&mut noise))
                 .expect("render");
