@@ -103,21 +103,7 @@ impl ForwardCamera {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
-    pub(crate) fn camera() -> ForwardCamera {
-        ForwardCamera {
-            sensor: "front".into(),
-            width_px: 160,
-            height_px: 120,
-            cx_px: 80.0,
-            cy_px: 60.0,
-            focal_px: 138.6,
-            height_mm: 100.0,
-            tilt_rad: -25f64.to_radians(),
-            mount_mm: [0.0, 0.0],
-        }
-    }
+    use super::super::testing::camera;
 
     #[test]
     fn the_principal_ray_meets_the_floor_at_height_over_tan_tilt() {

@@ -229,21 +229,8 @@ fn grow(img: &Grey, level: f32, tolerance: f32) -> Vec<bool> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::testing::camera;
     use super::*;
-
-    fn camera() -> ForwardCamera {
-        ForwardCamera {
-            sensor: "front".into(),
-            width_px: 160,
-            height_px: 120,
-            cx_px: 80.0,
-            cy_px: 60.0,
-            focal_px: 138.6,
-            height_mm: 100.0,
-            tilt_rad: -25f64.to_radians(),
-            mount_mm: [0.0, 0.0],
-        }
-    }
 
     /// A light floor with a dark block whose bottom edge is at row `bottom` between columns
     /// `x0..x1`.

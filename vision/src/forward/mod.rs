@@ -59,6 +59,21 @@ pub(crate) mod testing {
     use super::Grey;
     use image::Luma;
 
+    /// The E6 camera: 160 x 120, f 138.6, 100 mm up, tilted 25 degrees down, on the axle.
+    pub fn camera() -> super::ForwardCamera {
+        super::ForwardCamera {
+            sensor: "front".into(),
+            width_px: 160,
+            height_px: 120,
+            cx_px: 80.0,
+            cy_px: 60.0,
+            focal_px: 138.6,
+            height_mm: 100.0,
+            tilt_rad: -25f64.to_radians(),
+            mount_mm: [0.0, 0.0],
+        }
+    }
+
     /// A smooth texture of a few sinusoids and blobs, shifted by `(dx, dy)` (its content moves
     /// right and down by that much).
     pub fn texture(w: u32, h: u32, dx: f64, dy: f64) -> Grey {

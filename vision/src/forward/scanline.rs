@@ -200,22 +200,9 @@ impl ScanLine {
 
 #[cfg(test)]
 mod tests {
+    use super::super::testing::camera;
     use super::*;
     use image::Luma;
-
-    fn camera() -> ForwardCamera {
-        ForwardCamera {
-            sensor: "front".into(),
-            width_px: 160,
-            height_px: 120,
-            cx_px: 80.0,
-            cy_px: 60.0,
-            focal_px: 138.6,
-            height_mm: 100.0,
-            tilt_rad: -25f64.to_radians(),
-            mount_mm: [0.0, 0.0],
-        }
-    }
 
     /// What the camera sees inside a drum painted by azimuth when the robot faces `heading`.
     fn drum(c: &ForwardCamera, heading: f64) -> Grey {
