@@ -339,15 +339,13 @@ impl Scenario {
     pub fn forward_camera(&self) -> Option<ForwardCamera> {
         let s = self.sensor(self.vision.sensor.as_deref()).ok()?;
         let p = s.pinhole.as_ref()?;
-        let [cx, cy] = s
-            .principal_point_px
-            .unwrap_or([s.width_px as f64 / 2.0, s.height_px as f64 / 2.0]);
+        let built = s.build().ok()?;
         Some(ForwardCamera {
             sensor: s.name.clone(),
             width_px: s.width_px,
             height_px: s.height_px,
-            cx_px: cx,
-            cy_px: cy,
+            cx_px: built.cx_px,
+            cy_px: built.cy_px,
             focal_px: p.focal_px,
             height_mm: p.height_mm,
             tilt_rad: p.tilt_deg.to_radians(),

@@ -194,8 +194,11 @@ impl ForwardOdometry {
             pyramid: pyramid(img, self.config.lk.levels, self.config.lk.smooth_sigma_px),
             profile: self.scanline.profile(img),
         };
-        let previous = self.previous.as_ref().map(|p| p.profile.clone());
-        let rotation = self.rotation(&now.profile, previous.as_deref());
+        let previous = self.previous.take();
+        let rotation = self.rotation(
+            &now.profile,
+            previous.as_ref().map(|p| p.profile.as_slice()),
+        );
         if self.key.is_none() {
             self.key = Some(Key {
                 profile: now.profile.clone(),
@@ -203,18 +206,14 @@ impl ForwardOdometry {
                 frames: 0,
             });
         }
-        let out = self
-            .previous
-            .as_ref()
-            .zip(rotation)
-            .map(|(prev, rotation_rad)| {
-                let (lk, ncc) = self.translations(prev, &now, rotation_rad);
-                OdometryStep {
-                    rotation_rad,
-                    lk,
-                    ncc,
-                }
-            });
+        let out = previous.as_ref().zip(rotation).map(|(prev, rotation_rad)| {
+            let (lk, ncc) = self.translations(prev, &now, rotation_rad);
+            OdometryStep {
+                rotation_rad,
+                lk,
+                ncc,
+            }
+        });
         self.previous = Some(now);
         out
     }
