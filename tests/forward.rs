@@ -45,9 +45,7 @@ fn e6_replay_reads_turns_within_a_degree_legs_within_5_percent_and_avoids_by_seg
             "turn read {read}, true {truth}"
         );
     }
-    // The target is 5% for both; cross-correlation reads the last leg of test 2 (9.5 in)
-    // 5.1% long (seed 6), so its bound here is 6% until that is understood.
-    for (key, bound) in [("lk_legs_in", 0.05), ("ncc_legs_in", 0.06)] {
+    for (key, bound) in [("lk_legs_in", 0.05), ("ncc_legs_in", 0.05)] {
         let legs = pairs(&m, key);
         assert_eq!(legs.len(), 4, "{key}: {m}");
         for (read, truth) in &legs {

@@ -9,6 +9,7 @@
 //! gradients, dilation) come from `imageproc`.
 
 pub mod camera;
+pub mod features;
 pub mod flow;
 pub mod ground;
 pub mod harris;
@@ -18,12 +19,13 @@ pub mod odometry;
 pub mod scanline;
 
 pub use camera::ForwardCamera;
+pub use features::{FeatureConfig, FeatureMotion, FeatureTracks};
 pub use flow::{FlowBalance, FlowConfig, FlowField, horn_schunck, reduce};
 pub use ground::{GroundConfig, GroundSegmenter, GroundView};
 pub use harris::{Corner, HarrisConfig, harris_corners};
 pub use lk::{LkConfig, pyramid, track_lk};
 pub use ncc::{NccConfig, NccMatch, match_ncc};
-pub use odometry::{FeatureMethod, FeatureMotion, ForwardOdometry, OdometryConfig, OdometryStep};
+pub use odometry::{FeatureMethod, ForwardOdometry, OdometryConfig, OdometryStep};
 pub use scanline::{ScanLine, ScanLineConfig};
 
 use image::{ImageBuffer, Luma, RgbaImage};
@@ -83,6 +85,48 @@ pub(crate) mod testing {
                 + 0.6 * (u * 0.11 + v * 0.17).sin()
                 + 0.4 * ((u - 40.0).powi(2) / 60.0 + (v - 30.0).powi(2) / 90.0).cos();
             Luma([(128.0 + 45.0 * s) as f32])
+        })
+    }
+
+    /// What `camera` sees of a light floor with dark squares (20-60 mm, one in each 150 mm
+    /// cell) from the robot pose `(x_mm, y_mm, heading_rad)`, 3 x 3 samples a pixel.
+    pub fn floor_view(
+        camera: &super::ForwardCamera,
+        x_mm: f64,
+        y_mm: f64,
+        heading_rad: f64,
+    ) -> Grey {
+        let pose = nalgebra::Isometry2::new(nalgebra::Vector2::new(x_mm, y_mm), heading_rad);
+        let dark = |x: f64, y: f64| -> bool {
+            let cell = 150.0;
+            let (i, j) = ((x / cell).floor() as i64, (y / cell).floor() as i64);
+            let h = (i.wrapping_mul(73_856_093) ^ j.wrapping_mul(19_349_663)).unsigned_abs();
+            let size = 20.0 + (h % 41) as f64;
+            let (jx, jy) = (
+                ((h / 41) % 41) as f64 - 20.0,
+                ((h / 1681) % 41) as f64 - 20.0,
+            );
+            let (cx, cy) = ((i as f64 + 0.5) * cell + jx, (j as f64 + 0.5) * cell + jy);
+            (x - cx).abs() < 0.5 * size && (y - cy).abs() < 0.5 * size
+        };
+        Grey::from_fn(camera.width_px, camera.height_px, |px, py| {
+            let mut sum = 0.0;
+            for sy in 0..3 {
+                for sx in 0..3 {
+                    let (u, v) = (
+                        px as f64 + (sx as f64 - 1.0) / 3.0,
+                        py as f64 + (sy as f64 - 1.0) / 3.0,
+                    );
+                    sum += match camera.floor_point(u, v) {
+                        Some(p) => {
+                            let w = pose * p;
+                            if dark(w.x, w.y) { 40.0 } else { 210.0 }
+                        }
+                        None => 120.0,
+                    };
+                }
+            }
+            Luma([sum as f32 / 9.0])
         })
     }
 

@@ -32,6 +32,11 @@ pub struct ScanLineConfig {
     /// its pixels, so the shift is found to a fraction of a pixel without interpolating the
     /// profile).
     pub oversample: u32,
+    /// The most the robot turns between two frames, deg: the shifts tried are kept within
+    /// this of the expected one (ours: the paper tries every shift in `[rho - w, rho]`, up to
+    /// 18 degrees; with the far scene changing under forward motion, a short overlap far out
+    /// can score lower than the true shift; 6 covers 90 deg/s at 15 frames/s).
+    pub max_step_deg: f64,
 }
 
 impl Default for ScanLineConfig {
@@ -43,6 +48,7 @@ impl Default for ScanLineConfig {
             rho_px: 40.0,
             reference_width_px: 160.0,
             oversample: 4,
+            max_step_deg: 6.0,
         }
     }
 }
@@ -55,6 +61,7 @@ pub struct ScanLine {
     /// `alpha` of eq. (5): rad per bin.
     alpha_rad: f64,
     rho: i64,
+    max_step_rad: f64,
 }
 
 impl ScanLine {
@@ -62,6 +69,7 @@ impl ScanLine {
     pub fn new(camera: &ForwardCamera, config: &ScanLineConfig) -> Result<Self, VisionError> {
         crate::positive("scanline.w_px", config.w_px)?;
         crate::positive("scanline.reference_width_px", config.reference_width_px)?;
+        crate::positive("scanline.max_step_deg", config.max_step_deg)?;
         let k = config.oversample.max(1) as f64;
         let scale = camera.width_px as f64 / config.reference_width_px;
         let w = (config.w_px * scale * k).round() as usize;
@@ -109,6 +117,7 @@ impl ScanLine {
             samples,
             alpha_rad,
             rho,
+            max_step_rad: config.max_step_deg.to_radians(),
         })
     }
 
@@ -178,9 +187,14 @@ impl ScanLine {
     /// (ours: the paper keeps whole pixels, 0.4 degrees each on a 160-pixel camera, and a turn's
     /// frames would add up their rounding).
     pub fn shift(&self, a: &[f32], b: &[f32]) -> f64 {
+        self.shift_within(a, b, self.rho - a.len() as i64, self.rho)
+    }
+
+    /// Eq. (4) over the whole shifts in `[lo, hi]` (within eq. (4)'s range), refined.
+    fn shift_within(&self, a: &[f32], b: &[f32], lo: i64, hi: i64) -> f64 {
         let w = a.len() as i64;
+        let (lo, hi) = (lo.max(self.rho - w), hi.min(self.rho));
         let f = |t: i64| Self::difference(a, b, t);
-        let (lo, hi) = (self.rho - w, self.rho);
         let best = (lo..=hi)
             .min_by(|&x, &y| f(x).total_cmp(&f(y)))
             .unwrap_or(0);
@@ -195,6 +209,18 @@ impl ScanLine {
     /// positive (a left turn moves the scene right, to later bins: `p_s < 0`).
     pub fn rotation_rad(&self, a: &[f32], b: &[f32]) -> f64 {
         -self.alpha_rad * self.shift(a, b)
+    }
+
+    /// Eq. (5) with the shifts of eq. (4) kept within `max_step_deg` of the rotation
+    /// `expected_rad` (the rotation since the earlier frame as last read, or 0).
+    pub fn rotation_near(&self, a: &[f32], b: &[f32], expected_rad: f64) -> f64 {
+        let centre = -expected_rad / self.alpha_rad;
+        let half = self.max_step_rad / self.alpha_rad;
+        let (lo, hi) = (
+            (centre - half).floor() as i64,
+            (centre + half).ceil() as i64,
+        );
+        -self.alpha_rad * self.shift_within(a, b, lo, hi)
     }
 }
 
@@ -252,6 +278,30 @@ mod tests {
             let read = s.rotation_rad(&a, &b).to_degrees();
             assert!((read - deg).abs() < 0.01, "{deg}: read {read}");
         }
+    }
+
+    /// Near an expected rotation the reading is the same as the paper's full search, and it
+    /// stays within `max_step_deg` of the expected one whatever the profiles.
+    #[test]
+    fn a_search_near_the_expected_turn_reads_it_and_stays_within_the_step() {
+        let c = camera();
+        let s = ScanLine::new(&c, &ScanLineConfig::default()).unwrap();
+        let a = s.profile(&drum(&c, 0.0));
+        for (deg, expected) in [(3.6f64, 0.0f64), (-2.0, 0.0), (9.0, 7.0), (-11.5, -9.0)] {
+            let b = s.profile(&drum(&c, deg.to_radians()));
+            let read = s.rotation_near(&a, &b, expected.to_radians()).to_degrees();
+            assert!(
+                (read - deg).abs() < 0.01,
+                "{deg} near {expected}: read {read}"
+            );
+        }
+        let b = s.profile(&drum(&c, 9f64.to_radians()));
+        let read = s.rotation_near(&a, &b, 0.0).to_degrees();
+        let bin = s.alpha_rad().to_degrees();
+        assert!(
+            read.abs() <= 6.0 + bin,
+            "9 degrees searched within 6 read {read}"
+        );
     }
 
     #[test]
