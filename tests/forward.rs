@@ -66,8 +66,9 @@ fn e6_replay_reads_turns_within_a_degree_legs_within_5_percent_and_avoids_by_seg
     assert!(seg["distance_mm"].as_f64().unwrap() > 3000.0, "{seg}");
     let flow = &avoidance[1];
     assert_eq!(flow["method"], "optical_flow");
+    // The paper shows it noisier: its contacts are reported, not bounded; it must not stall.
     assert!(flow["contacts"].as_u64().is_some(), "{flow}");
-    assert!(flow["distance_mm"].as_f64().unwrap() > 300.0, "{flow}");
+    assert!(flow["distance_mm"].as_f64().unwrap() > 3000.0, "{flow}");
     for a in avoidance {
         assert!(a["fps"].as_f64().unwrap() > 0.0, "{a}");
     }

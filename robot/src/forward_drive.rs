@@ -95,7 +95,7 @@ impl Controller for FlowAvoidance {
             return straight(self.drive.speed_mm_s);
         }
         match s.flow {
-            Some(f) if f.total_px() > self.threshold_px => {
+            Some(f) if f.larger_px() > self.threshold_px => {
                 let side = if f.left_px > f.right_px { -1.0 } else { 1.0 };
                 self.turn = Some((side, s.t_s + self.drive.flow_turn_s));
                 turn(side * rate)

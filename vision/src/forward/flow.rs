@@ -22,8 +22,10 @@ pub struct FlowConfig {
     /// Rows from the top of the image left out (far away: little flow, the horizon's clutter),
     /// as a fraction of the height.
     pub skip_top: f64,
-    /// Mean flow magnitude over both halves (px a frame, full resolution) past which an
-    /// obstacle is taken to be in front.
+    /// Mean flow magnitude over the half with more flow (px a frame, full resolution) past
+    /// which an obstacle is taken to be near (ours: the paper compares "the flow" with a
+    /// threshold; an obstacle on a plain floor fills one side first and its flow, only along its
+    /// edges, is diluted by the other half's floor in a mean over both).
     pub threshold_px: f32,
 }
 
@@ -34,7 +36,7 @@ impl Default for FlowConfig {
             iterations: 60,
             downsample: 2,
             skip_top: 0.25,
-            threshold_px: 0.6,
+            threshold_px: 0.45,
         }
     }
 }
@@ -102,6 +104,11 @@ impl FlowBalance {
     /// The mean over both halves.
     pub fn total_px(&self) -> f32 {
         0.5 * (self.left_px + self.right_px)
+    }
+
+    /// The mean over the half with more flow.
+    pub fn larger_px(&self) -> f32 {
+        self.left_px.max(self.right_px)
     }
 }
 
@@ -229,5 +236,6 @@ mod tests {
         assert_eq!(b.left_px, 0.0);
         assert_eq!(b.right_px, 4.0);
         assert_eq!(b.total_px(), 2.0);
+        assert_eq!(b.larger_px(), 4.0);
     }
 }
