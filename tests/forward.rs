@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{omniloop, scenario_path, tmp};
+use common::{omniloop, tmp};
 use serde_json::Value;
 
 fn pairs(m: &Value, key: &str) -> Vec<(f64, f64)> {
@@ -82,18 +82,9 @@ fn e6_replay_reads_turns_within_a_degree_legs_within_5_percent_and_avoids_by_seg
     }
 }
 
-/// `omniloop check` on the obstacle scenario with `from` replaced by `to`: status, stderr.
+/// `omniloop check` on `forward_obstacles.toml` with `from` replaced by `to`: status, stderr.
 fn check_variant(name: &str, from: &str, to: &str) -> (Option<i32>, String) {
-    let text = std::fs::read_to_string(scenario_path("forward_obstacles.toml")).unwrap();
-    assert!(text.contains(from), "{from}");
-    let dir = tmp(name);
-    let file = dir.join("broken.toml");
-    std::fs::write(&file, text.replacen(from, to, 1)).unwrap();
-    let out = common::bin().arg("check").arg(&file).output().unwrap();
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    common::check_variant("forward_obstacles.toml", name, from, to)
 }
 
 #[test]

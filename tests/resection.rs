@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{omniloop, scenario_path, tmp};
+use common::{omniloop, tmp};
 use serde_json::Value;
 
 /// The places of a run's `summary.json`.
@@ -64,19 +64,9 @@ fn e5_replay_locates_every_place_of_table_1_within_2_cm_and_past_a_hidden_mark()
     assert!(dir.join("resection.png").is_file());
 }
 
-/// Writes the lab scenario with `from` replaced by `to` and returns `omniloop check`'s status
-/// and standard error.
+/// `omniloop check` on `resection_lab.toml` with `from` replaced by `to`: status, stderr.
 fn check_variant(name: &str, from: &str, to: &str) -> (Option<i32>, String) {
-    let text = std::fs::read_to_string(scenario_path("resection_lab.toml")).unwrap();
-    assert!(text.contains(from), "{from}");
-    let dir = tmp(name);
-    let file = dir.join("broken.toml");
-    std::fs::write(&file, text.replacen(from, to, 1)).unwrap();
-    let out = common::bin().arg("check").arg(&file).output().unwrap();
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    common::check_variant("resection_lab.toml", name, from, to)
 }
 
 #[test]

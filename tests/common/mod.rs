@@ -55,3 +55,18 @@ where
     );
     String::from_utf8(out.stdout).unwrap()
 }
+
+/// `omniloop check` on scenario file `scenario` (of `scenarios/`) with the first `from`
+/// replaced by `to`, written under a folder named `name`: its exit status and standard error.
+pub fn check_variant(scenario: &str, name: &str, from: &str, to: &str) -> (Option<i32>, String) {
+    let text = std::fs::read_to_string(scenario_path(scenario)).unwrap();
+    assert!(text.contains(from), "{scenario}: {from}");
+    let dir = tmp(name);
+    let file = dir.join("broken.toml");
+    std::fs::write(&file, text.replacen(from, to, 1)).unwrap();
+    let out = bin().arg("check").arg(&file).output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
