@@ -22,6 +22,7 @@ pub mod record;
 pub mod scenario;
 pub mod score;
 pub mod simulation;
+pub mod sweep;
 pub mod topview;
 pub mod validate;
 

@@ -8,6 +8,7 @@ use omniloop::calibrate::calibrate_sensor;
 use omniloop::experiments::{REPLAYS, ReplayContext, replay};
 use omniloop::output::{default_out_dir, write_run};
 use omniloop::simulation::{RunOptions, render_snapshot};
+use omniloop::sweep::Seeds;
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice};
 use std::io::IsTerminal;
@@ -99,6 +100,36 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Run a scenario over a grid of values and seeds in parallel: sweep.csv, sweep.md, sweep.png.
+    Sweep {
+        /// Scenario file.
+        scenario: PathBuf,
+        /// A dotted key of the scenario and its values: TOML literals, bare words for strings,
+        /// ranges A..B:STEP (ends included); array items as `name[2].key`. Repeat for a grid.
+        #[arg(long = "set", value_name = "KEY=V1,V2,...")]
+        set: Vec<String>,
+        /// Seeds of each combination: N (the scenario's seed and the N - 1 after it) or A..B.
+        #[arg(long, default_value = "1")]
+        seeds: Seeds,
+        /// Runs at a time (default: one a core); the CPU renderer shares the cores among them.
+        #[arg(long, default_value_t = 0)]
+        jobs: usize,
+        /// Output folder (default: runs/<scenario name>_sweep).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Renderer for the sensors' images: auto, gpu or cpu.
+        #[arg(long, default_value = "auto")]
+        renderer: RendererChoice,
+        /// The metric of sweep.png: success_rate or a column of sweep.csv.
+        #[arg(long, default_value = "success_rate")]
+        plot: String,
+        /// Keep each run's own outputs in OUT/runs/.
+        #[arg(long)]
+        keep_runs: bool,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate.
     Calibrate {
         /// Scenario file.
@@ -111,6 +142,8 @@ enum Command {
         out: Option<PathBuf>,
     },
 }
+
+mod sweep;
 
 /// An error that makes the command exit with a given code.
 #[derive(Debug)]
@@ -312,6 +345,27 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("\nwritten to {}", dir.display());
             Ok(())
         }
+        Command::Sweep {
+            scenario,
+            set,
+            seeds,
+            jobs,
+            out,
+            renderer,
+            plot,
+            keep_runs,
+            quiet,
+        } => sweep::command(sweep::Args {
+            scenario,
+            sets: set,
+            seeds,
+            jobs,
+            out,
+            renderer,
+            plot,
+            keep_runs,
+            quiet,
+        }),
         Command::Calibrate {
             scenario,
             sensor,

@@ -1,0 +1,317 @@
+//! The sweep's table: `sweep.csv` (one row a run: the swept values, the seed, every scalar of
+//! its `summary.json`, the error if any) and `sweep.md` (one row a combination: runs, success
+//! rate, contacts, mean and worst of the main metrics).
+
+use super::set::value_text;
+use super::{Outcome, Plan, describe};
+use serde_json::Value as Json;
+use std::fmt::Write as _;
+
+/// One run's row: its values as text, its scalars by column name, its error.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// The job's index.
+    pub run: usize,
+    /// Which combination.
+    pub combination: usize,
+    /// The seed.
+    pub seed: u64,
+    /// Every scalar of the summary (nested keys joined by dots), in the summary's order.
+    pub scalars: Vec<(String, Json)>,
+    /// Why the run failed, or "not run" when it never started.
+    pub error: Option<String>,
+    /// Whether the run succeeded: no error, no contact, and its goal reached when it had one.
+    pub success: bool,
+}
+
+impl Row {
+    /// A scalar as a number (booleans as 0 and 1).
+    pub fn number(&self, key: &str) -> Option<f64> {
+        self.scalars
+            .iter()
+            .find(|(k, _)| k == key)
+            .and_then(|(_, v)| match v {
+                Json::Bool(b) => Some(if *b { 1.0 } else { 0.0 }),
+                v => v.as_f64(),
+            })
+    }
+}
+
+/// The rows of a sweep, in the plan's order.
+pub fn rows(plan: &Plan, outcomes: &[Option<Outcome>]) -> Vec<Row> {
+    plan.jobs
+        .iter()
+        .zip(outcomes)
+        .map(|(job, o)| {
+            let (scalars, error) = match o.as_ref().map(|o| &o.result) {
+                Some(Ok(summary)) => {
+                    let mut out = Vec::new();
+                    let json = serde_json::to_value(summary).unwrap_or(Json::Null);
+                    flatten("", &json, &mut out);
+                    (out, None)
+                }
+                Some(Err(e)) => (Vec::new(), Some(e.clone())),
+                None => (
+                    Vec::new(),
+                    Some("not run (the sweep was stopped)".to_string()),
+                ),
+            };
+            let mut row = Row {
+                run: job.index,
+                combination: job.combination,
+                seed: job.seed,
+                scalars,
+                error,
+                success: false,
+            };
+            let has_goal = job.scenario.goal.is_some();
+            row.success = row.error.is_none()
+                && row.number("wall_contacts") == Some(0.0)
+                && (!has_goal || row.number("reached_goal") == Some(1.0));
+            row
+        })
+        .collect()
+}
+
+/// The scalars of `v` under `prefix`: objects flattened with dots, arrays left out.
+fn flatten(prefix: &str, v: &Json, out: &mut Vec<(String, Json)>) {
+    match v {
+        Json::Object(map) => {
+            for (k, v) in map {
+                let key = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                flatten(&key, v, out);
+            }
+        }
+        Json::Array(_) => {}
+        scalar => out.push((prefix.to_string(), scalar.clone())),
+    }
+}
+
+/// The metric columns of `rows`: every scalar key, in the order first met.
+fn columns(rows: &[Row]) -> Vec<String> {
+    let mut cols: Vec<String> = Vec::new();
+    for r in rows {
+        for (k, _) in &r.scalars {
+            if !cols.contains(k) {
+                cols.push(k.clone());
+            }
+        }
+    }
+    cols
+}
+
+/// A CSV field, quoted when it needs to be.
+fn field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// `sweep.csv`: `run`, the swept keys, `seed`, `success`, `error`, then every scalar.
+pub fn csv(plan: &Plan, rows: &[Row]) -> String {
+    let cols = columns(rows);
+    let mut head: Vec<String> = vec!["run".into()];
+    head.extend(plan.sets.iter().map(|s| s.key.clone()));
+    head.extend(["seed", "success", "error"].map(String::from));
+    head.extend(cols.iter().cloned());
+    let mut out = head.iter().map(|h| field(h)).collect::<Vec<_>>().join(",") + "\n";
+    for (r, job) in rows.iter().zip(&plan.jobs) {
+        let mut line = vec![r.run.to_string()];
+        line.extend(job.values.iter().map(value_text));
+        line.push(r.seed.to_string());
+        line.push(r.success.to_string());
+        line.push(r.error.clone().unwrap_or_default());
+        for c in &cols {
+            let v = r.scalars.iter().find(|(k, _)| k == c).map(|(_, v)| v);
+            line.push(match v {
+                None | Some(Json::Null) => String::new(),
+                Some(Json::String(s)) => s.clone(),
+                Some(v) => v.to_string(),
+            });
+        }
+        out.push_str(&line.iter().map(|f| field(f)).collect::<Vec<_>>().join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// One combination over its seeds.
+#[derive(Debug, Clone)]
+pub struct Aggregate {
+    /// Which combination.
+    pub combination: usize,
+    /// Runs that finished (with or without error).
+    pub runs: usize,
+    /// Runs that failed with an error.
+    pub errors: usize,
+    /// Successes over runs.
+    pub success_rate: f64,
+    /// Contacts over all runs.
+    pub contacts: u64,
+    /// Rows of the combination.
+    pub rows: Vec<Row>,
+}
+
+impl Aggregate {
+    /// The mean of a metric over the runs that have it (`success_rate` is the rate).
+    pub fn mean(&self, metric: &str) -> Option<f64> {
+        if metric == "success_rate" {
+            return Some(self.success_rate);
+        }
+        let v: Vec<f64> = self.rows.iter().filter_map(|r| r.number(metric)).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    }
+
+    /// The worst of a metric: the largest, or the smallest where less is worse.
+    pub fn worst(&self, metric: &str) -> Option<f64> {
+        let v = self.rows.iter().filter_map(|r| r.number(metric));
+        if LESS_IS_WORSE.contains(&metric) {
+            v.reduce(f64::min)
+        } else {
+            v.reduce(f64::max)
+        }
+    }
+}
+
+/// Metrics whose smallest value is the worst.
+const LESS_IS_WORSE: [&str; 2] = ["min_clearance_mm", "cycles_per_s"];
+
+/// The combinations' aggregates, in order.
+pub fn aggregates(rows: &[Row]) -> Vec<Aggregate> {
+    let mut out: Vec<Aggregate> = Vec::new();
+    for r in rows {
+        if out.last().is_none_or(|a| a.combination != r.combination) {
+            out.push(Aggregate {
+                combination: r.combination,
+                runs: 0,
+                errors: 0,
+                success_rate: 0.0,
+                contacts: 0,
+                rows: Vec::new(),
+            });
+        }
+        let a = out.last_mut().expect("pushed above");
+        a.rows.push(r.clone());
+    }
+    for a in &mut out {
+        let ran: Vec<&Row> = a
+            .rows
+            .iter()
+            .filter(|r| !r.error.as_deref().is_some_and(|e| e.starts_with("not run")))
+            .collect();
+        a.runs = ran.len();
+        a.errors = ran.iter().filter(|r| r.error.is_some()).count();
+        a.contacts = ran
+            .iter()
+            .filter_map(|r| r.number("wall_contacts"))
+            .sum::<f64>() as u64;
+        let ok = ran.iter().filter(|r| r.success).count();
+        a.success_rate = if a.runs == 0 {
+            0.0
+        } else {
+            ok as f64 / a.runs as f64
+        };
+    }
+    out
+}
+
+/// The main metrics of `sweep.md`, those any run has.
+const MAIN: [(&str, &str); 5] = [
+    ("time_to_goal_s", "time to goal (s)"),
+    ("min_clearance_mm", "clearance (mm)"),
+    ("peak_speed_mm_s", "peak speed (mm/s)"),
+    ("pose_error_mm", "pose error (mm)"),
+    ("freespace_error_mm", "free-space error (mm)"),
+];
+
+/// `sweep.md`: one row a combination.
+pub fn markdown(plan: &Plan, rows: &[Row], header: &str) -> String {
+    let aggs = aggregates(rows);
+    let main: Vec<(&str, &str)> = MAIN
+        .into_iter()
+        .filter(|(k, _)| rows.iter().any(|r| r.number(k).is_some()))
+        .collect();
+    let mut md = format!(
+        "# Sweep of {} ({})\n\n{header}\n\n",
+        plan.name,
+        plan.file.display()
+    );
+    md.push_str("Success: the run ended without error and without a contact, at its goal when it has one. Each metric: mean / worst over the runs that have it (worst clearance is the smallest).\n\n");
+    let mut head: Vec<String> = plan.sets.iter().map(|s| s.key.clone()).collect();
+    head.extend(["runs", "success", "contacts"].map(String::from));
+    head.extend(main.iter().map(|(_, t)| t.to_string()));
+    let _ = writeln!(md, "| {} |", head.join(" | "));
+    let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
+    for a in &aggs {
+        let job = &plan.jobs[a.rows[0].run];
+        let mut cells: Vec<String> = job.values.iter().map(value_text).collect();
+        cells.extend([
+            if a.errors > 0 {
+                format!("{} ({} failed)", a.runs, a.errors)
+            } else {
+                a.runs.to_string()
+            },
+            format!("{:.0}%", 100.0 * a.success_rate),
+            a.contacts.to_string(),
+        ]);
+        for (k, _) in &main {
+            cells.push(match (a.mean(k), a.worst(k)) {
+                (Some(m), Some(w)) => format!("{} / {}", one_place(m), one_place(w)),
+                _ => "-".into(),
+            });
+        }
+        let _ = writeln!(md, "| {} |", cells.join(" | "));
+    }
+    let failed: Vec<&Row> = rows.iter().filter(|r| r.error.is_some()).collect();
+    if !failed.is_empty() {
+        md.push_str("\n## Runs that did not finish\n\n");
+        for r in failed.iter().take(50) {
+            let job = &plan.jobs[r.run];
+            let _ = writeln!(
+                md,
+                "- run {} ({}, seed {}): {}",
+                r.run,
+                describe(&plan.sets, &job.values),
+                r.seed,
+                r.error.as_deref().unwrap_or_default()
+            );
+        }
+        if failed.len() > 50 {
+            let _ = writeln!(md, "- ... and {} more (sweep.csv)", failed.len() - 50);
+        }
+    }
+    md
+}
+
+/// `v` to one decimal, a rounded-away sign left out (`-0.0` reads `0.0`).
+fn one_place(v: f64) -> String {
+    let s = format!("{v:.1}");
+    if s == "-0.0" { "0.0".into() } else { s }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nested_scalars_flatten_with_dots_and_arrays_are_left_out() {
+        let v = serde_json::json!({"a": 1, "b": {"c": 2.5, "d": [1, 2]}, "e": null});
+        let mut out = Vec::new();
+        flatten("", &v, &mut out);
+        let keys: Vec<&str> = out.iter().map(|(k, _)| k.as_str()).collect();
+        assert_eq!(keys, ["a", "b.c", "e"]);
+    }
+
+    #[test]
+    fn csv_fields_with_commas_or_quotes_are_quoted() {
+        assert_eq!(field("a,b"), "\"a,b\"");
+        assert_eq!(field("say \"x\""), "\"say \"\"x\"\"\"");
+        assert_eq!(field("plain"), "plain");
+    }
+}

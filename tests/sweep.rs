@@ -1,0 +1,177 @@
+//! `omniloop sweep` end to end: a small sweep's rows equal the runs made one by one, bit for bit
+//! in their trajectories and whatever `--jobs` is; a bad `--set` stops it before anything runs.
+
+mod common;
+
+use common::{bin, omniloop, scenario_path, tmp};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Columns that depend on the machine's load or on the threads, not on the run.
+const TIMING: [&str; 3] = ["wall_time_s", "cycles_per_s", "renderer"];
+
+/// The fields of one CSV line (quoted fields may hold commas).
+fn fields(line: &str) -> Vec<String> {
+    let (mut out, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
+}
+
+/// `sweep.csv` as rows of column -> value, the timing columns left out.
+fn table(dir: &Path) -> Vec<BTreeMap<String, String>> {
+    let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    let mut lines = text.lines();
+    let head = fields(lines.next().unwrap());
+    lines
+        .map(|l| {
+            let cells = fields(l);
+            assert_eq!(cells.len(), head.len(), "{l}");
+            head.iter()
+                .zip(cells)
+                .filter(|(h, _)| !TIMING.contains(&h.as_str()))
+                .map(|(h, c)| (h.clone(), c))
+                .collect()
+        })
+        .collect()
+}
+
+fn sweep(out: &Path, jobs: &str) {
+    let out = out.display().to_string();
+    omniloop([
+        "sweep",
+        scenario_path("corner55_velocity_aware.toml")
+            .to_str()
+            .unwrap(),
+        "--set",
+        "robot.max_speed_mm_s=300,400",
+        "--seeds",
+        "2",
+        "--jobs",
+        jobs,
+        "--renderer",
+        "cpu",
+        "--keep-runs",
+        "--out",
+        out.as_str(),
+    ]);
+}
+
+/// The run folders of a sweep, in run order.
+fn run_dirs(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut d: Vec<_> = std::fs::read_dir(dir.join("runs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    d.sort();
+    d
+}
+
+#[test]
+fn a_sweep_equals_its_runs_one_by_one_whatever_the_jobs() {
+    let root = tmp("sweep_small");
+    let (two, one) = (root.join("jobs2"), root.join("jobs1"));
+    sweep(&two, "2");
+    sweep(&one, "1");
+    for f in ["sweep.csv", "sweep.md", "sweep.png"] {
+        assert!(two.join(f).is_file(), "{f}");
+    }
+    let rows = table(&two);
+    assert_eq!(rows.len(), 4);
+    assert_eq!(rows, table(&one), "--jobs 2 and --jobs 1 give other rows");
+    let (dirs2, dirs1) = (run_dirs(&two), run_dirs(&one));
+    assert_eq!(dirs2.len(), 4);
+    for (a, b) in dirs2.iter().zip(&dirs1) {
+        let ta = std::fs::read(a.join("trajectory.csv")).unwrap();
+        assert_eq!(
+            ta,
+            std::fs::read(b.join("trajectory.csv")).unwrap(),
+            "{a:?}"
+        );
+    }
+
+    // Each row again, as a run of its own.
+    let text = std::fs::read_to_string(scenario_path("corner55_velocity_aware.toml")).unwrap();
+    for (k, row) in rows.iter().enumerate() {
+        let speed = &row["robot.max_speed_mm_s"];
+        let seed = &row["seed"];
+        assert!(text.contains("max_speed_mm_s = 400.0"));
+        let edited = text.replacen(
+            "max_speed_mm_s = 400.0",
+            &format!("max_speed_mm_s = {speed}"),
+            1,
+        );
+        let dir = root.join(format!("alone{k}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("corner55_velocity_aware.toml");
+        std::fs::write(&file, edited).unwrap();
+        let out = dir.join("out");
+        omniloop([
+            "run",
+            file.to_str().unwrap(),
+            "--seed",
+            seed,
+            "--renderer",
+            "cpu",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        for key in [
+            "cycles",
+            "wall_contacts",
+            "path_length_mm",
+            "min_clearance_mm",
+        ] {
+            assert_eq!(row[key], summary[key].to_string(), "run {k}: {key}");
+        }
+        assert_eq!(row["reached_goal"], summary["reached_goal"].to_string());
+        assert_eq!(
+            std::fs::read(out.join("trajectory.csv")).unwrap(),
+            std::fs::read(dirs2[k].join("trajectory.csv")).unwrap(),
+            "run {k}: the trajectory alone differs from the sweep's"
+        );
+    }
+}
+
+#[test]
+fn a_bad_set_exits_2_before_anything_runs() {
+    let dir = tmp("sweep_bad");
+    let scenario = scenario_path("corner55_velocity_aware.toml");
+    for (set, expect) in [
+        (
+            "robot.max_speed_mm_s=400,-5",
+            "--set robot.max_speed_mm_s=400,-5:1:26:",
+        ),
+        (
+            "robot.max_speed_mm_s=400,fast!",
+            "--set robot.max_speed_mm_s=400,fast!:1:26:",
+        ),
+        ("experiment.corner.angle_dg=40", "unknown field `angle_dg`"),
+        ("robot.sensors[7].noise_sigma=1", "item 7 of 1"),
+    ] {
+        let out = bin()
+            .args(["sweep", scenario.to_str().unwrap(), "--set", set, "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{set}: {err}");
+        assert!(err.contains(expect), "{set}: {err}");
+        assert!(!dir.join("sweep.csv").exists(), "{set}: something ran");
+    }
+}
