@@ -1,5 +1,7 @@
-//! Running a plan's jobs on a pool of workers, one run each at a time, the CPU renderer's own
-//! threads shared out so that the cores are not oversubscribed.
+//! Running a plan's jobs on a pool of workers, one run each at a time. The workers are tasks
+//! of one thread pool of a thread a core, which the CPU renderer's parallel loops also use: while
+//! every worker is busy each renders on its own thread, and a thread left idle (the last runs of
+//! a sweep) helps the others render, so the cores are neither oversubscribed nor left waiting.
 
 use super::{Job, Plan};
 use crate::output::write_run;
@@ -15,8 +17,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 pub struct SweepOptions {
     /// Runs at a time.
     pub workers: usize,
-    /// Threads of the CPU renderer within each run.
-    pub render_threads: usize,
+    /// Threads of the pool the workers and the CPU renderer share (at least `workers`).
+    pub threads: usize,
     /// The renderer of every run.
     pub renderer: RendererChoice,
     /// Where each run's own outputs go (`runs/` of the sweep), if kept.
@@ -30,7 +32,7 @@ impl SweepOptions {
         let workers = if workers == 0 { cores } else { workers };
         Self {
             workers,
-            render_threads: (cores / workers).max(1),
+            threads: cores.max(workers),
             renderer,
             keep_runs: None,
         }
@@ -58,29 +60,33 @@ pub fn run_jobs(
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<Outcome>>> = Mutex::new(vec![None; plan.jobs.len()]);
     let workers = options.workers.clamp(1, plan.jobs.len().max(1));
-    std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(options.render_threads)
-                    .build();
-                loop {
-                    if stop.load(Ordering::SeqCst) {
-                        break;
-                    }
-                    let i = next.fetch_add(1, Ordering::SeqCst);
-                    let Some(job) = plan.jobs.get(i) else { break };
-                    let result = match &pool {
-                        Ok(pool) => pool.install(|| run_one(plan, job, options)),
-                        Err(e) => Err(format!("cannot start the renderer's threads: {e}")),
-                    };
-                    let outcome = Outcome { job: i, result };
-                    done(&outcome);
-                    results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(outcome);
-                }
-            });
+    let worker = || {
+        loop {
+            if stop.load(Ordering::SeqCst) {
+                break;
+            }
+            let i = next.fetch_add(1, Ordering::SeqCst);
+            let Some(job) = plan.jobs.get(i) else { break };
+            let outcome = Outcome {
+                job: i,
+                result: run_one(plan, job, options),
+            };
+            done(&outcome);
+            results.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(outcome);
         }
-    });
+    };
+    match rayon::ThreadPoolBuilder::new()
+        .num_threads(options.threads.max(workers))
+        .build()
+    {
+        Ok(pool) => pool.scope(|s| {
+            for _ in 0..workers {
+                s.spawn(|_| worker());
+            }
+        }),
+        // Without a pool of its own the sweep runs one job at a time on the global pool.
+        Err(_) => worker(),
+    }
     results.into_inner().unwrap_or_else(|e| e.into_inner())
 }
 

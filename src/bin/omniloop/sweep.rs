@@ -117,12 +117,12 @@ pub fn command(a: Args) -> anyhow::Result<()> {
     }
     let stopped = STOP.load(Ordering::SeqCst);
     let header = format!(
-        "{ran} of {n} runs ({combos} combinations x {} seeds){}, {} at a time ({} renderer \
-         threads each), renderer {:?}: {wall_s:.1} s, {:.2} runs/s. Figure: sweep.png ({metric}).",
+        "{ran} of {n} runs ({combos} combinations x {} seeds){}, {} at a time on {} threads, \
+         renderer {:?}: {wall_s:.1} s, {:.2} runs/s. Figure: sweep.png ({metric}).",
         n / combos.max(1),
         if stopped { ", stopped by Ctrl-C" } else { "" },
         options.workers.min(n),
-        options.render_threads,
+        options.threads,
         a.renderer,
         ran as f64 / wall_s.max(1e-9),
     );
