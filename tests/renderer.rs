@@ -9,7 +9,7 @@ use omniloop::simulation::render_snapshot;
 use omniloop_sim::optics::HyperbolicMirror;
 use omniloop_sim::render::SensorRays;
 use omniloop_sim::{
-    FloorRect, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorSpec, Wall,
+    FloorRect, FrameRequest, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorSpec, Wall,
 };
 mod common;
 
@@ -327,6 +327,53 @@ fn gpu_and_cpu_renders_agree() {
             );
         }
     }
+}
+
+/// Every sensor of every compared scene traced in one GPU batch (different scenes, mirrors,
+/// sizes and poses side by side) gives each image exactly as traced alone; the CPU renderer's
+/// batch is its frames one by one.
+#[test]
+fn a_gpu_batch_equals_its_frames_traced_one_by_one() {
+    let Some(mut gpu) = gpu_or_skip() else {
+        return;
+    };
+    let mut frames = Vec::new();
+    for (name, pose) in compared_scenes() {
+        let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
+        let mut bodies = s.robot_bodies();
+        if let Some(p) = pose {
+            bodies[0].start = p;
+        }
+        let world = omniloop_sim::World::new(&s.world, &bodies, 0.002).unwrap();
+        let scene = Scene::of_world(&world);
+        let pose = world.robot_state(0).pose;
+        for spec in &s.robot.sensors {
+            frames.push((scene.clone(), spec.build().unwrap(), pose));
+        }
+    }
+    assert!(frames.len() >= 6, "{} frames", frames.len());
+    let requests: Vec<FrameRequest> = frames
+        .iter()
+        .map(|(scene, sensor, pose)| FrameRequest {
+            scene,
+            sensor,
+            pose,
+        })
+        .collect();
+    let batch = gpu.render_batch_packed(&requests).unwrap();
+    assert_eq!(batch.len(), frames.len());
+    for (k, (scene, sensor, pose)) in frames.iter().enumerate() {
+        let alone = gpu.render_packed(scene, sensor, pose).unwrap();
+        let diff = batch[k].iter().zip(alone).filter(|(a, b)| a != b).count();
+        assert_eq!(diff, 0, "frame {k} ({}): {diff} pixels differ", sensor.name);
+    }
+    let mut cpu = Renderer::cpu();
+    let cpu_batch = cpu.render_batch_packed(&requests[..2]).unwrap();
+    let (scene, sensor, pose) = &frames[1];
+    assert_eq!(
+        cpu_batch[1],
+        cpu.render_packed(scene, sensor, pose).unwrap()
+    );
 }
 
 /// Golden images: the CPU render (no noise) of each render example. A render passes when at

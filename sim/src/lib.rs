@@ -15,7 +15,7 @@ pub mod world;
 pub use corridor::Corridor;
 pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use layout::{Board, Cube, FieldSpec, FloorRect, Layout, Pillar, Rgb, Wall};
-pub use render::{RenderError, Renderer, RendererChoice, Scene, SensorNoise};
+pub use render::{FrameRequest, RenderError, Renderer, RendererChoice, Scene, SensorNoise};
 pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};
 pub use world::{RobotBodySpec, RobotState, RobotStats, World};

@@ -1,11 +1,16 @@
-//! The wgpu compute renderer: `trace.wgsl` traces every pixel of a frame; the scene and the
-//! sensor are storage and uniform buffers; the image is read back as packed RGBA8.
+//! The wgpu compute renderer: `trace.wgsl` traces every pixel of a batch of frames in one
+//! dispatch (the z dimension picks the frame); the frames' scenes share one storage buffer per
+//! primitive kind, each frame's header saying where its primitives and pixels start; the images
+//! are read back together as packed RGBA8. A single frame is a batch of one, so a frame traced
+//! alone and in a batch is the same computation.
 //!
-//! One [`GpuRenderer`] owns its device, pipeline and buffers; buffers grow when a scene or an
-//! image needs more room and are reused otherwise.
+//! One [`GpuRenderer`] owns its device, pipeline and buffers; buffers grow when a batch needs more
+//! room and are reused otherwise.
 
 use super::RenderError;
-use super::scene::{BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene};
+use super::scene::{
+    BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals,
+};
 use crate::optics::Optics;
 use crate::sensor::Sensor;
 use bytemuck::{Pod, Zeroable};
@@ -85,6 +90,73 @@ impl SensorParams {
     }
 }
 
+/// One frame's header in a batch (`Frame` of `trace.wgsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct FrameParams {
+    globals: SceneGlobals,
+    sensor: SensorParams,
+    /// First box, cylinder, board, stripe edge.
+    offsets: [u32; 4],
+    /// First floor rectangle, quad, pixel; unused.
+    offsets2: [u32; 4],
+}
+
+/// One frame to trace: the scene, the sensor and the robot's pose.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameRequest<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The sensor.
+    pub sensor: &'a Sensor,
+    /// The robot's pose.
+    pub pose: &'a Isometry2<f64>,
+}
+
+/// The concatenated primitives and headers of a batch.
+#[derive(Default)]
+struct Batch {
+    frames: Vec<FrameParams>,
+    boxes: Vec<BoxPrim>,
+    cylinders: Vec<CylinderPrim>,
+    boards: Vec<BoardPrim>,
+    stripes: Vec<f32>,
+    rects: Vec<FloorRectPrim>,
+    quads: Vec<QuadPrim>,
+    pixels: usize,
+}
+
+impl Batch {
+    fn of(requests: &[FrameRequest<'_>]) -> Result<Self, RenderError> {
+        let mut b = Self::default();
+        let at =
+            |n: usize| u32::try_from(n).map_err(|_| RenderError::Device("batch too large".into()));
+        for r in requests {
+            let sc = r.scene;
+            b.frames.push(FrameParams {
+                globals: sc.globals,
+                sensor: SensorParams::new(r.sensor, r.pose),
+                offsets: [
+                    at(b.boxes.len())?,
+                    at(b.cylinders.len())?,
+                    at(b.boards.len())?,
+                    at(b.stripes.len())?,
+                ],
+                offsets2: [at(b.rects.len())?, at(b.quads.len())?, at(b.pixels)?, 0],
+            });
+            b.boxes.extend_from_slice(&sc.boxes);
+            b.cylinders.extend_from_slice(&sc.cylinders);
+            b.boards.extend_from_slice(&sc.boards);
+            b.stripes.extend_from_slice(&sc.stripe_edges);
+            b.rects.extend_from_slice(&sc.floor_rects);
+            b.quads.extend_from_slice(&sc.quads);
+            b.pixels += (r.sensor.width_px * r.sensor.height_px) as usize;
+        }
+        at(b.pixels)?;
+        Ok(b)
+    }
+}
+
 /// A storage buffer that grows to fit.
 struct Storage {
     buffer: wgpu::Buffer,
@@ -138,8 +210,7 @@ pub struct GpuRenderer {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     adapter_name: String,
-    globals: wgpu::Buffer,
-    sensor: wgpu::Buffer,
+    frames: Storage,
     boxes: Storage,
     cylinders: Storage,
     boards: Storage,
@@ -208,8 +279,7 @@ impl GpuRenderer {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace"),
             entries: &[
-                entry(0, B::Uniform),
-                entry(1, B::Uniform),
+                entry(0, ro),
                 entry(2, ro),
                 entry(3, ro),
                 entry(4, ro),
@@ -232,19 +302,12 @@ impl GpuRenderer {
             compilation_options: Default::default(),
             cache: None,
         });
-        let uniform = |label, size| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        };
-        let globals = uniform(
-            "globals",
-            std::mem::size_of::<super::scene::SceneGlobals>() as u64,
+        let frames = Storage::new(
+            &device,
+            "frames",
+            std::mem::size_of::<FrameParams>() as u64,
+            STORAGE_RW,
         );
-        let sensor = uniform("sensor", std::mem::size_of::<SensorParams>() as u64);
         let boxes = Storage::new(&device, "boxes", 64 * 48, STORAGE_RW);
         let cylinders = Storage::new(&device, "cylinders", 16 * 32, STORAGE_RW);
         let boards = Storage::new(&device, "boards", 4 * 48, STORAGE_RW);
@@ -258,8 +321,7 @@ impl GpuRenderer {
             pipeline,
             layout,
             adapter_name,
-            globals,
-            sensor,
+            frames,
             boxes,
             cylinders,
             boards,
@@ -304,73 +366,45 @@ impl GpuRenderer {
     ) -> Result<(), RenderError> {
         let n = (sensor.width_px * sensor.height_px) as usize;
         assert_eq!(out.len(), n);
-        let bytes = (n * 4) as u64;
-        let mut rebind = self.bind_group.is_none();
-        if bytes > self.pixel_capacity {
-            let cap = bytes.next_power_of_two();
-            (self.pixels, self.readback) = Self::pixel_buffers(&self.device, cap);
-            self.pixel_capacity = cap;
-            rebind = true;
+        let images = self.render_batch(&[FrameRequest {
+            scene,
+            sensor,
+            pose,
+        }])?;
+        out.copy_from_slice(&images[0]);
+        Ok(())
+    }
+
+    /// Renders every frame of `requests` in one dispatch with one readback: each image packed
+    /// RGBA8, `width * height` pixels, in the order asked.
+    pub fn render_batch(
+        &mut self,
+        requests: &[FrameRequest<'_>],
+    ) -> Result<Vec<Vec<u32>>, RenderError> {
+        if requests.is_empty() {
+            return Ok(Vec::new());
         }
-        let (d, q) = (&self.device, &self.queue);
-        q.write_buffer(&self.globals, 0, bytemuck::bytes_of(&scene.globals));
-        q.write_buffer(
-            &self.sensor,
-            0,
-            bytemuck::bytes_of(&SensorParams::new(sensor, pose)),
-        );
-        rebind |= self
-            .boxes
-            .write(d, q, bytemuck::cast_slice::<BoxPrim, u8>(&scene.boxes));
-        rebind |= self.cylinders.write(
-            d,
-            q,
-            bytemuck::cast_slice::<CylinderPrim, u8>(&scene.cylinders),
-        );
-        rebind |= self
-            .boards
-            .write(d, q, bytemuck::cast_slice::<BoardPrim, u8>(&scene.boards));
-        rebind |= self
-            .stripes
-            .write(d, q, bytemuck::cast_slice::<f32, u8>(&scene.stripe_edges));
-        rebind |= self.rects.write(
-            d,
-            q,
-            bytemuck::cast_slice::<FloorRectPrim, u8>(&scene.floor_rects),
-        );
-        rebind |= self
-            .quads
-            .write(d, q, bytemuck::cast_slice::<QuadPrim, u8>(&scene.quads));
+        let batch = Batch::of(requests)?;
+        let bytes = (batch.pixels * 4) as u64;
+        let mut rebind = self.upload(&batch, bytes);
+        rebind |= self.bind_group.is_none();
         if rebind {
-            let buffers = [
-                &self.globals,
-                &self.sensor,
-                &self.boxes.buffer,
-                &self.cylinders.buffer,
-                &self.boards.buffer,
-                &self.stripes.buffer,
-                &self.rects.buffer,
-                &self.pixels,
-                &self.quads.buffer,
-            ];
-            let entries: Vec<wgpu::BindGroupEntry> = buffers
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            self.bind_group = Some(self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("trace"),
-                layout: &self.layout,
-                entries: &entries,
-            }));
+            self.rebind();
         }
+        let max_w = requests
+            .iter()
+            .map(|r| r.sensor.width_px)
+            .max()
+            .unwrap_or(1);
+        let max_h = requests
+            .iter()
+            .map(|r| r.sensor.height_px)
+            .max()
+            .unwrap_or(1);
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("frame"),
+                label: Some("batch"),
             });
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -379,10 +413,71 @@ impl GpuRenderer {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, self.bind_group.as_ref(), &[]);
-            pass.dispatch_workgroups(sensor.width_px.div_ceil(8), sensor.height_px.div_ceil(8), 1);
+            pass.dispatch_workgroups(max_w.div_ceil(8), max_h.div_ceil(8), requests.len() as u32);
         }
         encoder.copy_buffer_to_buffer(&self.pixels, 0, &self.readback, 0, Some(bytes));
         self.queue.submit([encoder.finish()]);
+        let all = self.read_back(bytes)?;
+        let mut out = Vec::with_capacity(requests.len());
+        let mut at = 0;
+        for r in requests {
+            let n = (r.sensor.width_px * r.sensor.height_px) as usize;
+            out.push(all[at..at + n].to_vec());
+            at += n;
+        }
+        Ok(out)
+    }
+
+    /// Writes the batch's buffers, growing those too small; returns whether any was replaced.
+    fn upload(&mut self, b: &Batch, pixel_bytes: u64) -> bool {
+        let mut rebind = false;
+        if pixel_bytes > self.pixel_capacity {
+            let cap = pixel_bytes.next_power_of_two();
+            (self.pixels, self.readback) = Self::pixel_buffers(&self.device, cap);
+            self.pixel_capacity = cap;
+            rebind = true;
+        }
+        let (d, q) = (&self.device, &self.queue);
+        rebind |= self.frames.write(d, q, bytemuck::cast_slice(&b.frames));
+        rebind |= self.boxes.write(d, q, bytemuck::cast_slice(&b.boxes));
+        rebind |= self
+            .cylinders
+            .write(d, q, bytemuck::cast_slice(&b.cylinders));
+        rebind |= self.boards.write(d, q, bytemuck::cast_slice(&b.boards));
+        rebind |= self.stripes.write(d, q, bytemuck::cast_slice(&b.stripes));
+        rebind |= self.rects.write(d, q, bytemuck::cast_slice(&b.rects));
+        rebind |= self.quads.write(d, q, bytemuck::cast_slice(&b.quads));
+        rebind
+    }
+
+    /// A new bind group over the current buffers.
+    fn rebind(&mut self) {
+        let buffers = [
+            (0, &self.frames.buffer),
+            (2, &self.boxes.buffer),
+            (3, &self.cylinders.buffer),
+            (4, &self.boards.buffer),
+            (5, &self.stripes.buffer),
+            (6, &self.rects.buffer),
+            (7, &self.pixels),
+            (8, &self.quads.buffer),
+        ];
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: *i,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        self.bind_group = Some(self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("trace"),
+            layout: &self.layout,
+            entries: &entries,
+        }));
+    }
+
+    /// Maps the first `bytes` of the readback buffer and copies them out.
+    fn read_back(&mut self, bytes: u64) -> Result<Vec<u32>, RenderError> {
         let slice = self.readback.slice(0..bytes);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -394,13 +489,13 @@ impl GpuRenderer {
         rx.recv()
             .map_err(|e| RenderError::Device(e.to_string()))?
             .map_err(|e| RenderError::Device(e.to_string()))?;
-        {
+        let out = {
             let view = slice
                 .get_mapped_range()
                 .map_err(|e| RenderError::Device(e.to_string()))?;
-            out.copy_from_slice(bytemuck::cast_slice(&view));
-        }
+            bytemuck::cast_slice::<u8, u32>(&view).to_vec()
+        };
         self.readback.unmap();
-        Ok(())
+        Ok(out)
     }
 }

@@ -8,7 +8,7 @@ pub mod scene;
 pub mod trace;
 
 pub use cpu::{CpuRenderer, SensorRays};
-pub use gpu::GpuRenderer;
+pub use gpu::{FrameRequest, GpuRenderer};
 pub use noise::SensorNoise;
 pub use scene::Scene;
 
@@ -151,6 +151,21 @@ impl Renderer {
             }
         }
         Ok(&self.pixels)
+    }
+
+    /// Renders the clean frames of `requests` as packed RGBA8, in order: on the GPU in one
+    /// dispatch with one readback, on the CPU one after the other.
+    pub fn render_batch_packed(
+        &mut self,
+        requests: &[FrameRequest<'_>],
+    ) -> Result<Vec<Vec<u32>>, RenderError> {
+        if let Backend::Gpu(g) = &mut self.backend {
+            return g.render_batch(requests);
+        }
+        requests
+            .iter()
+            .map(|r| Ok(self.render_packed(r.scene, r.sensor, r.pose)?.to_vec()))
+            .collect()
     }
 
     /// Renders a frame with the sensor's noise drawn from `noise` (or none when `None`).

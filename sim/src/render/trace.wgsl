@@ -1,4 +1,4 @@
-// omniloop catadioptric tracer: one invocation per pixel.
+// omniloop catadioptric tracer: one invocation per pixel of each frame of a batch (z: frame).
 // camera ray -> mirror (hyperbolic, conical, spherical) or pinhole -> scene (floor, boxes,
 // quadrilateral prisms, cylinders, striped boards) -> Lambert shading -> packed RGBA8.
 // The scene half matches sim/src/render/trace.rs operation for operation.
@@ -31,8 +31,16 @@ struct BoardPrim { range: vec4<u32>, color_a: vec4<f32>, color_b: vec4<f32> };
 struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
 struct QuadPrim { c01: vec4<f32>, c23: vec4<f32>, z: vec4<f32>, color: vec4<f32> };
 
-@group(0) @binding(0) var<uniform> g: Globals;
-@group(0) @binding(1) var<uniform> sensor: SensorParams;
+// One frame of a batch: its scene's scalars, its sensor and pose, and where its primitives and
+// pixels start in the shared arrays.
+struct Frame {
+    g: Globals,
+    sensor: SensorParams,
+    offsets: vec4<u32>,     // first box, cylinder, board, stripe edge
+    offsets2: vec4<u32>,    // first floor rect, quad, pixel, unused
+};
+
+@group(0) @binding(0) var<storage, read> frames: array<Frame>;
 @group(0) @binding(2) var<storage, read> boxes: array<BoxPrim>;
 @group(0) @binding(3) var<storage, read> cylinders: array<CylinderPrim>;
 @group(0) @binding(4) var<storage, read> boards: array<BoardPrim>;
@@ -40,6 +48,12 @@ struct QuadPrim { c01: vec4<f32>, c23: vec4<f32>, z: vec4<f32>, color: vec4<f32>
 @group(0) @binding(6) var<storage, read> floor_rects: array<FloorRectPrim>;
 @group(0) @binding(7) var<storage, read_write> pixels: array<u32>;
 @group(0) @binding(8) var<storage, read> quads: array<QuadPrim>;
+
+// The invocation's frame (global_invocation_id.z), read once in main.
+var<private> g: Globals;
+var<private> sensor: SensorParams;
+var<private> off: vec4<u32>;
+var<private> off2: vec4<u32>;
 
 const T_EPS: f32 = 1e-3;
 const BIG: f32 = 3.0e38;
@@ -131,7 +145,7 @@ fn floor_color(x: f32, y: f32) -> vec3<f32> {
     var inside = g.flags.y == 0u;
     var mark = -1;
     for (var i = 0u; i < g.counts.x; i = i + 1u) {
-        let r = floor_rects[i];
+        let r = floor_rects[off2.x + i];
         let dx = x - r.geom.x;
         let dy = y - r.geom.y;
         let lx = r.frame.x * dx + r.frame.y * dy;
@@ -145,7 +159,7 @@ fn floor_color(x: f32, y: f32) -> vec3<f32> {
             mark = i32(i);
         }
     }
-    if (mark >= 0) { return floor_rects[mark].color.xyz; }
+    if (mark >= 0) { return floor_rects[off2.x + u32(mark)].color.xyz; }
     if (!inside) { return g.outside_rgb.xyz; }
     if (g.flags.x != 0u) {
         let ax = abs(x);
@@ -209,14 +223,14 @@ fn hit_box(b: BoxPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
     }
     var rgb = b.color.xyz;
     if (b.color.w >= 0.0 && tn != sx.x) {
-        let board = boards[u32(b.color.w)];
+        let board = boards[off.z + u32(b.color.w)];
         let f = (lox + tn * ldx + hx) / (2.0 * hx);
         let first = board.range.x;
         let count = board.range.y;
         var k = 0u;
         if (count > 0u) { k = count - 1u; }
         for (var i = 0u; i < count; i = i + 1u) {
-            if (f <= stripe_edges[first + i]) { k = i; break; }
+            if (f <= stripe_edges[off.w + first + i]) { k = i; break; }
         }
         if (k % 2u == 0u) { rgb = board.color_a.xyz; } else { rgb = board.color_b.xyz; }
     }
@@ -304,10 +318,15 @@ fn pack(c: vec3<f32>) -> u32 {
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let fr = frames[id.z];
+    g = fr.g;
+    sensor = fr.sensor;
+    off = fr.offsets;
+    off2 = fr.offsets2;
     let w = sensor.size.x;
     let h = sensor.size.y;
     if (id.x >= w || id.y >= h) { return; }
-    let index = id.y * w + id.x;
+    let index = off2.z + id.y * w + id.x;
     let x = f32(id.x) + 0.5 - sensor.intr.x;
     let y = sensor.intr.y - (f32(id.y) + 0.5);
     let ray = scene_ray(x, y);
@@ -332,15 +351,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     for (var i = 0u; i < g.flags.z; i = i + 1u) {
-        let hb = hit_box(boxes[i], o, d, t_max);
+        let hb = hit_box(boxes[off.x + i], o, d, t_max);
         if (hb.ok) { best = hb; t_max = hb.t; }
     }
     for (var i = 0u; i < g.counts.z; i = i + 1u) {
-        let hq = hit_quad(quads[i], o, d, t_max);
+        let hq = hit_quad(quads[off2.y + i], o, d, t_max);
         if (hq.ok) { best = hq; t_max = hq.t; }
     }
     for (var i = 0u; i < g.flags.w; i = i + 1u) {
-        let hc = hit_cylinder(cylinders[i], o, d, t_max);
+        let hc = hit_cylinder(cylinders[off.y + i], o, d, t_max);
         if (hc.ok) { best = hc; t_max = hc.t; }
     }
     if (!best.ok) {
