@@ -1,13 +1,14 @@
 //! Renderer benchmark: median time per frame (and frames per second) of the field scene seen
 //! through the corner paper's hyperbolic mirror, at 256x220 and 512x512, on the CPU and, when an
-//! adapter exists, the GPU (readback included, noise excluded).
+//! adapter exists, the GPU (readback included, noise excluded); then batches of 1, 16 and 256
+//! frames (the GPU traces a batch in one dispatch).
 //!
 //!     cargo bench --bench render
 
 mod common;
 
 use omniloop::load_scenario;
-use omniloop_sim::{Renderer, RendererChoice, Scene, World};
+use omniloop_sim::{FrameRequest, Renderer, RendererChoice, Scene, World};
 use std::time::Instant;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -60,6 +61,61 @@ fn main() {
                 format!("{}x{}", sensor.width_px, sensor.height_px),
                 m,
                 1e3 / m
+            );
+        }
+    }
+    batches(&mut renderers, &scene, &small, &pose);
+}
+
+/// Frames/s of batches of 1, 16 and 256 frames of the small sensor, each frame at its own pose
+/// (a step apart along x): on the GPU one dispatch and one readback a batch, on the CPU the
+/// frames one after the other.
+fn batches(
+    renderers: &mut [Renderer],
+    scene: &Scene,
+    sensor: &omniloop_sim::Sensor,
+    pose: &nalgebra::Isometry2<f64>,
+) {
+    println!(
+        "\n{:<48} {:>10} {:>12} {:>10}",
+        "batched (256x220)", "batch", "median ms", "frames/s"
+    );
+    let poses: Vec<nalgebra::Isometry2<f64>> = (0..256)
+        .map(|k| {
+            let mut p = *pose;
+            p.translation.x += 2.0 * k as f64;
+            p
+        })
+        .collect();
+    for r in renderers.iter_mut() {
+        for n in [1usize, 16, 256] {
+            if !r.is_gpu() && n > 16 {
+                continue;
+            }
+            let requests: Vec<FrameRequest> = poses[..n]
+                .iter()
+                .map(|p| FrameRequest {
+                    scene,
+                    sensor,
+                    pose: p,
+                })
+                .collect();
+            r.render_batch_packed(&requests).expect("render");
+            let reps = if n >= 256 { 5 } else { 20 };
+            let times: Vec<f64> = (0..reps)
+                .map(|_| {
+                    let t = Instant::now();
+                    r.render_batch_packed(&requests).expect("render");
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect();
+            let m = median(times);
+            println!(
+                "{:<48} {:>10} {:>12.3} {:>10.1}",
+                r.name(),
+                n,
+                m,
+                n as f64 * 1e3 / m
             );
         }
     }

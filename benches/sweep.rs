@@ -5,7 +5,7 @@
 
 mod common;
 
-use omniloop::sweep::{Seeds, SweepOptions, plan, run_jobs};
+use omniloop::sweep::{Seeds, SweepOptions, plan, run_jobs, shared_gpu};
 use omniloop_sim::RendererChoice;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -70,4 +70,38 @@ fn main() {
             speedup / cores as f64
         );
     }
+    gpu_batched(&plan, cores, &stop);
+}
+
+/// The same sweep with every run's frames traced in shared GPU batches, 16 runs at a time
+/// (one batch of up to 16 frames a cycle), when an adapter opens.
+fn gpu_batched(plan: &omniloop::sweep::Plan, cores: usize, stop: &AtomicBool) {
+    let server = match shared_gpu(RendererChoice::Gpu) {
+        Ok(Some(s)) => s,
+        Ok(None) => return,
+        Err(e) => {
+            println!("GPU batches: not measured ({e})");
+            return;
+        }
+    };
+    let handle = server.handle();
+    let mut options = SweepOptions::new(16, cores, RendererChoice::Gpu);
+    options.shared_gpu = Some(handle.clone());
+    let t = Instant::now();
+    let out = run_jobs(plan, &options, stop, |_| {});
+    let s = t.elapsed().as_secs_f64();
+    let cycles: u64 = out
+        .iter()
+        .flatten()
+        .filter_map(|o| o.result.as_ref().ok())
+        .map(|s| s.cycles)
+        .sum();
+    println!(
+        "16 workers, GPU batches on {}: {} runs in {s:.1} s, {:.2} runs/s, {:.0} closed-loop \
+         cycles/s",
+        handle.name(),
+        plan.jobs.len(),
+        plan.jobs.len() as f64 / s,
+        cycles as f64 / s
+    );
 }

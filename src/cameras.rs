@@ -6,6 +6,7 @@ use crate::simulation::{RunError, sensor_noise_seed};
 use image::RgbaImage;
 use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
 use omniloop_sim::optics::Optics;
+use omniloop_sim::render::BatchHandle;
 use omniloop_sim::{Renderer, RendererChoice, Scene, Sensor, SensorNoise, World};
 use std::f64::consts::PI;
 
@@ -85,6 +86,7 @@ impl Cameras {
         wanted: &[String],
         all: bool,
         choice: RendererChoice,
+        shared: Option<&BatchHandle>,
         notice: impl FnOnce(&str),
     ) -> Result<Option<Self>, RunError> {
         let specs = &scenario.robot.sensors;
@@ -105,7 +107,10 @@ impl Cameras {
             });
         }
         Ok(Some(Self {
-            renderer: Renderer::new(choice, notice)?,
+            renderer: match shared {
+                Some(server) => Renderer::shared(server),
+                None => Renderer::new(choice, notice)?,
+            },
             cameras,
             images: Vec::new(),
         }))

@@ -14,6 +14,7 @@ use crate::score::TruthScore;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
 use omniloop_robot::{ControllerKind, Estimates, Observation, Robot, RobotError};
+use omniloop_sim::render::BatchHandle;
 use omniloop_sim::{RenderError, Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
 use omniloop_vision::resection::ColumnCalibration;
 use omniloop_vision::{RadialCalibration, VisionError};
@@ -60,6 +61,8 @@ pub struct RunOptions {
     pub save_frames_every: Option<u64>,
     /// Where saved frames go.
     pub frames_dir: Option<PathBuf>,
+    /// A GPU shared with other runs, its frames traced in batches (overrides `renderer`).
+    pub shared_gpu: Option<BatchHandle>,
 }
 
 /// The seed of sensor `index`'s noise, derived from the run's seed.
@@ -182,6 +185,7 @@ impl Simulation {
             robot.cameras(),
             options.save_frames_every.is_some() || scenario.experiment_takes_frames(),
             options.renderer,
+            options.shared_gpu.as_ref(),
             notice,
         )?;
         Ok(Self {

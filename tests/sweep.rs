@@ -175,3 +175,54 @@ fn a_bad_set_exits_2_before_anything_runs() {
         assert!(!dir.join("sweep.csv").exists(), "{set}: something ran");
     }
 }
+
+/// With `--renderer gpu` the runs' frames are traced in shared batches; each run's trajectory
+/// is the one it gets alone on the GPU.
+#[test]
+fn gpu_batches_across_runs_give_each_run_its_own_trajectory() {
+    if let Err(e) = omniloop_sim::Renderer::new(omniloop_sim::RendererChoice::Gpu, |_| {}) {
+        assert!(
+            std::env::var_os("OMNILOOP_REQUIRE_GPU").is_none(),
+            "OMNILOOP_REQUIRE_GPU is set but no adapter opened: {e}"
+        );
+        eprintln!("skipping the batched GPU sweep: {e}");
+        return;
+    }
+    let root = tmp("sweep_gpu");
+    let scenario = scenario_path("corner55_velocity_aware.toml");
+    let sweep_dir = root.join("sweep");
+    let out = omniloop([
+        "sweep",
+        scenario.to_str().unwrap(),
+        "--seeds",
+        "2",
+        "--jobs",
+        "2",
+        "--renderer",
+        "gpu",
+        "--keep-runs",
+        "--out",
+        sweep_dir.to_str().unwrap(),
+    ]);
+    assert!(out.contains("(batched)"), "{out}");
+    let rows = table(&sweep_dir);
+    for (k, dir) in run_dirs(&sweep_dir).iter().enumerate() {
+        let alone = root.join(format!("alone{k}"));
+        omniloop([
+            "run",
+            scenario.to_str().unwrap(),
+            "--seed",
+            rows[k]["seed"].as_str(),
+            "--renderer",
+            "gpu",
+            "-q",
+            "--out",
+            alone.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            std::fs::read(dir.join("trajectory.csv")).unwrap(),
+            std::fs::read(alone.join("trajectory.csv")).unwrap(),
+            "run {k}"
+        );
+    }
+}

@@ -12,7 +12,7 @@ pub mod workers;
 
 pub use report::{Aggregate, Row, rows};
 pub use set::{Set, SetError};
-pub use workers::{Outcome, SweepOptions, run_jobs};
+pub use workers::{Outcome, SweepOptions, run_jobs, shared_gpu};
 
 use crate::load::{LoadError, load_scenario, parse_scenario};
 use crate::scenario::Scenario;

@@ -7,10 +7,12 @@ use super::{Job, Plan};
 use crate::output::write_run;
 use crate::record::Summary;
 use crate::simulation::{RunOptions, run_scenario};
-use omniloop_sim::RendererChoice;
+use omniloop_sim::render::{BatchHandle, BatchServer, GpuRenderer};
+use omniloop_sim::{RenderError, RendererChoice};
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Duration;
 
 /// How a sweep runs.
 #[derive(Debug, Clone)]
@@ -23,7 +25,27 @@ pub struct SweepOptions {
     pub renderer: RendererChoice,
     /// Where each run's own outputs go (`runs/` of the sweep), if kept.
     pub keep_runs: Option<PathBuf>,
+    /// The GPU every run's frames go to, traced in batches across runs (see [`shared_gpu`]).
+    pub shared_gpu: Option<BatchHandle>,
 }
+
+/// A batch server on the GPU for a sweep with `choice`: with `gpu`, the first adapter; with
+/// `auto`, a hardware one (a software rasterizer is slower than the CPU renderer: none);
+/// with `cpu`, none.
+pub fn shared_gpu(choice: RendererChoice) -> Result<Option<BatchServer>, RenderError> {
+    let gpu = match choice {
+        RendererChoice::Cpu => return Ok(None),
+        RendererChoice::Gpu => GpuRenderer::new()?,
+        RendererChoice::Auto => match GpuRenderer::hardware()? {
+            Some(g) => g,
+            None => return Ok(None),
+        },
+    };
+    Ok(Some(BatchServer::start(gpu, BATCH_WAIT)))
+}
+
+/// How long a batch waits for the runs that have not sent their frame yet.
+const BATCH_WAIT: Duration = Duration::from_millis(10);
 
 impl SweepOptions {
     /// `workers` runs at a time (0: one a core) over `cores` cores.
@@ -35,6 +57,7 @@ impl SweepOptions {
             threads: cores.max(workers),
             renderer,
             keep_runs: None,
+            shared_gpu: None,
         }
     }
 }
@@ -94,6 +117,7 @@ pub fn run_jobs(
 fn run_one(plan: &Plan, job: &Job, options: &SweepOptions) -> Result<Summary, String> {
     let run_options = RunOptions {
         renderer: options.renderer,
+        shared_gpu: options.shared_gpu.clone(),
         ..RunOptions::default()
     };
     let out = run_scenario(&job.scenario, &run_options, |_| {}, |_, _| {})

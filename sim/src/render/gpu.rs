@@ -245,6 +245,17 @@ impl GpuRenderer {
         Self::with_adapter(Self::adapter()?)
     }
 
+    /// The first adapter when it is a hardware GPU; `None` when there is none or only a
+    /// software rasterizer.
+    pub fn hardware() -> Result<Option<Self>, RenderError> {
+        match Self::adapter() {
+            Ok(a) if a.get_info().device_type != wgpu::DeviceType::Cpu => {
+                Self::with_adapter(a).map(Some)
+            }
+            _ => Ok(None),
+        }
+    }
+
     /// The adapter wgpu offers first, preferring high performance.
     pub fn adapter() -> Result<wgpu::Adapter, RenderError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();

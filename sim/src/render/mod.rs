@@ -1,12 +1,14 @@
 //! Rendering the image a sensor sees: a wgpu compute tracer and a CPU reference that computes
 //! the same thing, chosen with `--renderer auto|gpu|cpu`.
 
+pub mod batch;
 pub mod cpu;
 pub mod gpu;
 pub mod noise;
 pub mod scene;
 pub mod trace;
 
+pub use batch::{BatchClient, BatchHandle, BatchServer};
 pub use cpu::{CpuRenderer, SensorRays};
 pub use gpu::{FrameRequest, GpuRenderer};
 pub use noise::SensorNoise;
@@ -58,6 +60,7 @@ impl FromStr for RendererChoice {
 enum Backend {
     Cpu(CpuRenderer),
     Gpu(Box<GpuRenderer>),
+    Shared(BatchClient),
 }
 
 /// A renderer with its per-sensor caches.
@@ -97,6 +100,7 @@ impl Renderer {
         let name = match &backend {
             Backend::Cpu(_) => format!("cpu (rayon, {} threads)", rayon::current_num_threads()),
             Backend::Gpu(g) => g.adapter_name().to_string(),
+            Backend::Shared(_) => unreachable!("Renderer::shared names itself"),
         };
         Ok(Self {
             backend,
@@ -104,6 +108,17 @@ impl Renderer {
             rays: Vec::new(),
             pixels: Vec::new(),
         })
+    }
+
+    /// A renderer whose frames go to the shared GPU of `server`, traced in batches with other
+    /// runs' frames.
+    pub fn shared(server: &BatchHandle) -> Self {
+        Self {
+            backend: Backend::Shared(server.join()),
+            name: server.name().to_string(),
+            rays: Vec::new(),
+            pixels: Vec::new(),
+        }
     }
 
     /// The CPU renderer.
@@ -118,7 +133,7 @@ impl Renderer {
 
     /// Whether frames are traced on a GPU adapter.
     pub fn is_gpu(&self) -> bool {
-        matches!(self.backend, Backend::Gpu(_))
+        matches!(self.backend, Backend::Gpu(_) | Backend::Shared(_))
     }
 
     /// Renders the clean frame (no noise) as packed RGBA8 into the renderer's scratch buffer.
@@ -132,6 +147,7 @@ impl Renderer {
         self.pixels.resize(n, 0);
         match &mut self.backend {
             Backend::Gpu(g) => g.render(scene, sensor, pose, &mut self.pixels)?,
+            Backend::Shared(client) => self.pixels = client.render(scene, sensor, pose)?,
             Backend::Cpu(c) => {
                 // One cache entry a sensor name, traced again when the sensor changed (a camera
                 // on a pan unit).

@@ -232,6 +232,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 renderer,
                 save_frames_every: save_frames,
                 frames_dir: save_frames.map(|_| dir.join("frames")),
+                shared_gpu: None,
             };
             let bar = progress_bar(s.max_cycles(), quiet);
             bar.set_prefix(s.name.clone());

@@ -6,7 +6,8 @@ use super::Exit;
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use omniloop::sweep::{
-    PlanError, Seeds, Set, SweepOptions, known_metric, plan, rows, run_jobs, write_outputs,
+    PlanError, Seeds, Set, SweepOptions, known_metric, plan, rows, run_jobs, shared_gpu,
+    write_outputs,
 };
 use omniloop::{LoadError, output::default_out_dir};
 use omniloop_sim::RendererChoice;
@@ -85,6 +86,13 @@ pub fn command(a: Args) -> anyhow::Result<()> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut options = SweepOptions::new(a.jobs, cores, a.renderer);
     options.keep_runs = a.keep_runs.then(|| dir.join("runs"));
+    // One GPU for all runs, their frames traced in batches; kept alive for the whole sweep.
+    let server = shared_gpu(a.renderer)?;
+    options.shared_gpu = server.as_ref().map(|s| s.handle());
+    let renderer = match &options.shared_gpu {
+        Some(h) => h.name().to_string(),
+        None => "cpu".to_string(),
+    };
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let _ = ctrlc::set_handler(|| {
         if STOP.swap(true, Ordering::SeqCst) {
@@ -118,12 +126,11 @@ pub fn command(a: Args) -> anyhow::Result<()> {
     let stopped = STOP.load(Ordering::SeqCst);
     let header = format!(
         "{ran} of {n} runs ({combos} combinations x {} seeds){}, {} at a time on {} threads, \
-         renderer {:?}: {wall_s:.1} s, {:.2} runs/s. Figure: sweep.png ({metric}).",
+         renderer {renderer}: {wall_s:.1} s, {:.2} runs/s. Figure: sweep.png ({metric}).",
         n / combos.max(1),
         if stopped { ", stopped by Ctrl-C" } else { "" },
         options.workers.min(n),
         options.threads,
-        a.renderer,
         ran as f64 / wall_s.max(1e-9),
     );
     let md = write_outputs(&dir, &plan, &rows, &metric, &header)?;

@@ -1,0 +1,176 @@
+//! One GPU shared by many runs: each run's renderer sends its frames to a [`BatchServer`], which
+//! waits until every run that has joined has a frame waiting (or `wait` has passed since the
+//! first), traces them all in one dispatch with one readback ([`GpuRenderer::render_batch`]) and
+//! hands each run its image. Runs that render in the same cycle so share the GPU's fixed cost
+//! per dispatch; a frame's image is the one it would get alone.
+
+use super::gpu::{FrameRequest, GpuRenderer};
+use super::{RenderError, Scene};
+use crate::sensor::Sensor;
+use nalgebra::Isometry2;
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
+use std::time::{Duration, Instant};
+
+/// A frame waiting for its batch, and where its image goes.
+struct Pending {
+    scene: Scene,
+    sensor: Sensor,
+    pose: Isometry2<f64>,
+    reply: Sender<Result<Vec<u32>, String>>,
+}
+
+enum Message {
+    Join,
+    Leave,
+    Frame(Box<Pending>),
+}
+
+/// The thread that owns the GPU and traces the batches.
+pub struct BatchServer {
+    handle: BatchHandle,
+}
+
+/// A way to reach a [`BatchServer`]: clone it into each run.
+#[derive(Clone)]
+pub struct BatchHandle {
+    tx: Sender<Message>,
+    name: String,
+}
+
+impl std::fmt::Debug for BatchHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "BatchHandle({})", self.name)
+    }
+}
+
+impl BatchServer {
+    /// Starts the server on `gpu`; a batch goes out when every joined run has a frame in it or
+    /// `wait` after its first frame.
+    pub fn start(mut gpu: GpuRenderer, wait: Duration) -> Self {
+        let (tx, rx) = channel();
+        let name = format!("{} (batched)", gpu.adapter_name());
+        std::thread::spawn(move || serve(&mut gpu, &rx, wait));
+        Self {
+            handle: BatchHandle { tx, name },
+        }
+    }
+
+    /// A handle for a run.
+    pub fn handle(&self) -> BatchHandle {
+        self.handle.clone()
+    }
+}
+
+impl BatchHandle {
+    /// The renderer's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Joins the server: until the client is dropped, batches wait for its frames too.
+    pub fn join(&self) -> BatchClient {
+        let _ = self.tx.send(Message::Join);
+        BatchClient {
+            tx: self.tx.clone(),
+        }
+    }
+}
+
+/// One run's place at the server.
+pub struct BatchClient {
+    tx: Sender<Message>,
+}
+
+impl BatchClient {
+    /// The image of one frame, traced in the next batch.
+    pub fn render(
+        &self,
+        scene: &Scene,
+        sensor: &Sensor,
+        pose: &Isometry2<f64>,
+    ) -> Result<Vec<u32>, RenderError> {
+        let (reply, rx) = channel();
+        let frame = Pending {
+            scene: scene.clone(),
+            sensor: sensor.clone(),
+            pose: *pose,
+            reply,
+        };
+        let gone = || RenderError::Device("the batch renderer stopped".into());
+        self.tx
+            .send(Message::Frame(Box::new(frame)))
+            .map_err(|_| gone())?;
+        rx.recv().map_err(|_| gone())?.map_err(RenderError::Device)
+    }
+}
+
+impl Drop for BatchClient {
+    fn drop(&mut self) {
+        let _ = self.tx.send(Message::Leave);
+    }
+}
+
+/// The server's loop: gather, trace, reply; ends when every handle and client is gone.
+fn serve(gpu: &mut GpuRenderer, rx: &Receiver<Message>, wait: Duration) {
+    let mut active = 0usize;
+    let mut pending: Vec<Pending> = Vec::new();
+    let mut deadline = Instant::now();
+    loop {
+        let msg = if pending.is_empty() {
+            match rx.recv() {
+                Ok(m) => m,
+                Err(_) => return,
+            }
+        } else {
+            match rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+                Ok(m) => m,
+                Err(RecvTimeoutError::Timeout) => {
+                    flush(gpu, &mut pending);
+                    continue;
+                }
+                Err(RecvTimeoutError::Disconnected) => {
+                    flush(gpu, &mut pending);
+                    return;
+                }
+            }
+        };
+        match msg {
+            Message::Join => active += 1,
+            Message::Leave => active = active.saturating_sub(1),
+            Message::Frame(f) => {
+                if pending.is_empty() {
+                    deadline = Instant::now() + wait;
+                }
+                pending.push(*f);
+            }
+        }
+        if !pending.is_empty() && pending.len() >= active.max(1) {
+            flush(gpu, &mut pending);
+        }
+    }
+}
+
+/// Traces the waiting frames in one batch and sends each its image.
+fn flush(gpu: &mut GpuRenderer, pending: &mut Vec<Pending>) {
+    let frames = std::mem::take(pending);
+    let requests: Vec<FrameRequest> = frames
+        .iter()
+        .map(|p| FrameRequest {
+            scene: &p.scene,
+            sensor: &p.sensor,
+            pose: &p.pose,
+        })
+        .collect();
+    match gpu.render_batch(&requests) {
+        Ok(images) => {
+            for (p, img) in frames.iter().zip(images) {
+                let _ = p.reply.send(Ok(img));
+            }
+        }
+        Err(e) => {
+            for p in &frames {
+                let _ = p.reply.send(Err(e.to_string()));
+            }
+        }
+    }
+}
