@@ -50,7 +50,8 @@ where
     let out = bin().args(args).output().unwrap();
     assert!(
         out.status.success(),
-        "{}",
+        "{}: {}",
+        out.status,
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).unwrap()

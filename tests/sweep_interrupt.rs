@@ -1,0 +1,51 @@
+//! `omniloop sweep` interrupted: alone in its binary, so that its signal meets no other test's
+//! processes.
+
+mod common;
+
+use common::{bin, scenario_path, tmp};
+
+/// Ctrl-C (SIGINT) stops starting runs, writes what finished and exits 130.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_sweep_keeps_what_finished() {
+    let dir = tmp("sweep_interrupted");
+    let mut child = bin()
+        .args([
+            "sweep",
+            scenario_path("corner55_velocity_aware.toml")
+                .to_str()
+                .unwrap(),
+            "--seeds",
+            "40",
+            "--jobs",
+            "1",
+            "--renderer",
+            "cpu",
+            "--out",
+        ])
+        .arg(&dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_secs(3));
+    let killed = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130));
+    let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 41, "{csv}");
+    let not_run = csv
+        .lines()
+        .filter(|l| l.contains("not run (the sweep was stopped)"))
+        .count();
+    assert!(
+        not_run >= 30,
+        "40 runs of about a second each: {not_run} not run after 3 s"
+    );
+    assert!(dir.join("sweep.md").is_file() && dir.join("sweep.png").is_file());
+}
