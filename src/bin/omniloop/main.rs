@@ -168,12 +168,21 @@ fn load(path: &Path) -> anyhow::Result<Scenario> {
 }
 
 fn progress_bar(total: u64, quiet: bool) -> ProgressBar {
+    styled_bar(
+        total,
+        quiet,
+        "{prefix} [{bar:40}] {pos}/{len} cycles {per_sec} eta {eta}",
+    )
+}
+
+/// A progress bar drawn with `template` on a terminal, hidden otherwise or when `quiet`.
+fn styled_bar(total: u64, quiet: bool, template: &str) -> ProgressBar {
     if quiet || !std::io::stderr().is_terminal() {
         return ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
     }
     let bar = ProgressBar::new(total);
     bar.set_style(
-        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} cycles {per_sec} eta {eta}")
+        ProgressStyle::with_template(template)
             .expect("valid template")
             .progress_chars("=> "),
     );

@@ -4,14 +4,12 @@
 
 use super::Exit;
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use omniloop::sweep::{
     PlanError, Seeds, Set, SweepOptions, known_metric, plan, rows, run_jobs, shared_gpu,
     write_outputs,
 };
 use omniloop::{LoadError, output::default_out_dir};
 use omniloop_sim::RendererChoice;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -42,19 +40,6 @@ fn parse_sets(args: &[String]) -> anyhow::Result<Vec<Set>> {
         return Err(Exit(2).into());
     }
     Ok(sets.into_iter().filter_map(Result::ok).collect())
-}
-
-fn bar(total: u64, quiet: bool) -> ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
-    }
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} runs {msg} eta {eta}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
-    bar
 }
 
 /// Runs the sweep.
@@ -102,7 +87,11 @@ pub fn command(a: Args) -> anyhow::Result<()> {
     });
     let n = plan.jobs.len();
     let combos = plan.jobs.last().map_or(0, |j| j.combination + 1);
-    let progress = bar(n as u64, a.quiet);
+    let progress = super::styled_bar(
+        n as u64,
+        a.quiet,
+        "{prefix} [{bar:40}] {pos}/{len} runs {msg} eta {eta}",
+    );
     progress.set_prefix(plan.name.clone());
     let failed = AtomicUsize::new(0);
     let start = Instant::now();
