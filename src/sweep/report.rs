@@ -308,6 +308,49 @@ mod tests {
         assert_eq!(keys, ["a", "b.c", "e"]);
     }
 
+    /// A run that failed keeps its row with its error; one that never started says so; neither
+    /// counts as a success, and only the failed one counts as run.
+    #[test]
+    fn failed_and_unstarted_runs_keep_their_rows() {
+        let scenario = crate::Scenario::from_toml("[robot]\n").expect("a bare scenario parses");
+        let set = super::super::Set::parse("robot.max_speed_mm_s=400").unwrap();
+        let job = |index| super::super::Job {
+            index,
+            combination: 0,
+            values: set.values.clone(),
+            seed: index as u64,
+            scenario: scenario.clone(),
+        };
+        let plan = Plan {
+            file: "x.toml".into(),
+            name: "x".into(),
+            sets: vec![set.clone()],
+            jobs: vec![job(0), job(1)],
+        };
+        let outcomes = vec![
+            Some(Outcome {
+                job: 0,
+                result: Err("GPU device error: lost, badly".into()),
+            }),
+            None,
+        ];
+        let rows = rows(&plan, &outcomes);
+        assert!(rows.iter().all(|r| !r.success));
+        let text = csv(&plan, &rows);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "run,robot.max_speed_mm_s,seed,success,error");
+        assert_eq!(lines[1], "0,400,0,false,\"GPU device error: lost, badly\"");
+        assert!(
+            lines[2].ends_with("not run (the sweep was stopped)"),
+            "{}",
+            lines[2]
+        );
+        let a = &aggregates(&rows)[0];
+        assert_eq!((a.runs, a.errors, a.success_rate), (1, 1, 0.0));
+        let md = markdown(&plan, &rows, "");
+        assert!(md.contains("| 400 | 1 (1 failed) | 0% | 0 |"), "{md}");
+    }
+
     #[test]
     fn csv_fields_with_commas_or_quotes_are_quoted() {
         assert_eq!(field("a,b"), "\"a,b\"");
