@@ -377,13 +377,12 @@ impl GpuRenderer {
     ) -> Result<(), RenderError> {
         let n = (sensor.width_px * sensor.height_px) as usize;
         assert_eq!(out.len(), n);
-        let images = self.render_batch(&[FrameRequest {
+        let request = FrameRequest {
             scene,
             sensor,
             pose,
-        }])?;
-        out.copy_from_slice(&images[0]);
-        Ok(())
+        };
+        self.trace(&[request], |all| out.copy_from_slice(all))
     }
 
     /// Renders every frame of `requests` in one dispatch with one readback: each image packed
@@ -395,6 +394,25 @@ impl GpuRenderer {
         if requests.is_empty() {
             return Ok(Vec::new());
         }
+        let mut out = Vec::with_capacity(requests.len());
+        self.trace(requests, |all| {
+            let mut at = 0;
+            for r in requests {
+                let n = (r.sensor.width_px * r.sensor.height_px) as usize;
+                out.push(all[at..at + n].to_vec());
+                at += n;
+            }
+        })?;
+        Ok(out)
+    }
+
+    /// Traces `requests` (not empty) in one dispatch and hands `take` their pixels, frame after
+    /// frame, straight from the mapped readback buffer.
+    fn trace(
+        &mut self,
+        requests: &[FrameRequest<'_>],
+        take: impl FnOnce(&[u32]),
+    ) -> Result<(), RenderError> {
         let batch = Batch::of(requests)?;
         let bytes = (batch.pixels * 4) as u64;
         let mut rebind = self.upload(&batch, bytes);
@@ -428,15 +446,7 @@ impl GpuRenderer {
         }
         encoder.copy_buffer_to_buffer(&self.pixels, 0, &self.readback, 0, Some(bytes));
         self.queue.submit([encoder.finish()]);
-        let all = self.read_back(bytes)?;
-        let mut out = Vec::with_capacity(requests.len());
-        let mut at = 0;
-        for r in requests {
-            let n = (r.sensor.width_px * r.sensor.height_px) as usize;
-            out.push(all[at..at + n].to_vec());
-            at += n;
-        }
-        Ok(out)
+        self.read_back(bytes, take)
     }
 
     /// Writes the batch's buffers, growing those too small; returns whether any was replaced.
@@ -487,8 +497,8 @@ impl GpuRenderer {
         }));
     }
 
-    /// Maps the first `bytes` of the readback buffer and copies them out.
-    fn read_back(&mut self, bytes: u64) -> Result<Vec<u32>, RenderError> {
+    /// Maps the first `bytes` of the readback buffer and hands them to `take`.
+    fn read_back(&mut self, bytes: u64, take: impl FnOnce(&[u32])) -> Result<(), RenderError> {
         let slice = self.readback.slice(0..bytes);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -500,13 +510,13 @@ impl GpuRenderer {
         rx.recv()
             .map_err(|e| RenderError::Device(e.to_string()))?
             .map_err(|e| RenderError::Device(e.to_string()))?;
-        let out = {
+        {
             let view = slice
                 .get_mapped_range()
                 .map_err(|e| RenderError::Device(e.to_string()))?;
-            bytemuck::cast_slice::<u8, u32>(&view).to_vec()
-        };
+            take(bytemuck::cast_slice::<u8, u32>(&view));
+        }
         self.readback.unmap();
-        Ok(out)
+        Ok(())
     }
 }
