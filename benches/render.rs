@@ -16,6 +16,19 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Median time of `f` over `reps` calls, ms.
+fn median_ms(reps: usize, mut f: impl FnMut()) -> f64 {
+    median(
+        (0..reps)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect(),
+    )
+}
+
 fn main() {
     let path = common::scenario_path("render_hyperbolic.toml");
     let s = load_scenario(&path).expect("render_hyperbolic.toml loads");
@@ -47,14 +60,9 @@ fn main() {
                 r.render_packed(&scene, sensor, &pose).expect("render");
             }
             let frames = if sensor.width_px > 256 { 60 } else { 200 };
-            let times: Vec<f64> = (0..frames)
-                .map(|_| {
-                    let t = Instant::now();
-                    r.render_packed(&scene, sensor, &pose).expect("render");
-                    t.elapsed().as_secs_f64() * 1e3
-                })
-                .collect();
-            let m = median(times);
+            let m = median_ms(frames, || {
+                r.render_packed(&scene, sensor, &pose).expect("render");
+            });
             println!(
                 "{:<48} {:>10} {:>12.3} {:>10.1}",
                 r.name(),
@@ -102,14 +110,9 @@ fn batches(
                 .collect();
             r.render_batch_packed(&requests).expect("render");
             let reps = if n >= 256 { 5 } else { 20 };
-            let times: Vec<f64> = (0..reps)
-                .map(|_| {
-                    let t = Instant::now();
-                    r.render_batch_packed(&requests).expect("render");
-                    t.elapsed().as_secs_f64() * 1e3
-                })
-                .collect();
-            let m = median(times);
+            let m = median_ms(reps, || {
+                r.render_batch_packed(&requests).expect("render");
+            });
             println!(
                 "{:<48} {:>10} {:>12.3} {:>10.1}",
                 r.name(),

@@ -44,8 +44,6 @@ pub struct Set {
     pub arg: String,
     /// The key as written.
     pub key: String,
-    /// 1-based column of the first value in the argument.
-    pub value_column: usize,
     /// The values, in order.
     pub values: Vec<Value>,
     /// 1-based column in the argument of each value (a range's values share its column).
@@ -87,7 +85,6 @@ impl Set {
         Ok(Self {
             arg: arg.to_string(),
             key: key.to_string(),
-            value_column: start,
             values: out,
             columns,
             path,
@@ -136,10 +133,8 @@ impl Set {
 
     /// The column of `value` in the argument (the first value's when it is not one of them).
     pub fn column_of(&self, value: &Value) -> usize {
-        self.values
-            .iter()
-            .position(|v| v == value)
-            .map_or(self.value_column, |k| self.columns[k])
+        let k = self.values.iter().position(|v| v == value).unwrap_or(0);
+        self.columns.get(k).copied().unwrap_or(1)
     }
 
     /// Whether the scenario field `field` (as validation names it) lies at or under this key,

@@ -100,7 +100,7 @@ impl Renderer {
         let name = match &backend {
             Backend::Cpu(_) => format!("cpu (rayon, {} threads)", rayon::current_num_threads()),
             Backend::Gpu(g) => g.adapter_name().to_string(),
-            Backend::Shared(_) => unreachable!("Renderer::shared names itself"),
+            Backend::Shared(_) => "shared GPU (batched)".to_string(),
         };
         Ok(Self {
             backend,
