@@ -23,11 +23,15 @@ enum Message {
     Join,
     Leave,
     Frame(Box<Pending>),
+    Stop,
 }
 
-/// The thread that owns the GPU and traces the batches.
+/// The thread that owns the GPU and traces the batches. Dropping it stops the thread and waits
+/// for it, so that the GPU device is released before the process exits (a Vulkan driver torn
+/// down by the process's exit while another thread still destroys its device can crash).
 pub struct BatchServer {
     handle: BatchHandle,
+    thread: Option<std::thread::JoinHandle<()>>,
 }
 
 /// A way to reach a [`BatchServer`]: clone it into each run.
@@ -49,15 +53,25 @@ impl BatchServer {
     pub fn start(mut gpu: GpuRenderer, wait: Duration) -> Self {
         let (tx, rx) = channel();
         let name = format!("{} (batched)", gpu.adapter_name());
-        std::thread::spawn(move || serve(&mut gpu, &rx, wait));
+        let thread = std::thread::spawn(move || serve(&mut gpu, &rx, wait));
         Self {
             handle: BatchHandle { tx, name },
+            thread: Some(thread),
         }
     }
 
     /// A handle for a run.
     pub fn handle(&self) -> BatchHandle {
         self.handle.clone()
+    }
+}
+
+impl Drop for BatchServer {
+    fn drop(&mut self) {
+        let _ = self.handle.tx.send(Message::Stop);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
     }
 }
 
@@ -110,7 +124,8 @@ impl Drop for BatchClient {
     }
 }
 
-/// The server's loop: gather, trace, reply; ends when every handle and client is gone.
+/// The server's loop: gather, trace, reply; ends on `Stop` or when every handle and client is
+/// gone.
 fn serve(gpu: &mut GpuRenderer, rx: &Receiver<Message>, wait: Duration) {
     let mut active = 0usize;
     let mut pending: Vec<Pending> = Vec::new();
@@ -142,6 +157,10 @@ fn serve(gpu: &mut GpuRenderer, rx: &Receiver<Message>, wait: Duration) {
                     deadline = Instant::now() + wait;
                 }
                 pending.push(*f);
+            }
+            Message::Stop => {
+                flush(gpu, &mut pending);
+                return;
             }
         }
         if !pending.is_empty() && pending.len() >= active.max(1) {
