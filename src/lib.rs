@@ -19,6 +19,7 @@ pub mod odometry;
 pub mod output;
 pub mod pilot;
 pub mod record;
+pub mod runner;
 pub mod scenario;
 pub mod score;
 pub mod simulation;
@@ -28,8 +29,18 @@ pub mod validate;
 
 pub use load::{LoadError, Problem, load_scenario, parse_scenario};
 pub use record::{Summary, TrajectoryRow};
+pub use runner::Runner;
 pub use scenario::Scenario;
 pub use simulation::{RunOptions, RunOutput, Simulation, run_scenario};
+
+/// Motion models and the avoidance controllers.
+pub use omniloop_control as control;
+/// The robot's side of the boundary: the [`robot::RobotSoftware`] trait, what it receives and
+/// returns, and the built-in stack.
+pub use omniloop_robot as robot;
+/// Image processing: calibration tables, free space, self-localization and the papers' other
+/// estimators (it takes images, never a world).
+pub use omniloop_vision as vision;
 
 /// A complete, commented scenario showing every key with its default.
 pub const DEFAULT_SCENARIO: &str = include_str!("default_scenario.toml");

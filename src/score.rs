@@ -72,11 +72,16 @@ impl TruthScore {
         })
     }
 
-    /// After a cycle in which the robot headed for target `heading_for`, ending at `p` at time
-    /// `t_s`: the target counts as reached when the robot centre is within the tolerance of it.
-    /// Reaching the last target (the goal) sets the time to goal.
+    /// After a cycle in which the robot headed for target `heading_for` (when its software
+    /// does not say, the first target not reached yet), ending at `p` at time `t_s`: the target
+    /// counts as reached when the robot centre is within the tolerance of it. Reaching the last
+    /// target (the goal) sets the time to goal.
     pub fn targets(&mut self, p: Point2<f64>, heading_for: Option<usize>, t_s: f64) {
-        let Some(i) = heading_for.filter(|&i| i < self.targets.len()) else {
+        let next = || self.reached.iter().position(|r| !r);
+        let Some(i) = heading_for
+            .or_else(next)
+            .filter(|&i| i < self.targets.len())
+        else {
             return;
         };
         if (p - self.targets[i]).norm() <= self.tolerance_mm {

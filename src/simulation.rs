@@ -13,7 +13,10 @@ use crate::scenario::Scenario;
 use crate::score::TruthScore;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
-use omniloop_robot::{ControllerKind, Estimates, Observation, Robot, RobotError};
+use omniloop_robot::{
+    ControllerKind, Estimates, FixOutcome, Observation, Robot, RobotConfig, RobotError,
+    RobotSoftware,
+};
 use omniloop_sim::render::BatchHandle;
 use omniloop_sim::{RenderError, Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
 use omniloop_vision::resection::ColumnCalibration;
@@ -131,7 +134,7 @@ pub struct Simulation {
     cameras: Option<Cameras>,
     calibrations: Vec<RadialCalibration>,
     odometry: WheelOdometry,
-    robot: Robot,
+    robot: Box<dyn RobotSoftware>,
     pilot: Option<Pilot>,
     others: Vec<Pilot>,
     truth: TruthScore,
@@ -143,11 +146,23 @@ pub struct Simulation {
 }
 
 impl Simulation {
-    /// Builds the world, the robot's software and the cameras of a validated scenario.
+    /// Builds the world, the built-in robot software and the cameras of a validated scenario.
     /// `notice` receives one-line messages for the user (e.g. the renderer's choice).
     pub fn new(
         scenario: &Scenario,
         options: &RunOptions,
+        notice: impl FnOnce(&str),
+    ) -> Result<Self, RunError> {
+        Self::with_software(scenario, options, builtin_software, notice)
+    }
+
+    /// Builds the world and the cameras of a validated scenario, with the robot's software
+    /// that `software` builds from what the robot is told ([`RobotConfig`]: its start, body,
+    /// cameras and their calibrations, goal, map; never the world).
+    pub fn with_software(
+        scenario: &Scenario,
+        options: &RunOptions,
+        software: impl FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
         notice: impl FnOnce(&str),
     ) -> Result<Self, RunError> {
         let world = World::new(
@@ -156,7 +171,7 @@ impl Simulation {
             scenario.run.physics_step_s,
         )?;
         let calibrations = calibrations(scenario)?;
-        let robot = Robot::new(&scenario.robot_config(calibrations.clone(), columns(scenario)?))?;
+        let robot = software(&scenario.robot_config(calibrations.clone(), columns(scenario)?))?;
         let r = &scenario.robot;
         let pilot = match (&scenario.goal, scenario.control.kind) {
             (Some(g), ControllerKind::GoToGoalTruth) => Some(Pilot::new(
@@ -182,7 +197,7 @@ impl Simulation {
         }
         let cameras = Cameras::open(
             scenario,
-            robot.cameras(),
+            &robot.cameras(),
             options.save_frames_every.is_some() || scenario.experiment_takes_frames(),
             options.renderer,
             options.shared_gpu.as_ref(),
@@ -217,8 +232,8 @@ impl Simulation {
     }
 
     /// The robot's software.
-    pub fn robot_mut(&mut self) -> &mut Robot {
-        &mut self.robot
+    pub fn robot_mut(&mut self) -> &mut dyn RobotSoftware {
+        self.robot.as_mut()
     }
 
     /// Control cycles run so far.
@@ -405,11 +420,10 @@ impl Simulation {
             ));
         }
         let stats = self.world.stats(0);
-        let localizes = self.robot.stages().contains(&"floor_localization");
         let summary = Summary {
             scenario: self.scenario.name.clone(),
             seed: self.scenario.seed,
-            controller: self.scenario.control.kind.name().to_string(),
+            controller: self.robot.name(),
             cycles: self.cycle,
             sim_time_s: self.world.time_s(),
             wall_time_s,
@@ -425,7 +439,7 @@ impl Simulation {
             freespace_error_mm: self.truth.freespace_error_mm(),
             pose_error_mm: self.truth.pose_error_mm(),
             targets_reached: self.truth.targets_reached(),
-            localization_fixes: localizes.then(|| self.robot.fixes().0),
+            localization_fixes: localization_fixes(&self.estimates),
             checkpoint_heading_error_deg: self.truth.checkpoint_heading_errors_deg(),
             experiment: serde_json::Map::new(),
         };
@@ -439,6 +453,27 @@ impl Simulation {
     }
 }
 
+/// The built-in robot software of a configuration.
+pub fn builtin_software(config: &RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError> {
+    Ok(Box::new(Robot::new(config)?))
+}
+
+/// The fixes the estimator used (set or pulled its estimate by), when the robot localizes on
+/// the floor region (its `floor_localization` stage reported a fix or why it found none).
+fn localization_fixes(records: &[Estimates]) -> Option<usize> {
+    const STAGE: &str = "floor_localization";
+    let localizes = records.iter().any(|e| {
+        e.fixes.iter().any(|f| f.source == STAGE) || e.not_found.iter().any(|n| n.source == STAGE)
+    });
+    let used = |e: &Estimates| {
+        e.fixes
+            .iter()
+            .filter(|f| matches!(f.outcome, FixOutcome::Anchored | FixOutcome::Used))
+            .count()
+    };
+    localizes.then(|| records.iter().map(used).sum())
+}
+
 /// Runs a validated scenario to its end by its experiment's procedure (driving to the goal
 /// when it names none), calling `progress(cycle, total)` along the way. The summary's
 /// `wall_time_s` covers the whole run, set-up included (calibration, opening the renderer);
@@ -446,6 +481,17 @@ impl Simulation {
 pub fn run_scenario(
     scenario: &Scenario,
     options: &RunOptions,
+    notice: impl FnOnce(&str),
+    progress: impl FnMut(u64, u64),
+) -> Result<RunOutput, RunError> {
+    run_scenario_with(scenario, options, builtin_software, notice, progress)
+}
+
+/// [`run_scenario`] with the robot's software that `software` builds.
+pub fn run_scenario_with(
+    scenario: &Scenario,
+    options: &RunOptions,
+    software: impl FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
     notice: impl FnOnce(&str),
     mut progress: impl FnMut(u64, u64),
 ) -> Result<RunOutput, RunError> {
@@ -456,7 +502,7 @@ pub fn run_scenario(
             source: image::ImageError::IoError(e),
         })?;
     }
-    let mut sim = Simulation::new(scenario, options, notice)?;
+    let mut sim = Simulation::with_software(scenario, options, software, notice)?;
     let mut experiment = experiments::procedure(scenario);
     let loop_start = Instant::now();
     experiment.run(&mut sim, &mut progress)?;

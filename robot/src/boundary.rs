@@ -75,6 +75,22 @@ impl<'a> Observation<'a> {
     pub fn frame(&self, sensor: &str) -> Option<&Frame<'a>> {
         self.frames.iter().find(|f| f.sensor == sensor)
     }
+
+    /// The image of the camera called `sensor`, or the error naming who needed it (`reader`).
+    pub fn image(
+        &self,
+        sensor: &str,
+        reader: &'static str,
+    ) -> Result<&'a RgbaImage, crate::RobotError> {
+        self.frames
+            .iter()
+            .find(|f| f.sensor == sensor)
+            .map(|f| f.image)
+            .ok_or_else(|| crate::RobotError::MissingFrame {
+                sensor: sensor.to_string(),
+                stage: reader,
+            })
+    }
 }
 
 /// A velocity command in the robot's body frame (x forward, y left).
@@ -111,4 +127,60 @@ pub struct Outputs {
     pub actuators: Vec<ActuatorCommand>,
     /// What the robot believes after this cycle.
     pub estimates: Estimates,
+}
+
+impl Outputs {
+    /// A drive command and the beliefs behind it, no actuator commands.
+    pub fn drive(command: BodyCommand, estimates: Estimates) -> Self {
+        Self {
+            command,
+            actuators: Vec::new(),
+            estimates,
+        }
+    }
+}
+
+/// The robot's software: whatever turns what the robot's sensors give into commands.
+///
+/// The simulator calls it once a control cycle, in this order: [`cameras_now`] (which frames
+/// to render), [`cycle`] with the [`Observation`] of those frames and the actuators' state,
+/// then, once the world has moved on one period, [`odometry`] with the wheel encoders'
+/// reading. Nothing else reaches it: no world, no true pose. The built-in stack
+/// ([`crate::Robot`]) is one implementation; a user's crate, a Python object or a learning
+/// agent are others.
+///
+/// [`cameras_now`]: RobotSoftware::cameras_now
+/// [`cycle`]: RobotSoftware::cycle
+/// [`odometry`]: RobotSoftware::odometry
+pub trait RobotSoftware: Send {
+    /// Its name in `summary.json` (`controller`); default: `custom`.
+    fn name(&self) -> String {
+        "custom".to_string()
+    }
+
+    /// Every camera (`[[robot.sensors]] name`) it may read: the simulator renders only these.
+    fn cameras(&self) -> Vec<String>;
+
+    /// The cameras whose frames it reads in the coming cycle (default: all of
+    /// [`RobotSoftware::cameras`]); a camera left out gives no frame and draws no noise.
+    fn cameras_now(&self) -> Vec<String> {
+        self.cameras()
+    }
+
+    /// One control cycle: from what the sensors give to a body-frame command, actuator
+    /// commands and what it believes (recorded beside the truth, never scored by it here).
+    fn cycle(&mut self, obs: &Observation<'_>) -> Result<Outputs, crate::RobotError>;
+
+    /// What the wheel encoders measured over the period that just ended.
+    fn odometry(&mut self, reading: &OdometryReading);
+
+    /// The robot was carried to a place it is not told (an experimenter moving it): its pose
+    /// is unknown until it finds it again. Default: nothing to forget.
+    fn forget_pose(&mut self) {}
+
+    /// Its pose estimate now (world frame), recorded in the final row of `trajectory.csv`;
+    /// default: none.
+    fn estimate(&self) -> Option<nalgebra::Isometry2<f64>> {
+        None
+    }
 }

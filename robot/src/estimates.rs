@@ -149,6 +149,14 @@ pub struct Estimates {
 }
 
 impl Estimates {
+    /// An empty record of the cycle at `t_s`, for the software to fill in.
+    pub fn at(t_s: f64) -> Self {
+        Self {
+            t_s,
+            ..Self::default()
+        }
+    }
+
     /// The first full-pose fix of the cycle from stage `source`, with what became of it.
     pub fn pose_fix(&self, source: &str) -> Option<&Fix> {
         self.fixes

@@ -1,6 +1,7 @@
 //! omniloop-robot: the robot's software, behind the boundary a real robot has.
 //!
-//! Each control cycle the [`Robot`] receives what its own sensors give and nothing else
+//! The robot's software is anything that implements [`RobotSoftware`]; [`Robot`], the
+//! built-in stack, is one. Each control cycle it receives what its own sensors give and nothing else
 //! ([`Observation`]: camera frames by sensor name with their time, the state of its actuators;
 //! [`OdometryReading`]: what the wheel encoders measured over the last period), and returns a
 //! body-frame velocity command, actuator commands and what it believes ([`Outputs`],
@@ -29,6 +30,7 @@ pub mod wander;
 
 pub use boundary::{
     ActuatorCommand, ActuatorState, BodyCommand, Frame, Observation, OdometryReading, Outputs,
+    RobotSoftware,
 };
 pub use config::{
     BodySpec, ControlSpec, ControllerKind, ForwardDriveConfig, ForwardVisionConfig, GoalSpec,
@@ -55,6 +57,9 @@ pub enum RobotError {
     /// The configuration names a sensor or calibration the robot does not have.
     #[error("{0}")]
     Config(String),
+    /// A user's robot software failed, and why.
+    #[error("{0}")]
+    Software(Box<dyn std::error::Error + Send + Sync>),
     /// A stage needs a camera frame that the cycle did not bring.
     #[error("no frame from sensor {sensor:?} this cycle (stage {stage})")]
     MissingFrame {

@@ -1,7 +1,7 @@
 //! The robot's software: perception stages, estimator, mission and controller in one cycle.
 
 use crate::RobotError;
-use crate::boundary::{Observation, OdometryReading, Outputs};
+use crate::boundary::{Observation, OdometryReading, Outputs, RobotSoftware};
 use crate::config::RobotConfig;
 use crate::controller::{self, Controller, Situation};
 use crate::estimates::{Estimates, Fix};
@@ -17,6 +17,7 @@ pub struct Robot {
     controller: Box<dyn Controller>,
     mission: Option<Mission>,
     cameras: Vec<String>,
+    controller_name: String,
 }
 
 impl Robot {
@@ -40,17 +41,35 @@ impl Robot {
             mission: config.goal.as_ref().map(Mission::new),
             stages,
             cameras,
+            controller_name: config.control.kind.name().to_string(),
         })
     }
 
+    /// The names of the perception stages, in the order they run.
+    pub fn stages(&self) -> Vec<&'static str> {
+        self.stages.iter().map(|s| s.name()).collect()
+    }
+
+    /// Fixes used and rejected so far.
+    pub fn fixes(&self) -> (usize, usize) {
+        self.estimator.fixes()
+    }
+}
+
+impl RobotSoftware for Robot {
+    /// The controller's name.
+    fn name(&self) -> String {
+        self.controller_name.clone()
+    }
+
     /// The cameras whose frames the stack reads each cycle.
-    pub fn cameras(&self) -> &[String] {
-        &self.cameras
+    fn cameras(&self) -> Vec<String> {
+        self.cameras.clone()
     }
 
     /// The cameras whose frames the stack reads this cycle (a stage that is not looking, e.g.
     /// while the robot drives to another observation point, needs none).
-    pub fn cameras_now(&self) -> Vec<String> {
+    fn cameras_now(&self) -> Vec<String> {
         let mut out: Vec<String> = Vec::new();
         for c in self
             .stages
@@ -65,18 +84,13 @@ impl Robot {
         out
     }
 
-    /// The names of the perception stages, in the order they run.
-    pub fn stages(&self) -> Vec<&'static str> {
-        self.stages.iter().map(|s| s.name()).collect()
-    }
-
     /// Takes a wheel odometry reading.
-    pub fn odometry(&mut self, reading: &OdometryReading) {
+    fn odometry(&mut self, reading: &OdometryReading) {
         self.estimator.odometry(reading);
     }
 
     /// The robot was carried to a place it is not told: its pose is unknown until a fix.
-    pub fn forget_pose(&mut self) {
+    fn forget_pose(&mut self) {
         self.estimator.forget();
         for stage in &mut self.stages {
             stage.carried();
@@ -84,17 +98,12 @@ impl Robot {
     }
 
     /// The current pose estimate (world frame).
-    pub fn estimate(&self) -> Option<Isometry2<f64>> {
+    fn estimate(&self) -> Option<Isometry2<f64>> {
         self.estimator.estimate()
     }
 
-    /// Fixes used and rejected so far.
-    pub fn fixes(&self) -> (usize, usize) {
-        self.estimator.fixes()
-    }
-
     /// One control cycle: perceive, fuse, judge the mission on the estimate, decide.
-    pub fn cycle(&mut self, obs: &Observation<'_>) -> Result<Outputs, RobotError> {
+    fn cycle(&mut self, obs: &Observation<'_>) -> Result<Outputs, RobotError> {
         let belief = Belief {
             pose: self.estimator.estimate(),
             fixed: self.estimator.has_fix(),

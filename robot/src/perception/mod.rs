@@ -194,10 +194,5 @@ fn image<'a>(
     sensor: &str,
     stage: &'static str,
 ) -> Result<&'a RgbaImage, RobotError> {
-    obs.frame(sensor)
-        .map(|f| f.image)
-        .ok_or_else(|| RobotError::MissingFrame {
-            sensor: sensor.to_string(),
-            stage,
-        })
+    obs.image(sensor, stage)
 }
