@@ -1,5 +1,5 @@
 //! The simulator's own pilot: drives a robot through waypoints on its *true* pose. It moves the
-//! other robots (moving obstacles) and, with `control.kind = "go_to_goal_truth"`, the robot under
+//! other robots (moving obstacles) and, with `run.pilot = "truth"`, the robot under
 //! test as a reference that needs no vision. It is not the robot's software and never runs in
 //! it.
 

@@ -7,9 +7,10 @@ use crate::experiments::ExperimentSpec;
 use crate::odometry::OdometrySpec;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::DifferentialDrive;
+use omniloop_robot::perception::CameraNeed;
 use omniloop_robot::{
-    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StereoRig,
-    VisionSpec, WorldMap,
+    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StageEntry,
+    StereoRig, VisionSpec, WorldMap, stages_of,
 };
 use omniloop_sim::{Layout, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
@@ -75,6 +76,21 @@ pub struct RunSpec {
     pub physics_step_s: f64,
     /// End the run as soon as the goal is reached.
     pub stop_at_goal: bool,
+    /// Who drives the robot: its software (`"robot"`), or the simulator's pilot on the true
+    /// pose (`"truth"`, a reference that needs no vision: the software still runs and is
+    /// recorded, but its commands are not applied).
+    pub pilot: PilotChoice,
+}
+
+/// Who drives the robot under test (`run.pilot`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PilotChoice {
+    /// Its software.
+    #[default]
+    Robot,
+    /// The simulator, straight to the goal's targets on the true pose.
+    Truth,
 }
 
 impl Default for RunSpec {
@@ -84,6 +100,7 @@ impl Default for RunSpec {
             control_period_s: 0.04,
             physics_step_s: 0.002,
             stop_at_goal: true,
+            pilot: PilotChoice::Robot,
         }
     }
 }
@@ -477,29 +494,34 @@ impl Scenario {
         })
     }
 
-    /// Whether the robot's software resects from a pinhole camera's columns (which it
-    /// calibrates first).
-    pub fn needs_columns(&self) -> bool {
-        self.resects()
-            && self
-                .sensor(self.vision.sensor.as_deref())
-                .is_ok_and(|s| s.pinhole.is_some())
+    /// The perception stages the built-in software runs for this scenario (none when its
+    /// controller is unknown: validation says so).
+    pub fn stages(&self) -> Vec<&'static StageEntry> {
+        stages_of(&self.robot_config(Vec::new(), Vec::new())).unwrap_or_default()
     }
 
-    fn resects(&self) -> bool {
-        self.control.pose_source == omniloop_robot::PoseSource::Resection
+    /// Whether vision's camera is a pinhole.
+    fn vision_is_pinhole(&self) -> bool {
+        self.sensor(self.vision.sensor.as_deref())
+            .is_ok_and(|s| s.pinhole.is_some())
+    }
+
+    /// Whether the robot's software reads bearings from a pinhole camera's columns (which it
+    /// calibrates first).
+    pub fn needs_columns(&self) -> bool {
+        let pinhole_ok = |s: &&StageEntry| s.camera == CameraNeed::MirrorOrPinhole;
+        self.stages().iter().any(pinhole_ok) && self.vision_is_pinhole()
     }
 
     /// Whether the robot's software uses a mirror camera's image-to-floor map.
     pub fn needs_calibration(&self) -> bool {
-        (self.resects() && !self.needs_columns())
-            || self.control.kind.uses_freespace()
-            || self.control.pose_source == omniloop_robot::PoseSource::Localization
-            || self.experiment_takes_frames()
-            || self
-                .goal
-                .as_ref()
-                .is_some_and(|g| !g.checkpoints_mm.is_empty())
+        let pinhole = self.vision_is_pinhole();
+        let mirror = |s: &&StageEntry| match s.camera {
+            CameraNeed::Mirror | CameraNeed::MirrorFloor => true,
+            CameraNeed::MirrorOrPinhole => !pinhole,
+            CameraNeed::None | CameraNeed::Forward => false,
+        };
+        self.stages().iter().any(mirror) || self.experiment_takes_frames()
     }
 
     /// Whether the scenario's experiment takes camera frames itself.

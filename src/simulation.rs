@@ -9,13 +9,12 @@ use crate::experiments;
 use crate::odometry::WheelOdometry;
 use crate::pilot::Pilot;
 use crate::record::{Summary, TrajectoryRow};
-use crate::scenario::Scenario;
+use crate::scenario::{PilotChoice, Scenario};
 use crate::score::TruthScore;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
 use omniloop_robot::{
-    ControllerKind, Estimates, FixOutcome, Observation, Robot, RobotConfig, RobotError,
-    RobotSoftware,
+    Estimates, FixOutcome, Observation, Robot, RobotConfig, RobotError, RobotSoftware,
 };
 use omniloop_sim::render::BatchHandle;
 use omniloop_sim::{RenderError, Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
@@ -173,8 +172,8 @@ impl Simulation {
         let calibrations = calibrations(scenario)?;
         let robot = software(&scenario.robot_config(calibrations.clone(), columns(scenario)?))?;
         let r = &scenario.robot;
-        let pilot = match (&scenario.goal, scenario.control.kind) {
-            (Some(g), ControllerKind::GoToGoalTruth) => Some(Pilot::new(
+        let pilot = match (&scenario.goal, scenario.run.pilot) {
+            (Some(g), PilotChoice::Truth) => Some(Pilot::new(
                 g.targets(),
                 g.tolerance_mm,
                 false,
@@ -423,7 +422,10 @@ impl Simulation {
         let summary = Summary {
             scenario: self.scenario.name.clone(),
             seed: self.scenario.seed,
-            controller: self.robot.name(),
+            controller: match self.pilot {
+                Some(_) => "truth_pilot".to_string(),
+                None => self.robot.name(),
+            },
             cycles: self.cycle,
             sim_time_s: self.world.time_s(),
             wall_time_s,

@@ -1,9 +1,11 @@
 //! Validation of a parsed scenario: every rule a value must satisfy, checked once, each
 //! failure naming the dotted path of the field it concerns.
 
-use crate::scenario::{PoseSpec, Scenario};
+use crate::scenario::{PilotChoice, PoseSpec, Scenario};
 use nalgebra::Point2;
-use omniloop_robot::{ControllerKind, PoseSource};
+use omniloop_robot::controllers::{self, CONTROLLERS};
+use omniloop_robot::perception::{self, CameraNeed, STAGES};
+use omniloop_robot::{ConfigProblem, ControllerEntry, RobotConfig, StageEntry};
 use omniloop_sim::{Layout, SensorSpec};
 use std::fmt;
 
@@ -226,17 +228,6 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
     }
 
     let rb = &s.robot;
-    let forward = matches!(
-        s.control.kind,
-        ControllerKind::Segmentation | ControllerKind::OpticalFlow
-    ) || s.vision.forward.visual_odometry;
-    if forward && s.forward_camera().is_none() {
-        c.fail(
-            "vision.sensor",
-            "the forward camera's avoidance and visual odometry need vision's camera to be a \
-             pinhole ([robot.sensors.pinhole])",
-        );
-    }
     if let Some(d) = &rb.differential {
         c.positive("robot.differential.track_mm", d.track_mm);
         c.positive(
@@ -309,25 +300,7 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             );
         }
     }
-    check_vision_and_control(&mut c, s);
-    if !matches!(
-        s.control.kind,
-        ControllerKind::Idle
-            | ControllerKind::Wander
-            | ControllerKind::Observe
-            | ControllerKind::Segmentation
-            | ControllerKind::OpticalFlow
-            | ControllerKind::Script
-    ) && s.goal.is_none()
-    {
-        c.fail(
-            "control.kind",
-            format!(
-                "controller {:?} needs a [goal] table",
-                s.control.kind.name()
-            ),
-        );
-    }
+    check_software(&mut c, s);
     if let Some(g) = &s.goal {
         for (k, wp) in g.waypoints_mm.iter().enumerate() {
             if !in_floor(w, Point2::new(wp[0], wp[1])) {
@@ -344,89 +317,24 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
     c.out
 }
 
-fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
-    let fs = &s.vision.freespace;
-    if fs.directions < 4 {
-        c.fail(
-            "vision.freespace.directions",
-            format!("must be >= 4 (got {})", fs.directions),
-        );
-    }
-    if fs.rings < 1 {
-        c.fail("vision.freespace.rings", "must be >= 1");
-    }
-    c.positive("vision.freespace.inner_mm", fs.inner_mm);
-    if fs.outer_mm.is_nan() || fs.outer_mm <= fs.inner_mm {
-        c.fail(
-            "vision.freespace.outer_mm",
-            format!(
-                "must exceed inner_mm = {} (got {})",
-                fs.inner_mm, fs.outer_mm
-            ),
-        );
-    }
-    if fs.r_th.is_nan() || fs.r_th <= 0.0 || fs.r_th > 1.0 {
-        c.fail(
-            "vision.freespace.r_th",
-            format!("must lie in (0, 1] (got {})", fs.r_th),
-        );
-    }
-    if !fs.ring_edges_mm.is_empty() && !fs.ring_edges_px.is_empty() {
-        c.fail(
-            "vision.freespace.ring_edges_px",
-            "give ring_edges_mm or ring_edges_px, not both",
-        );
-    }
-    for (key, edges) in [
-        ("ring_edges_mm", &fs.ring_edges_mm),
-        ("ring_edges_px", &fs.ring_edges_px),
-    ] {
-        if !edges.is_empty() && edges.len() != fs.rings + 1 {
-            c.fail(
-                format!("vision.freespace.{key}"),
-                format!(
-                    "needs rings + 1 = {} values (got {})",
-                    fs.rings + 1,
-                    edges.len()
-                ),
-            );
+impl Checker {
+    fn problems(&mut self, list: Vec<ConfigProblem>) {
+        for p in list {
+            let dup = self
+                .out
+                .iter()
+                .any(|v| v.path.to_string() == p.field && v.message == p.message);
+            if !dup {
+                self.fail(p.field, p.message);
+            }
         }
     }
-    for k in 0..3 {
-        if fs.floor.rgb_min[k] > fs.floor.rgb_max[k] {
-            c.fail(
-                "vision.freespace.floor.rgb_min",
-                format!(
-                    "channel {k}: {} exceeds rgb_max {}",
-                    fs.floor.rgb_min[k], fs.floor.rgb_max[k]
-                ),
-            );
-        }
-    }
-    let a = &s.control.avoidance;
-    if !(a.margin_mm.is_finite() && a.margin_mm >= 0.0) {
-        c.fail(
-            "control.avoidance.margin_mm",
-            format!("must be >= 0 (got {})", a.margin_mm),
-        );
-    }
-    c.positive("control.avoidance.free_distance_mm", a.free_distance_mm);
-    c.positive("control.avoidance.prediction_step_s", a.prediction_step_s);
-    if a.candidates < 4 {
-        c.fail(
-            "control.avoidance.candidates",
-            format!("must be >= 4 (got {})", a.candidates),
-        );
-    }
-    if !(a.extra_horizon_s.is_finite() && a.extra_horizon_s >= 0.0) {
-        c.fail(
-            "control.avoidance.extra_horizon_s",
-            format!("must be >= 0 (got {})", a.extra_horizon_s),
-        );
-    }
-    check_localization(c, s);
-    check_omnistereo(c, s);
-    check_resection(c, s);
+}
+
+/// The robot's software: its controller and pose source by their registered names, their
+/// tables, the stages they run and what those need of the robot (checked by their own code),
+/// the odometry's errors, and vision's camera.
+fn check_software(c: &mut Checker, s: &Scenario) {
     let o = &s.odometry;
     for (key, v) in [
         ("speed_noise_frac", o.speed_noise_frac),
@@ -443,23 +351,146 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
         );
     }
     c.finite("odometry.omega_bias_rad_s", o.omega_bias_rad_s);
-    if !s.needs_calibration() {
+    check_boards(c, s);
+    let g = s.control.localization_gain;
+    if g.is_nan() || !(0.0..=1.0).contains(&g) {
+        c.fail(
+            "control.localization_gain",
+            format!("must lie in [0, 1] (got {g})"),
+        );
+    }
+    if s.run.pilot == PilotChoice::Truth && s.goal.is_none() {
+        c.fail(
+            "run.pilot",
+            "the truth pilot drives to the goal: add a [goal] table",
+        );
+    }
+    let Some(controller) = controller(c, s) else {
+        return;
+    };
+    if !perception::is_pose_source(&s.control.pose_source) {
+        c.fail(
+            "control.pose_source",
+            format!(
+                "no pose source {:?} (there are: {})",
+                s.control.pose_source,
+                perception::pose_sources()
+            ),
+        );
         return;
     }
-    // Vision sees through a mirror sensor: its calibration and the template must work.
+    check_tables(c, s, controller);
+    let stages = s.stages();
+    check_world_for(c, s, &stages);
+    let Some(config) = software_config(c, s, &stages) else {
+        return;
+    };
+    c.problems((controller.check_use)(&config));
+    for stage in &stages {
+        c.problems((stage.check)(&config));
+    }
+}
+
+/// The registered controller `control.kind` names, or the problem.
+fn controller(c: &mut Checker, s: &Scenario) -> Option<&'static ControllerEntry> {
+    let kind = &s.control.kind;
+    let Some(entry) = controllers::find(kind) else {
+        let why = if kind == "go_to_goal_truth" {
+            "\"go_to_goal_truth\" is the simulator's pilot, not the robot's controller: write \
+             [run] pilot = \"truth\""
+                .to_string()
+        } else {
+            format!(
+                "no controller {kind:?} (there are: {})",
+                controllers::names()
+            )
+        };
+        c.fail("control.kind", why);
+        return None;
+    };
+    if entry.needs_goal && s.goal.is_none() {
+        c.fail(
+            "control.kind",
+            format!("controller {kind:?} needs a [goal] table"),
+        );
+    }
+    Some(entry)
+}
+
+/// Every table written under `[control]` belongs to a registered controller or stage, which
+/// checks it (a table controllers share is checked once; the chosen controller's always).
+fn check_tables(c: &mut Checker, s: &Scenario, chosen: &ControllerEntry) {
+    let spec = &s.control;
+    let mut checked: Vec<&str> = Vec::new();
+    for name in spec.tables.names() {
+        if let Some(owner) = CONTROLLERS.iter().find(|e| e.table == Some(name)) {
+            c.problems((owner.check_table)(spec));
+            checked.push(name);
+        } else if !STAGES.iter().any(|e| e.table == Some(name)) {
+            let mut known = vec!["kind", "pose_source", "localization_gain"];
+            let tables = CONTROLLERS.iter().filter_map(|e| e.table);
+            for t in tables.chain(STAGES.iter().filter_map(|e| e.table)) {
+                if !known.contains(&t) {
+                    known.push(t);
+                }
+            }
+            c.fail(
+                format!("control.{name}"),
+                format!(
+                    "unknown field `{name}`, expected one of {}",
+                    known.join(", ")
+                ),
+            );
+        }
+    }
+    if chosen.table.is_none_or(|t| !checked.contains(&t)) {
+        c.problems((chosen.check_table)(spec));
+    }
+}
+
+/// What the stages need of the world that the robot is not told (its map holds the rest).
+fn check_world_for(c: &mut Checker, s: &Scenario, stages: &[&'static StageEntry]) {
+    let runs = |name: &str| stages.iter().any(|e| e.name == name);
+    if runs("floor_localization") && s.world.field.is_none() {
+        c.fail(
+            "control.pose_source",
+            "self-localization matches the floor region to the field: add [world.field]",
+        );
+    }
+    if runs("omnistereo")
+        && let Err((field, why)) = s.stereo_rig()
+    {
+        c.fail(field, why);
+    }
+    if runs("resection") {
+        check_resection_camera(c, s);
+    }
+}
+
+/// The configuration the robot's software is built from, with vision's camera calibrated when
+/// a stage needs it, or `None` when the camera cannot serve (the problem recorded).
+fn software_config(
+    c: &mut Checker,
+    s: &Scenario,
+    stages: &[&'static StageEntry],
+) -> Option<RobotConfig> {
+    if !s.needs_calibration() {
+        return Some(s.robot_config(Vec::new(), Vec::new()));
+    }
+    // Vision sees through a mirror sensor: its calibration must work.
     let sensors = &s.robot.sensors;
     let index = match s.vision_sensor_index() {
         Ok(i) => i,
         Err(e) => {
             let field = if s.vision.sensor.is_some() {
                 "vision.sensor"
-            } else if s.control.kind.uses_freespace() {
+            } else if s.stages().iter().any(|e| e.pose_source.is_none()) {
                 "control.kind"
             } else {
                 "control.pose_source"
             };
             c.fail(field, format!("vision sees through a camera: {e}"));
-            return;
+            return None;
         }
     };
     if sensors[index].pinhole.is_some() || sensors[index].optics_present().len() != 1 {
@@ -470,26 +501,25 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
                 sensors[index].name
             ),
         );
-        return;
+        return None;
     }
     let cal = match &s.vision.calibration_file {
         Some(path) => match omniloop_vision::RadialCalibration::load(path) {
             Ok(cal) => cal,
             Err(e) => {
                 c.fail("vision.calibration_file", e.to_string());
-                return;
+                return None;
             }
         },
         None => match crate::calibrate::calibrate_sensor(&sensors[index]) {
             Ok(cal) => cal,
             Err(e) => {
                 c.fail(format!("robot.sensors[{index}]"), e.to_string());
-                return;
+                return None;
             }
         },
     };
-    let needs_floor = s.control.kind.uses_freespace()
-        || s.control.pose_source == omniloop_robot::PoseSource::Localization;
+    let needs_floor = stages.iter().any(|e| e.camera == CameraNeed::MirrorFloor);
     if needs_floor && let Err(e) = cal.validate() {
         c.fail(
             format!("robot.sensors[{index}]"),
@@ -499,121 +529,15 @@ fn check_vision_and_control(c: &mut Checker, s: &Scenario) {
                 sensors[index].name
             ),
         );
-        return;
+        return None;
     }
-    if !c.out.is_empty() || !s.control.kind.uses_freespace() {
-        return;
-    }
-    if let Err(e) = omniloop_vision::freespace::PolarTemplate::new(fs, &cal) {
-        c.fail("vision.freespace", e.to_string());
-    }
+    let mut cal = cal;
+    cal.sensor = sensors[index].name.clone();
+    Some(s.robot_config(vec![cal], Vec::new()))
 }
 
-fn check_localization(c: &mut Checker, s: &Scenario) {
-    let l = &s.vision.localization;
-    let f = &l.field;
-    c.positive("vision.localization.field.a1_mm", f.a1_mm);
-    if f.a2_mm.is_nan() || f.a2_mm <= f.a1_mm {
-        c.fail(
-            "vision.localization.field.a2_mm",
-            format!("must exceed a1_mm = {} (got {})", f.a1_mm, f.a2_mm),
-        );
-    }
-    c.positive(
-        "vision.localization.field.goal_half_width_mm",
-        f.goal_half_width_mm,
-    );
-    if f.b_mm.is_nan() || f.b_mm <= f.goal_half_width_mm {
-        c.fail(
-            "vision.localization.field.b_mm",
-            format!(
-                "must exceed goal_half_width_mm = {} (got {})",
-                f.goal_half_width_mm, f.b_mm
-            ),
-        );
-    }
-    for (key, class) in [("goal_pos_x", &l.goal_pos_x), ("goal_neg_x", &l.goal_neg_x)] {
-        for (sub, r) in [("r", class.r), ("g", class.g)] {
-            if !(0.0..=1.0).contains(&r[0]) || !(0.0..=1.0).contains(&r[1]) || r[0] > r[1] {
-                c.fail(
-                    format!("vision.localization.{key}.{sub}"),
-                    format!("must be [min, max] within 0..1 (got [{}, {}])", r[0], r[1]),
-                );
-            }
-        }
-    }
-    if l.max_radius_frac.is_nan() || l.max_radius_frac <= 0.0 || l.max_radius_frac > 1.0 {
-        c.fail(
-            "vision.localization.max_radius_frac",
-            format!("must lie in (0, 1] (got {})", l.max_radius_frac),
-        );
-    }
-    c.positive("vision.localization.gate_initial_mm", l.gate_initial_mm);
-    c.positive("vision.localization.gate_mm", l.gate_mm);
-    c.positive(
-        "vision.localization.offset_threshold_mm",
-        l.offset_threshold_mm,
-    );
-    c.positive(
-        "vision.localization.rotation_threshold_rad",
-        l.rotation_threshold_rad,
-    );
-    if l.max_iterations == 0 {
-        c.fail("vision.localization.max_iterations", "must be >= 1");
-    }
-    let g = s.control.localization_gain;
-    if g.is_nan() || !(0.0..=1.0).contains(&g) {
-        c.fail(
-            "control.localization_gain",
-            format!("must lie in [0, 1] (got {g})"),
-        );
-    }
-    if s.control.pose_source == PoseSource::Localization && s.world.field.is_none() {
-        c.fail(
-            "control.pose_source",
-            "self-localization matches the floor region to the field: add [world.field]",
-        );
-    }
-}
-
-/// The omnistereo rig (`pose_source = "omnistereo"`) and the wandering controller's map.
-fn check_omnistereo(c: &mut Checker, s: &Scenario) {
-    let w = &s.control.wander;
-    c.positive("control.wander.clearance_mm", w.clearance_mm);
-    c.positive("control.wander.turn_rate_deg_s", w.turn_rate_deg_s);
-    if w.max_extra_turn_deg.is_nan() || w.max_extra_turn_deg < 0.0 {
-        c.fail(
-            "control.wander.max_extra_turn_deg",
-            format!("must be >= 0 (got {})", w.max_extra_turn_deg),
-        );
-    }
-    let map = s.robot_map();
-    if s.control.kind == ControllerKind::Wander && map.segments.is_empty() {
-        c.fail(
-            "control.kind",
-            "\"wander\" drives on a map of the world's walls and pillars: the world has no walls",
-        );
-    }
-    if s.control.pose_source != PoseSource::Omnistereo {
-        return;
-    }
-    if let Err(e) = s.vision.omnistereo.validate() {
-        c.fail("vision.omnistereo", e.to_string());
-    }
-    if map.landmarks.is_empty() {
-        c.fail(
-            "control.pose_source",
-            "omnistereo trilateration needs landmarks: add [[world.pillars]] of distinct colours",
-        );
-    }
-    if let Err((field, why)) = s.stereo_rig() {
-        c.fail(field, why);
-    }
-}
-
-/// The named boards (the robot's striped marks) and, with `pose_source = "resection"`, the
-/// three marks, the camera and the search.
-fn check_resection(c: &mut Checker, s: &Scenario) {
+/// The named boards (the robot's striped marks) are named once and striped well.
+fn check_boards(c: &mut Checker, s: &Scenario) {
     let mut names: Vec<&str> = Vec::new();
     for (i, b) in s.world.boards.iter().enumerate() {
         let Some(name) = &b.name else { continue };
@@ -632,30 +556,10 @@ fn check_resection(c: &mut Checker, s: &Scenario) {
             );
         }
     }
-    if s.control.pose_source != PoseSource::Resection {
-        return;
-    }
-    if let Err(e) = s.vision.resection.validate() {
-        c.fail("vision.resection", e.to_string());
-    }
-    let r = &s.control.resection;
-    c.positive("control.resection.pan_rate_deg_s", r.pan_rate_deg_s);
-    c.positive("control.resection.move_mm", r.move_mm);
-    if !(r.central_fraction > 0.0 && r.central_fraction <= 1.0) {
-        c.fail(
-            "control.resection.central_fraction",
-            format!("must be in (0, 1] (got {})", r.central_fraction),
-        );
-    }
-    if names.len() != 3 {
-        c.fail(
-            "control.pose_source",
-            format!(
-                "resection needs exactly three marks: name three [[world.boards]] (found {})",
-                names.len()
-            ),
-        );
-    }
+}
+
+/// Resection reads bearings through vision's camera, level when it is a pinhole.
+fn check_resection_camera(c: &mut Checker, s: &Scenario) {
     match s.vision_sensor_index() {
         Err(e) => c.fail(
             "vision.sensor",

@@ -46,10 +46,9 @@ fn family(v_max: f64, alpha: f64) {
     for angle in ANGLES {
         for width in WIDTHS {
             let s = corner(angle, width, v_max, alpha);
-            assert_eq!(
-                s.control.avoidance.speed,
-                omniloop_control::SpeedChoice::Chosen
-            );
+            let avoidance: omniloop_control::AvoidanceConfig =
+                s.control.table("avoidance").unwrap();
+            assert_eq!(avoidance.speed, omniloop_control::SpeedChoice::Chosen);
             let m: Summary = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
             eprintln!(
                 "| {angle} | {width} | {v_max} | {alpha} | {} | {} | {} | {:.1} | {:.0} | {:.1} |",

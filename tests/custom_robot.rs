@@ -20,7 +20,12 @@ fn the_example_robot_reaches_the_e1_goal_without_contact_and_writes_its_run() {
     // The truth side scored what the robot reported: its free space and its dead reckoning.
     assert!(s.freespace_error_mm.is_some_and(|e| e < 40.0), "{s:?}");
     assert!(s.pose_error_mm.is_some_and(|e| e < 20.0), "{s:?}");
-    for file in ["summary.json", "trajectory.csv", "estimates.jsonl", "topview.png"] {
+    for file in [
+        "summary.json",
+        "trajectory.csv",
+        "estimates.jsonl",
+        "topview.png",
+    ] {
         assert!(out.join(file).is_file(), "{file} missing");
     }
 }

@@ -101,6 +101,47 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             ),
             ":14:1: field `experiment.localization_map.spacing_mm`: must be a finite number >= 20",
         ),
+        // Controllers, pose sources and their tables are registered: names are looked up, and
+        // each table is parsed and checked by its owner, naming the field.
+        (
+            "unknown_controller",
+            format!("{BASE}\n[control]\nkind = \"velocity_awre\"\n"),
+            ":11:1: field `control.kind`: no controller \"velocity_awre\" (there are: idle, \
+             goal_direction, velocity_aware,",
+        ),
+        (
+            "truth_is_a_pilot",
+            format!("{BASE}\n[control]\nkind = \"go_to_goal_truth\"\n"),
+            ":11:1: field `control.kind`: \"go_to_goal_truth\" is the simulator's pilot",
+        ),
+        (
+            "unknown_pose_source",
+            format!("{BASE}\n[control]\npose_source = \"gps\"\n"),
+            ":11:1: field `control.pose_source`: no pose source \"gps\" (there are: odometry,",
+        ),
+        (
+            "avoidance_margin",
+            format!(
+                "{BASE}\n[control]\nkind = \"velocity_aware\"\n[control.avoidance]\nmargin_mm = -5.0\n"
+            ),
+            ":13:1: field `control.avoidance.margin_mm`: must be >= 0 (got -5)",
+        ),
+        (
+            "wander_type",
+            format!("{BASE}\n[control.wander]\nclearance_mm = \"wide\"\n"),
+            ":11:1: field `control.wander.clearance_mm`: invalid type: string \"wide\"",
+        ),
+        (
+            "script_unknown_key",
+            format!("{BASE}\n[control.script]\nspeed = 3.0\n"),
+            ":11:1: field `control.script.speed`: unknown field `speed`",
+        ),
+        (
+            "unknown_control_table",
+            format!("{BASE}\n[control.avodance]\nmargin_mm = 1.0\n"),
+            ":10:10: field `control.avodance`: unknown field `avodance`, expected one of kind, \
+             pose_source, localization_gain, avoidance, wander, forward, script, resection",
+        ),
     ];
     for (name, text, expected) in cases {
         let (code, err) = broken(name, &text);
@@ -175,7 +216,7 @@ fn same_scenario_and_seed_give_byte_identical_trajectories() {
 
 #[test]
 fn a_robot_commanded_into_a_wall_at_2000_mm_s_stays_outside_and_the_contact_is_counted() {
-    let text = "[run]\nduration_s = 3.0\n\n[world]\n[[world.walls]]\nfrom_mm = [600.0, -500.0]\nto_mm = [600.0, 500.0]\n\n[robot]\nstart = { x_mm = 0.0, y_mm = 0.0 }\nmax_speed_mm_s = 2000.0\naccel_limit_mm_s2 = 20000.0\n\n[goal]\nx_mm = 900.0\ny_mm = 0.0\n\n[control]\nkind = \"go_to_goal_truth\"\n";
+    let text = "[run]\nduration_s = 3.0\npilot = \"truth\"\n\n[world]\n[[world.walls]]\nfrom_mm = [600.0, -500.0]\nto_mm = [600.0, 500.0]\n\n[robot]\nstart = { x_mm = 0.0, y_mm = 0.0 }\nmax_speed_mm_s = 2000.0\naccel_limit_mm_s2 = 20000.0\n\n[goal]\nx_mm = 900.0\ny_mm = 0.0\n";
     let s = match parse_scenario(text, Path::new("wall.toml"), "wall") {
         Ok(s) => s,
         Err(LoadError::Invalid { problems }) => panic!("{problems:?}"),

@@ -52,7 +52,7 @@ fn on_patrol_the_checkpoint_keeps_the_heading_and_without_it_the_error_grows() {
     assert!(visits.len() >= 11, "{visits:?}");
     assert!(visits.iter().all(|&e| e <= 1.5), "{visits:?}");
     // The same patrol reading but not correcting: the error grows by the bias, lap by lap.
-    s.control.pose_source = omniloop_robot::PoseSource::Odometry;
+    s.control.pose_source = omniloop_robot::ODOMETRY.into();
     let without = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
     let drift = without.checkpoint_heading_error_deg.clone().unwrap();
     eprintln!("without: {drift:.2?}");

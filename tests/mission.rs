@@ -7,7 +7,6 @@ use common::{cpu, scenario};
 use nalgebra::{Point2, Vector2};
 use omniloop::odometry::OdometrySpec;
 use omniloop::run_scenario;
-use omniloop_robot::PoseSource;
 
 /// The odometry over-reads every distance by this fraction, and has no other error.
 const SCALE_BIAS: f64 = 0.15;
@@ -15,7 +14,7 @@ const SCALE_BIAS: f64 = 0.15;
 #[test]
 fn on_biased_odometry_the_robot_turns_where_its_estimate_says_the_waypoint_is() {
     let mut s = scenario("field_waypoints.toml");
-    s.control.pose_source = PoseSource::Odometry;
+    s.control.pose_source = omniloop_robot::ODOMETRY.into();
     s.odometry = OdometrySpec {
         speed_noise_frac: 0.0,
         omega_noise_rad_s: 0.0,

@@ -11,7 +11,6 @@ use omniloop::experiments::places::{place_results, places_table};
 use omniloop::record::Summary;
 use omniloop::run_scenario;
 use omniloop::scenario::PoseSpec;
-use omniloop_robot::PoseSource;
 use omniloop_vision::LocalizationMethod;
 
 /// Runs E2's scenario with `method` at `places` (all six of E2 when `None`) and checks every
@@ -104,7 +103,7 @@ fn without_localization_the_same_run_drifts_several_times_further() {
     // truth, by several times what localization leaves.
     let mut s = scenario("field_waypoints.toml");
     let with = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
-    s.control.pose_source = PoseSource::Odometry;
+    s.control.pose_source = omniloop_robot::ODOMETRY.into();
     let without = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
     let (a, b) = (with.pose_error_mm.unwrap(), without.pose_error_mm.unwrap());
     eprintln!("median pose error: {a:.1} mm with localization, {b:.1} mm on odometry alone");

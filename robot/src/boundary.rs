@@ -116,6 +116,19 @@ impl BodyCommand {
             omega_rad_s: 0.0,
         }
     }
+
+    /// Straight ahead (along the body's x axis) at `speed_mm_s`.
+    pub fn forward(speed_mm_s: f64) -> Self {
+        Self::translate(Vector2::new(speed_mm_s, 0.0))
+    }
+
+    /// A turn on the spot at `rate_rad_s` (counter-clockwise positive).
+    pub fn turn(rate_rad_s: f64) -> Self {
+        Self {
+            v_mm_s: Vector2::zeros(),
+            omega_rad_s: rate_rad_s,
+        }
+    }
 }
 
 /// What the robot's software returns from a control cycle.

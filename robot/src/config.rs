@@ -1,244 +1,59 @@
 //! The robot's software configuration: the `[vision]`, `[control]` and `[goal]` tables of a
 //! scenario, plus what the robot knows of its own body, cameras and start.
 
+use crate::tables::{ConfigProblem, Tables};
 use nalgebra::{Isometry2, Point2};
-use omniloop_control::AvoidanceConfig;
 use omniloop_vision::forward::{FlowConfig, ForwardCamera, GroundConfig, OdometryConfig};
 use omniloop_vision::luminance_heading::LuminanceConfig;
 use omniloop_vision::omnistereo::OmnistereoConfig;
 use omniloop_vision::resection::{ColumnCalibration, ResectionConfig, StripePattern};
 use omniloop_vision::{FreeSpaceConfig, LocalizationConfig, RadialCalibration};
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
-/// Which controller chooses the robot's command.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum ControllerKind {
-    /// Stand still (the default: nothing drives unless the scenario says so).
-    #[default]
-    Idle,
-    /// Not the robot's software: the simulator drives the robot straight to its targets on the
-    /// true pose (a reference that needs no vision). The robot's own controller stays idle; its
-    /// perception and estimator still run and are recorded.
-    GoToGoalTruth,
-    /// Free direction closest to the goal direction, from the image (ref. [4] of the corner
-    /// paper).
-    GoalDirection,
-    /// Velocity-aware avoidance of Sect. 3.2 of the corner paper, from the image.
-    VelocityAware,
-    /// Random wandering on the map (E4, Spacek and Burbridge, Sect. 2.1): forward until the
-    /// map says a pillar or a wall is near, then a random turn left or right.
-    Wander,
-    /// Stand still while the cameras search, and drive to the observation points perception
-    /// asks for (E5's "change the observation point by making a move", Fig. 4).
-    Observe,
-    /// A forward camera's ground segmentation (Ahmed et al., Sect. 2.1.1): straight while the
-    /// ground ahead reaches far enough, else turn on the spot to the clearer side.
-    Segmentation,
-    /// A forward camera's Horn-Schunck flow balance (Ahmed et al., Sect. 2.1.2): straight
-    /// until the flow is strong, then turn away from the side with more.
-    OpticalFlow,
-    /// Drive a list of moves (straight runs and turns on the spot) on dead reckoning
-    /// (`[control.script]`).
-    Script,
-}
-
-impl ControllerKind {
-    /// Whether the controller needs the free-space detection.
-    pub fn uses_freespace(self) -> bool {
-        matches!(self, Self::GoalDirection | Self::VelocityAware)
-    }
-
-    /// The name as written in scenario files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Idle => "idle",
-            Self::GoToGoalTruth => "go_to_goal_truth",
-            Self::GoalDirection => "goal_direction",
-            Self::VelocityAware => "velocity_aware",
-            Self::Wander => "wander",
-            Self::Observe => "observe",
-            Self::Segmentation => "segmentation",
-            Self::OpticalFlow => "optical_flow",
-            Self::Script => "script",
-        }
-    }
-}
-
-/// Where the robot's pose estimate comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum PoseSource {
-    /// Dead reckoning from wheel odometry alone, from the start pose the robot is given.
-    #[default]
-    Odometry,
-    /// Odometry corrected by floor-region self-localization (Sect. 4 of the corner paper) in
-    /// every cycle that gives a fix.
-    Localization,
-    /// Odometry whose heading is corrected at the goal's checkpoints from the luminance circle
-    /// (Kim, Kim and Kwon).
-    Checkpoints,
-    /// Odometry corrected by trilateration from the conical omnistereo ranges to the map's
-    /// landmarks (Spacek and Burbridge), every cycle that gives a fix.
-    Omnistereo,
-    /// Resection from three striped marks (Ishikawa, Kikuchi and Kato): a panning search for
-    /// the marks while the pose is unknown, one fix when all three are found.
-    Resection,
-}
-
-/// How the robot chooses its velocity (`[control]`).
+/// How the robot chooses its velocity and where its pose estimate comes from (`[control]`).
+///
+/// `kind` names a registered controller ([`crate::controllers::CONTROLLERS`]); `pose_source`
+/// is `"odometry"` or names a perception stage that gives the estimator fixes
+/// ([`crate::perception::STAGES`]). The other tables of the section (`[control.avoidance]`,
+/// `[control.wander]`, ...) belong to the registered controllers and stages, which parse and
+/// check them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct ControlSpec {
-    /// The controller.
-    pub kind: ControllerKind,
-    /// Settings of the avoidance controllers.
-    pub avoidance: AvoidanceConfig,
-    /// Where the pose estimate comes from.
-    pub pose_source: PoseSource,
-    /// With `pose_source = "localization"` or `"omnistereo"`: how far each fix pulls the
-    /// dead-reckoned pose toward itself (0: odometry only, 1: jump to the measurement).
+    /// The controller, by its registered name.
+    pub kind: String,
+    /// Where the pose estimate comes from: `"odometry"` (dead reckoning alone), or the pose
+    /// source of a registered stage (`"localization"`, `"checkpoints"`, `"omnistereo"`,
+    /// `"resection"`).
+    pub pose_source: String,
+    /// With a pose source other than odometry: how far each fix pulls the dead-reckoned pose
+    /// toward itself (0: odometry only, 1: jump to the measurement).
     pub localization_gain: f64,
-    /// Settings of the wandering controller (`kind = "wander"`).
-    pub wander: WanderConfig,
-    /// The search for the marks (`pose_source = "resection"`).
-    pub resection: SearchConfig,
-    /// Speeds of the forward camera's avoidance (`kind = "segmentation"`, `"optical_flow"`).
-    pub forward: ForwardDriveConfig,
-    /// The moves of `kind = "script"`.
-    pub script: ScriptConfig,
+    /// The registered parts' own tables.
+    #[serde(flatten)]
+    pub tables: Tables,
 }
 
-/// How the forward camera's avoidance drives (`[control.forward]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ForwardDriveConfig {
-    /// Speed straight ahead, mm/s.
-    pub speed_mm_s: f64,
-    /// Rate of the turns on the spot, deg/s.
-    pub turn_rate_deg_s: f64,
-    /// Segmentation: once turning, go on until this many ground pixels more than needed lie
-    /// ahead (so the robot does not stop turning at the first clear column).
-    pub hysteresis_px: u32,
-    /// Optical flow: how long one turn away from the stronger flow lasts, s.
-    pub flow_turn_s: f64,
-    /// Optical flow: frames after a turn whose flow is not read (it is the turn's own).
-    pub flow_settle_frames: u32,
-}
-
-impl Default for ForwardDriveConfig {
-    fn default() -> Self {
-        Self {
-            speed_mm_s: 150.0,
-            turn_rate_deg_s: 60.0,
-            hysteresis_px: 6,
-            flow_turn_s: 0.75,
-            flow_settle_frames: 2,
-        }
-    }
-}
-
-/// One move of a script.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Move {
-    /// Straight ahead by this much (negative: back), mm: `{ forward_mm = 914.4 }`.
-    ForwardMm(f64),
-    /// Turn on the spot by this much (counter-clockwise positive), degrees:
-    /// `{ turn_deg = -90.0 }`.
-    TurnDeg(f64),
-}
-
-/// A scripted drive (`[control.script]`), judged on dead reckoning.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ScriptConfig {
-    /// The moves, in order.
-    pub moves: Vec<Move>,
-    /// Speed of the straight runs, mm/s.
-    pub speed_mm_s: f64,
-    /// Rate of the turns, deg/s.
-    pub turn_rate_deg_s: f64,
-    /// Standstill after each move, s.
-    pub pause_s: f64,
-}
-
-impl Default for ScriptConfig {
-    fn default() -> Self {
-        Self {
-            moves: Vec::new(),
-            speed_mm_s: 150.0,
-            turn_rate_deg_s: 45.0,
-            pause_s: 0.5,
-        }
-    }
-}
-
-/// How the robot searches for the three marks (`[control.resection]`, Fig. 4 of the resection
-/// paper).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SearchConfig {
-    /// Rate of the pan from right to left, deg/s (the pan unit clips it to its limit).
-    pub pan_rate_deg_s: f64,
-    /// Sightings count toward a mark's bearing when its centre is within this fraction of the
-    /// half-width of the image from the optical axis (ours: the calibration is best there).
-    pub central_fraction: f64,
-    /// Length of the move to another observation point when a mark was not found, mm.
-    pub move_mm: f64,
-    /// Moves before the robot gives up.
-    pub max_moves: u32,
-}
-
-impl Default for SearchConfig {
-    fn default() -> Self {
-        Self {
-            pan_rate_deg_s: 60.0,
-            central_fraction: 0.5,
-            move_mm: 300.0,
-            max_moves: 3,
-        }
-    }
-}
-
-/// How the wandering controller drives (`[control.wander]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct WanderConfig {
-    /// Gap the robot keeps between its body and the map's obstacles, mm (room for the error
-    /// of its estimate).
-    pub clearance_mm: f64,
-    /// Rate of the turns, deg/s.
-    pub turn_rate_deg_s: f64,
-    /// Once the way ahead is clear the robot turns on by a random angle up to this, degrees
-    /// (ours: without it a robot that stops turning at the first clear heading skims along
-    /// walls).
-    pub max_extra_turn_deg: f64,
-}
-
-impl Default for WanderConfig {
-    fn default() -> Self {
-        Self {
-            clearance_mm: 200.0,
-            turn_rate_deg_s: 90.0,
-            max_extra_turn_deg: 60.0,
-        }
-    }
-}
+/// The pose source of dead reckoning alone.
+pub const ODOMETRY: &str = "odometry";
 
 impl Default for ControlSpec {
     fn default() -> Self {
         Self {
-            kind: ControllerKind::default(),
-            avoidance: AvoidanceConfig::default(),
-            pose_source: PoseSource::Odometry,
+            kind: "idle".to_string(),
+            pose_source: ODOMETRY.to_string(),
             localization_gain: 0.3,
-            wander: WanderConfig::default(),
-            resection: SearchConfig::default(),
-            forward: ForwardDriveConfig::default(),
-            script: ScriptConfig::default(),
+            tables: Tables::default(),
         }
+    }
+}
+
+impl ControlSpec {
+    /// Table `name` of `[control]` as its owner's settings.
+    pub fn table<T: DeserializeOwned + Default>(&self, name: &str) -> Result<T, ConfigProblem> {
+        self.tables.parse("control", name)
     }
 }
 
@@ -470,37 +285,9 @@ impl RobotConfig {
         self.calibrations.iter().find(|c| c.sensor == sensor)
     }
 
-    /// Whether the robot runs the free-space stage.
-    pub fn detects_freespace(&self) -> bool {
-        self.control.kind.uses_freespace()
-    }
-
-    /// Whether the robot runs the omnistereo stage.
-    pub fn uses_omnistereo(&self) -> bool {
-        self.control.pose_source == PoseSource::Omnistereo
-    }
-
-    /// Whether the robot's forward camera runs: its avoidance or its visual odometry.
-    pub fn uses_forward_camera(&self) -> bool {
-        matches!(
-            self.control.kind,
-            ControllerKind::Segmentation | ControllerKind::OpticalFlow
-        ) || self.vision.forward.visual_odometry
-    }
-
-    /// Whether the robot runs the resection stage.
-    pub fn resects(&self) -> bool {
-        self.control.pose_source == PoseSource::Resection
-    }
-
     /// The column calibration of camera `sensor`.
     pub fn columns(&self, sensor: &str) -> Option<&ColumnCalibration> {
         self.columns.iter().find(|c| c.sensor == sensor)
-    }
-
-    /// Whether the robot runs floor-region self-localization.
-    pub fn localizes(&self) -> bool {
-        self.control.pose_source == PoseSource::Localization
     }
 
     /// The goal's checkpoints, where the robot reads its heading from the luminance circle.

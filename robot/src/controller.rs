@@ -1,16 +1,15 @@
-//! Controllers: from what the robot perceives and believes to a body-frame velocity command.
+//! What a controller is: from what the robot perceives and believes to a body-frame velocity
+//! command. The controllers themselves, one file each, are registered in
+//! [`crate::controllers`].
 
 use crate::RobotError;
 use crate::boundary::BodyCommand;
-use crate::config::{ControllerKind, RobotConfig};
+use crate::config::{ControlSpec, RobotConfig};
 use crate::estimates::GroundReading;
-use crate::forward_drive;
-use crate::near_field::{NearField, NearSpace};
-use crate::wander::Wander;
+use crate::near_field::NearSpace;
+use crate::tables::ConfigProblem;
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop_control::{
-    AccelLimitedDrive, GoalDirection, SpeedChoice, Surroundings, VelocityAware,
-};
+use omniloop_control::Surroundings;
 use omniloop_vision::FreeSpace;
 use omniloop_vision::forward::FlowBalance;
 
@@ -47,81 +46,70 @@ pub trait Controller: Send {
     }
 }
 
-/// The controller a configuration names.
-pub fn build(config: &RobotConfig) -> Result<Box<dyn Controller>, RobotError> {
-    let b = &config.body;
-    let drive = AccelLimitedDrive::new(b.accel_limit_mm_s2, b.angular_accel_limit_rad_s2)?;
-    let avoid = config.control.avoidance.clone();
-    Ok(match config.control.kind {
-        // The truth pilot is the simulator's; the robot's own controller stays idle.
-        ControllerKind::Idle | ControllerKind::GoToGoalTruth => Box::new(Idle),
-        ControllerKind::GoalDirection => Box::new(GoalDirection::new(
-            avoid,
-            drive,
-            b.max_speed_mm_s,
-            b.radius_mm,
-        )?),
-        ControllerKind::VelocityAware => Box::new(VelocityAwareStack {
-            near: (avoid.speed == SpeedChoice::Chosen).then(|| NearField::new(b.radius_mm)),
-            controller: VelocityAware::new(
-                avoid,
-                drive,
-                b.max_speed_mm_s,
-                b.radius_mm,
-                config.control_period_s,
-            )?,
-        }),
-        ControllerKind::Wander => Box::new(Wander::new(config)?),
-        ControllerKind::Segmentation => Box::new(forward_drive::Segmentation::new(config)),
-        ControllerKind::OpticalFlow => Box::new(forward_drive::FlowAvoidance::new(config)),
-        ControllerKind::Script => Box::new(forward_drive::Script::new(config)),
-        ControllerKind::Observe => Box::new(Observe {
-            max_speed_mm_s: b.max_speed_mm_s,
-            accel_limit_mm_s2: b.accel_limit_mm_s2,
-            period_s: config.control_period_s,
-        }),
-    })
+/// A controller as the registry lists it: a new controller is its own file with one of these
+/// and one line in [`crate::controllers::CONTROLLERS`].
+pub struct ControllerEntry {
+    /// Its name in scenario files (`control.kind`) and in `summary.json`.
+    pub name: &'static str,
+    /// What it does, in one line, with the paper and section it follows.
+    pub summary: &'static str,
+    /// Its own table under `[control]`, if it has settings (controllers alike may share one).
+    pub table: Option<&'static str>,
+    /// Whether it drives to the scenario's `[goal]`, which must then be given.
+    pub needs_goal: bool,
+    /// The perception stages it reads, by name ([`crate::perception::STAGES`]).
+    pub stages: &'static [&'static str],
+    /// Parses and checks its table, naming each field at fault.
+    pub check_table: fn(&ControlSpec) -> Vec<ConfigProblem>,
+    /// Checks what it needs of the robot (a camera, a map) when it is the robot's controller.
+    pub check_use: fn(&RobotConfig) -> Vec<ConfigProblem>,
+    /// Builds it for a robot.
+    pub build: fn(&RobotConfig) -> Result<Box<dyn Controller>, RobotError>,
 }
 
-/// Stands still, or drives straight to the observation point perception asks for, arriving at
-/// rest: the speed is the one from which the acceleration limit stops the robot over the
-/// distance left (less one period's travel), capped at the top speed.
-struct Observe {
-    max_speed_mm_s: f64,
-    accel_limit_mm_s2: f64,
-    period_s: f64,
+/// A check that finds nothing (for a controller without a table, or without needs).
+pub fn no_problems<T: ?Sized>(_: &T) -> Vec<ConfigProblem> {
+    Vec::new()
 }
 
-impl Controller for Observe {
-    fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        let Some(target) = s.observation_point else {
-            return BodyCommand::STOP;
-        };
-        let to = s.odometry_pose.inverse_transform_point(&target).coords;
-        let d = to.norm();
-        if d < 1.0 {
-            return BodyCommand::STOP;
+/// Parses table `name` of `[control]` and runs `check` on it; either's problems.
+pub fn check_table<T: serde::de::DeserializeOwned + Default>(
+    spec: &ControlSpec,
+    name: &str,
+    check: impl FnOnce(&T, &mut crate::tables::Problems),
+) -> Vec<ConfigProblem> {
+    match spec.table::<T>(name) {
+        Ok(t) => {
+            let mut p = crate::tables::Problems::under(&format!("control.{name}"));
+            check(&t, &mut p);
+            p.list
         }
-        let a = self.accel_limit_mm_s2;
-        let t = self.period_s;
-        // v with v t + v^2 / (2 a) = d: the robot can still stop in what is left after a cycle.
-        let v = (-a * t + ((a * t).powi(2) + 2.0 * a * d).sqrt()).min(self.max_speed_mm_s);
-        BodyCommand::translate(to * (v / d))
+        Err(e) => vec![e],
     }
 }
 
-/// Stands still.
-struct Idle;
+/// Parses table `name` of `[control]` as `T`: its problem, if it does not parse.
+pub fn parses<T: serde::de::DeserializeOwned + Default>(
+    spec: &ControlSpec,
+    name: &str,
+) -> Vec<ConfigProblem> {
+    spec.table::<T>(name).err().into_iter().collect()
+}
 
-impl Controller for Idle {
-    fn decide(&mut self, _: &Situation<'_>) -> BodyCommand {
-        BodyCommand::STOP
-    }
+/// The settings table `name` of a robot's `[control]`, as a build error when it does not parse.
+pub fn settings<T: serde::de::DeserializeOwned + Default>(
+    config: &RobotConfig,
+    name: &str,
+) -> Result<T, RobotError> {
+    config
+        .control
+        .table(name)
+        .map_err(|e| RobotError::Config(e.to_string()))
 }
 
 /// Runs `f` on the surroundings vision reported (with `near` as the surely free boundary, when
-/// given) and the target, or stops without either.
-fn with_surroundings(
+/// given, else the free space's own) and the target, or stops without either.
+pub fn with_surroundings(
     s: &Situation<'_>,
     near: Option<NearSpace>,
     f: impl FnOnce(&Surroundings<'_>, Vector2<f64>) -> Vector2<f64>,
@@ -129,9 +117,8 @@ fn with_surroundings(
     let (Some(fs), Some(target)) = (s.freespace, s.target_body_mm) else {
         return BodyCommand::STOP;
     };
-    let coords = |pts: &[nalgebra::Point2<f64>]| -> Vec<Vector2<f64>> {
-        pts.iter().map(|p| p.coords).collect()
-    };
+    let coords =
+        |pts: &[Point2<f64>]| -> Vec<Vector2<f64>> { pts.iter().map(|p| p.coords).collect() };
     let obstacles = coords(&fs.obstacle_points);
     let near = near.unwrap_or_else(|| NearSpace {
         clear: coords(&fs.clear_points),
@@ -146,31 +133,4 @@ fn with_surroundings(
         blind_points: &near.blind,
     };
     BodyCommand::translate(f(&surroundings, target))
-}
-
-impl Controller for GoalDirection {
-    fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        with_surroundings(s, None, |sur, target| {
-            GoalDirection::decide(self, sur, target).v_mm_s
-        })
-    }
-}
-
-/// The velocity-aware controller; with chosen speeds, its near-field memory supplies where
-/// obstacles are inside the camera's blind zone.
-struct VelocityAwareStack {
-    controller: VelocityAware,
-    near: Option<NearField>,
-}
-
-impl Controller for VelocityAwareStack {
-    fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        let clear = match (&mut self.near, s.freespace) {
-            (Some(near), Some(fs)) => Some(near.update(fs, &s.odometry_pose, s.t_s)),
-            _ => None,
-        };
-        let v = s.velocity_body_mm_s;
-        let c = &self.controller;
-        with_surroundings(s, clear, |sur, target| c.decide(sur, target, v).v_mm_s)
-    }
 }

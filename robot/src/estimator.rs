@@ -15,7 +15,6 @@
 //! Measurements farther from the prediction than the gate (400 mm, 20 degrees) are not trusted.
 
 use crate::boundary::OdometryReading;
-use crate::config::PoseSource;
 use crate::estimates::{FixOutcome, Measurement};
 use nalgebra::{Isometry2, Vector2};
 use omniloop_control::{DeadReckoning, wrap_pi};
@@ -48,9 +47,9 @@ pub struct PoseEstimator {
 }
 
 impl PoseEstimator {
-    /// An estimator for a robot told it starts at `start` (world frame). With any source but
-    /// `PoseSource::Odometry` it takes fixes, each pulling the estimate by `gain`.
-    pub fn new(start: Isometry2<f64>, source: PoseSource, gain: f64) -> Self {
+    /// An estimator for a robot told it starts at `start` (world frame). When it `takes_fixes`
+    /// (any pose source but odometry) each fix pulls the estimate by `gain`.
+    pub fn new(start: Isometry2<f64>, takes_fixes: bool, gain: f64) -> Self {
         Self {
             reckoning: DeadReckoning::new(),
             anchor: Some(Anchor {
@@ -58,7 +57,7 @@ impl PoseEstimator {
                 odometry: None,
             }),
             anchored_by_fix: false,
-            takes_fixes: source != PoseSource::Odometry,
+            takes_fixes,
             gain,
             last_cycle: None,
             used: 0,
@@ -277,7 +276,7 @@ mod tests {
     #[test]
     fn odometry_moves_the_estimate_and_pose_fixes_pull_it_back() {
         let start = Isometry2::new(Vector2::new(-500.0, 0.0), 0.0);
-        let mut e = PoseEstimator::new(start, PoseSource::Localization, 0.5);
+        let mut e = PoseEstimator::new(start, true, 0.5);
         // An ambiguous fix cannot set the estimate.
         assert!(matches!(
             e.fuse(&pose_fix(-400.0, 10.0, 0.0, false)),
@@ -303,7 +302,7 @@ mod tests {
 
     #[test]
     fn with_odometry_as_the_source_fixes_are_ignored() {
-        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Odometry, 0.5);
+        let mut e = PoseEstimator::new(Isometry2::identity(), false, 0.5);
         assert_eq!(
             e.fuse(&pose_fix(100.0, 0.0, 0.0, true)),
             FixOutcome::Ignored
@@ -314,7 +313,7 @@ mod tests {
 
     #[test]
     fn a_forgotten_pose_is_unknown_until_an_unambiguous_fix() {
-        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Localization, 0.3);
+        let mut e = PoseEstimator::new(Isometry2::identity(), true, 0.3);
         e.forget();
         assert!(e.estimate().is_none());
         assert!(matches!(
@@ -334,7 +333,7 @@ mod tests {
 
     #[test]
     fn heading_and_position_fixes_correct_their_part_only() {
-        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Localization, 0.5);
+        let mut e = PoseEstimator::new(Isometry2::identity(), true, 0.5);
         assert_eq!(
             e.fuse(&Measurement::Heading { heading_rad: 0.2 }),
             FixOutcome::Used
@@ -350,11 +349,7 @@ mod tests {
         assert!((p.translation.vector - Vector2::new(20.0, -10.0)).norm() < 1e-12);
         assert!((p.rotation.angle() - 0.1).abs() < 1e-12);
         // Across the +-pi seam the heading moves the short way.
-        let mut e = PoseEstimator::new(
-            Isometry2::new(Vector2::zeros(), PI - 0.05),
-            PoseSource::Localization,
-            0.5,
-        );
+        let mut e = PoseEstimator::new(Isometry2::new(Vector2::zeros(), PI - 0.05), true, 0.5);
         e.fuse(&Measurement::Heading {
             heading_rad: -PI + 0.05,
         });
@@ -364,7 +359,7 @@ mod tests {
 
     #[test]
     fn a_motion_fix_replaces_part_of_the_odometry_increment() {
-        let mut e = PoseEstimator::new(Isometry2::identity(), PoseSource::Localization, 0.5);
+        let mut e = PoseEstimator::new(Isometry2::identity(), true, 0.5);
         // No earlier cycle yet.
         let delta = Isometry2::new(Vector2::new(100.0, 0.0), 0.0);
         assert!(matches!(

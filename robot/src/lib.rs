@@ -9,41 +9,44 @@
 //! robot and on recorded or live images of a real one.
 //!
 //! Inside, the stack is built from a [`RobotConfig`]:
-//! - perception stages ([`perception`]) turn frames into free space and fixes (a full pose,
+//! - perception stages ([`perception`], registered by name) turn frames into free space and fixes (a full pose,
 //!   a heading, a position or a relative motion);
 //! - the [`PoseEstimator`] dead-reckons the wheel odometry and fuses the fixes;
 //! - the [`Mission`] holds the targets (waypoints, then the goal) and moves on when the robot's
 //!   *own estimate* says a target is reached;
-//! - the controller ([`controller`]) chooses the command.
+//! - the controller ([`controllers`], registered by name) chooses the command.
 
 pub mod boundary;
 pub mod config;
 pub mod controller;
+pub mod controllers;
 pub mod estimates;
 pub mod estimator;
-pub mod forward_drive;
 pub mod mission;
 pub mod near_field;
 pub mod perception;
 pub mod robot;
-pub mod wander;
+pub mod tables;
 
 pub use boundary::{
     ActuatorCommand, ActuatorState, BodyCommand, Frame, Observation, OdometryReading, Outputs,
     RobotSoftware,
 };
 pub use config::{
-    BodySpec, ControlSpec, ControllerKind, ForwardDriveConfig, ForwardVisionConfig, GoalSpec,
-    MapLandmark, MapMark, MapSegment, Move, PoseSource, RobotConfig, ScriptConfig, SearchConfig,
-    StereoRig, VisionSpec, WanderConfig, WorldMap,
+    BodySpec, ControlSpec, ForwardVisionConfig, GoalSpec, MapLandmark, MapMark, MapSegment,
+    ODOMETRY, RobotConfig, StereoRig, VisionSpec, WorldMap,
 };
+pub use controller::{Controller, ControllerEntry};
+pub use controllers::CONTROLLERS;
 pub use estimates::{
     Estimates, Fix, FixOutcome, GroundReading, LandmarkSighting, Measurement, MotionReading,
     NotFound,
 };
 pub use estimator::PoseEstimator;
 pub use mission::Mission;
-pub use robot::Robot;
+pub use perception::{STAGES, StageEntry};
+pub use robot::{Robot, stages_of};
+pub use tables::{ConfigProblem, Tables};
 
 /// Why the robot's software could not be built or run a cycle.
 #[derive(Debug, thiserror::Error)]

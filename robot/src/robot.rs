@@ -2,13 +2,27 @@
 
 use crate::RobotError;
 use crate::boundary::{Observation, OdometryReading, Outputs, RobotSoftware};
-use crate::config::RobotConfig;
-use crate::controller::{self, Controller, Situation};
+use crate::config::{ODOMETRY, RobotConfig};
+use crate::controller::{Controller, Situation};
+use crate::controllers;
 use crate::estimates::{Estimates, Fix};
 use crate::estimator::PoseEstimator;
 use crate::mission::Mission;
-use crate::perception::{self, Belief, Percepts, Stage};
+use crate::perception::{self, Belief, Percepts, Stage, StageEntry};
 use nalgebra::Isometry2;
+
+/// The perception stages a configuration runs, in order: those its controller reads and those
+/// it asks for (its pose source, a goal's checkpoints, the visual odometry).
+pub fn stages_of(config: &RobotConfig) -> Result<Vec<&'static StageEntry>, RobotError> {
+    let kind = &config.control.kind;
+    let controller = controllers::find(kind).ok_or_else(|| {
+        RobotError::Config(format!(
+            "control.kind: no controller {kind:?} (there are: {})",
+            controllers::names()
+        ))
+    })?;
+    Ok(perception::wanted(config, controller.stages))
+}
 
 /// The robot's software stack, built once from a [`RobotConfig`].
 pub struct Robot {
@@ -24,7 +38,7 @@ impl Robot {
     /// Builds the stack: the perception stages the configuration asks for, the estimator from
     /// the start pose, the mission and the controller.
     pub fn new(config: &RobotConfig) -> Result<Self, RobotError> {
-        let stages = perception::build(config)?;
+        let stages = perception::build(config, &stages_of(config)?)?;
         let mut cameras: Vec<String> = Vec::new();
         for c in stages.iter().flat_map(|s| s.cameras()) {
             if !cameras.iter().any(|k| k == c) {
@@ -34,14 +48,14 @@ impl Robot {
         Ok(Self {
             estimator: PoseEstimator::new(
                 config.start,
-                config.control.pose_source,
+                config.control.pose_source != ODOMETRY,
                 config.control.localization_gain,
             ),
-            controller: controller::build(config)?,
+            controller: controllers::build(config)?,
             mission: config.goal.as_ref().map(Mission::new),
             stages,
             cameras,
-            controller_name: config.control.kind.name().to_string(),
+            controller_name: config.control.kind.clone(),
         })
     }
 

@@ -12,9 +12,15 @@ use crate::simulation::{OutputFile, RunError, RunOutput};
 use crate::validate::Checker;
 use nalgebra::{Isometry2, Vector2};
 use omniloop_control::wrap_pi;
-use omniloop_robot::{ControllerKind, Estimates, Move};
+use omniloop_robot::Estimates;
+use omniloop_robot::controllers::script::{Move, ScriptConfig};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
+
+/// The avoidance controllers the experiment measures.
+const AVOIDANCE: [&str; 2] = ["segmentation", "optical_flow"];
+/// The scripted drive whose visual odometry it scores.
+const SCRIPT: &str = "script";
 
 /// `[experiment.forward]`: no settings; what is measured follows from `control.kind`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -23,21 +29,21 @@ pub struct ForwardSpec {}
 
 impl ForwardSpec {
     pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
-        match s.control.kind {
-            ControllerKind::Segmentation | ControllerKind::OpticalFlow => {}
-            ControllerKind::Script if s.vision.forward.visual_odometry => {}
-            ControllerKind::Script => c.fail(
+        let kind = s.control.kind.as_str();
+        if AVOIDANCE.contains(&kind) || (kind == SCRIPT && s.vision.forward.visual_odometry) {
+        } else if kind == SCRIPT {
+            c.fail(
                 "vision.forward.visual_odometry",
                 "experiment.forward scores the visual odometry of a script: set it to true",
-            ),
-            k => c.fail(
+            );
+        } else {
+            c.fail(
                 "control.kind",
                 format!(
                     "experiment.forward measures \"segmentation\", \"optical_flow\" or \"script\", \
-                     not {:?}",
-                    k.name()
+                     not {kind:?}"
                 ),
-            ),
+            );
         }
         if s.robot.differential.is_none() {
             c.fail(
@@ -71,7 +77,7 @@ pub struct MoveResult {
 
 /// The procedure is driving; the metrics depend on the controller.
 pub struct Forward {
-    kind: ControllerKind,
+    kind: String,
     moves: Vec<Move>,
     start: Isometry2<f64>,
 }
@@ -80,8 +86,12 @@ impl Forward {
     /// The experiment of scenario `s`.
     pub fn new(s: &Scenario) -> Self {
         Self {
-            kind: s.control.kind,
-            moves: s.control.script.moves.clone(),
+            kind: s.control.kind.clone(),
+            moves: s
+                .control
+                .table::<ScriptConfig>(SCRIPT)
+                .map(|t| t.moves)
+                .unwrap_or_default(),
             start: s.start().isometry(),
         }
     }
@@ -177,27 +187,24 @@ impl Experiment for Forward {
     fn metrics(&self, out: &RunOutput) -> Metrics {
         let mut m = Metrics::new();
         let s = &out.summary;
-        match self.kind {
-            ControllerKind::Script => {
-                m.insert("moves".into(), serde_json::json!(self.moves(out)));
-            }
-            k => {
-                m.insert(
-                    "avoidance".into(),
-                    serde_json::json!({
-                        "method": k.name(),
-                        "contacts": s.wall_contacts,
-                        "distance_mm": s.path_length_mm,
-                        "fps": s.cycles_per_s,
-                    }),
-                );
-            }
+        if self.kind == SCRIPT {
+            m.insert("moves".into(), serde_json::json!(self.moves(out)));
+        } else {
+            m.insert(
+                "avoidance".into(),
+                serde_json::json!({
+                    "method": self.kind,
+                    "contacts": s.wall_contacts,
+                    "distance_mm": s.path_length_mm,
+                    "fps": s.cycles_per_s,
+                }),
+            );
         }
         m
     }
 
     fn files(&self, scenario: &Scenario, out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
-        if self.kind != ControllerKind::Script {
+        if self.kind != SCRIPT {
             return Ok(Vec::new());
         }
         let chart = path_chart(&scenario.name, self.start, out);
@@ -313,20 +320,22 @@ fn moves_of(summary: &crate::record::Summary) -> Vec<MoveResult> {
 fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
     let out = ctx.out.to_path_buf();
     let mut avoidance = Vec::new();
-    for kind in [ControllerKind::Segmentation, ControllerKind::OpticalFlow] {
-        let run = ctx.simulate_edited(kind.name(), OBSTACLES.0, OBSTACLES.1, |s| {
-            s.control.kind = kind;
-            s.name = format!("forward_{}", kind.name());
+    for kind in AVOIDANCE {
+        let run = ctx.simulate_edited(kind, OBSTACLES.0, OBSTACLES.1, |s| {
+            s.control.kind = kind.to_string();
+            s.name = format!("forward_{kind}");
             Ok(())
         })?;
-        write_run(&out.join(kind.name()), &run.scenario, &run.output)?;
+        write_run(&out.join(kind), &run.scenario, &run.output)?;
         avoidance.push(run.output.summary.experiment["avoidance"].clone());
     }
     let mut charts = Vec::new();
     let mut runs = Vec::new();
     for (name, moves) in odometry_runs() {
         let run = ctx.simulate_edited(name, ODOMETRY.0, ODOMETRY.1, |s| {
-            s.control.script.moves = moves.clone();
+            let mut script: ScriptConfig = s.control.table(SCRIPT)?;
+            script.moves = moves.clone();
+            s.control.tables.set(SCRIPT, &script)?;
             s.name = format!("forward_{name}");
             if name == "square" {
                 s.robot.start = Some(crate::scenario::PoseSpec {

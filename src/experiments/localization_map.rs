@@ -14,7 +14,6 @@ use crate::topview::{Mark, Panel, Spots, panels_png};
 use crate::validate::Checker;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::wrap_pi;
-use omniloop_robot::PoseSource;
 use omniloop_sim::SimError;
 use omniloop_vision::{FloorLocalizer, Localization, LocalizationMethod, LocalizationQuality};
 use rand::rngs::StdRng;
@@ -82,7 +81,7 @@ impl MapSpec {
                 );
             }
         }
-        if s.control.pose_source != PoseSource::Localization {
+        if s.control.pose_source != "localization" {
             c.fail(
                 at,
                 "the map localizes the robot's camera images: set control.pose_source = \

@@ -42,7 +42,7 @@ impl OmnistereoSpec {
                 format!("must be [near, far] with 0 <= near < far (got [{a}, {b}])"),
             );
         }
-        if s.control.pose_source != omniloop_robot::PoseSource::Omnistereo {
+        if s.control.pose_source != "omnistereo" {
             c.fail(
                 "control.pose_source",
                 "experiment.omnistereo scores the omnistereo stage: set pose_source = \

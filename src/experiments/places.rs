@@ -14,7 +14,7 @@ use crate::validate::Checker;
 use anyhow::Context;
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::wrap_pi;
-use omniloop_robot::{Measurement, PoseSource};
+use omniloop_robot::Measurement;
 use omniloop_vision::LocalizationMethod;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -54,7 +54,7 @@ impl PlacesSpec {
                 &s.world,
             );
         }
-        if s.control.pose_source != PoseSource::Localization {
+        if s.control.pose_source != "localization" {
             c.fail(
                 "experiment.places",
                 "the robot localizes itself at each place: set control.pose_source = \

@@ -14,8 +14,8 @@ use crate::topview::{Mark, Marker, Panel, Spots, panels_png};
 use crate::validate::Checker;
 use nalgebra::Point2;
 use omniloop_control::wrap_pi;
+use omniloop_robot::Measurement;
 use omniloop_robot::perception::resection::{GAVE_UP, NAME};
-use omniloop_robot::{Measurement, PoseSource};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -48,7 +48,7 @@ impl ResectionSpec {
                 &s.world,
             );
         }
-        if s.control.pose_source != PoseSource::Resection {
+        if s.control.pose_source != "resection" {
             c.fail(
                 "control.pose_source",
                 "experiment.resection scores the resection stage: set pose_source = \

@@ -4,11 +4,76 @@
 //! back to the global search when tracking fails; before, it searches globally, the
 //! prediction (the start pose moved by odometry) only choosing between the twins.
 
-use super::{Belief, Percepts, Sighting, Stage, image};
+use super::stage::{
+    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, calibration, image, vision_camera,
+};
 use crate::RobotError;
 use crate::boundary::Observation;
+use crate::config::RobotConfig;
 use crate::estimates::{Measurement, NotFound};
+use crate::tables::{ConfigProblem, Problems};
 use omniloop_vision::{FloorLocalizer, Localization, LocalizationConfig, RadialCalibration};
+
+/// The registry's entry.
+pub const ENTRY: StageEntry = StageEntry {
+    name: "floor_localization",
+    summary: "self-localization from the shape of the floor region (Sect. 4 of the corner paper)",
+    pose_source: Some("localization"),
+    table: None,
+    asked: |c| c.control.pose_source == "localization",
+    camera: CameraNeed::MirrorFloor,
+    check,
+    build: |c| {
+        let camera = vision_camera(c, "self-localization")?;
+        let cal = calibration(c, camera)?;
+        let config = c.vision.localization.clone();
+        Ok(Box::new(FloorLocalizationStage::new(camera, config, cal)?))
+    },
+};
+
+/// `[vision.localization]`'s values.
+fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
+    let l = &c.vision.localization;
+    let f = &l.field;
+    let mut p = Problems::under("vision.localization");
+    p.positive("field.a1_mm", f.a1_mm);
+    if f.a2_mm.is_nan() || f.a2_mm <= f.a1_mm {
+        p.fail(
+            "field.a2_mm",
+            format!("must exceed a1_mm = {} (got {})", f.a1_mm, f.a2_mm),
+        );
+    }
+    p.positive("field.goal_half_width_mm", f.goal_half_width_mm);
+    if f.b_mm.is_nan() || f.b_mm <= f.goal_half_width_mm {
+        let why = format!(
+            "must exceed goal_half_width_mm = {} (got {})",
+            f.goal_half_width_mm, f.b_mm
+        );
+        p.fail("field.b_mm", why);
+    }
+    for (key, class) in [("goal_pos_x", &l.goal_pos_x), ("goal_neg_x", &l.goal_neg_x)] {
+        for (sub, r) in [("r", class.r), ("g", class.g)] {
+            if !(0.0..=1.0).contains(&r[0]) || !(0.0..=1.0).contains(&r[1]) || r[0] > r[1] {
+                let why = format!("must be [min, max] within 0..1 (got [{}, {}])", r[0], r[1]);
+                p.fail(&format!("{key}.{sub}"), why);
+            }
+        }
+    }
+    if l.max_radius_frac.is_nan() || l.max_radius_frac <= 0.0 || l.max_radius_frac > 1.0 {
+        p.fail(
+            "max_radius_frac",
+            format!("must lie in (0, 1] (got {})", l.max_radius_frac),
+        );
+    }
+    p.positive("gate_initial_mm", l.gate_initial_mm);
+    p.positive("gate_mm", l.gate_mm);
+    p.positive("offset_threshold_mm", l.offset_threshold_mm);
+    p.positive("rotation_threshold_rad", l.rotation_threshold_rad);
+    if l.max_iterations == 0 {
+        p.fail("max_iterations", "must be >= 1");
+    }
+    p.list
+}
 
 /// Localizes the robot in every frame of one mirror camera.
 pub struct FloorLocalizationStage {

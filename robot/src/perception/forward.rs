@@ -1,45 +1,90 @@
 //! A forward camera's stages (Ahmed, Saatchi and Caparrelli): ground segmentation and
 //! Horn-Schunck flow for avoidance, scan-line and feature visual odometry.
 
-use super::{Belief, Percepts, Stage, image};
+use super::stage::{Belief, CameraNeed, Percepts, Stage, StageEntry, image};
 use crate::RobotError;
 use crate::boundary::Observation;
-use crate::config::{ControllerKind, RobotConfig};
+use crate::config::RobotConfig;
 use crate::estimates::GroundReading;
+use crate::tables::ConfigProblem;
 use omniloop_vision::forward::{
     FlowBalance, FlowConfig, ForwardCamera, ForwardOdometry, Grey, GroundSegmenter, grey,
     horn_schunck, reduce,
 };
 
-/// The forward camera's stages a configuration asks for.
-pub(super) fn build(
-    config: &RobotConfig,
-    stages: &mut Vec<Box<dyn Stage>>,
-) -> Result<(), RobotError> {
-    let camera = config.forward_camera.clone().ok_or_else(|| {
+/// The forward camera the stages read, or the error saying vision's camera is not one.
+fn camera(c: &RobotConfig) -> Result<ForwardCamera, RobotError> {
+    c.forward_camera.clone().ok_or_else(|| {
         RobotError::Config(format!(
             "controller {:?} and the visual odometry need a forward pinhole camera",
-            config.control.kind.name()
+            c.control.kind
         ))
-    })?;
-    let v = &config.vision.forward;
-    match config.control.kind {
-        ControllerKind::Segmentation => stages.push(Box::new(GroundStage {
-            segmenter: GroundSegmenter::new(&camera, 2.0 * config.body.radius_mm, v.ground.clone()),
-            camera: camera.sensor.clone(),
-        })),
-        ControllerKind::OpticalFlow => stages.push(Box::new(FlowStage {
-            camera: camera.sensor.clone(),
-            config: v.flow.clone(),
-            previous: None,
-        })),
-        _ => {}
-    }
-    if v.visual_odometry {
-        stages.push(Box::new(VisualOdometryStage::new(camera, v)?));
-    }
-    Ok(())
+    })
 }
+
+/// The registry's entry of the ground segmentation.
+pub const GROUND: StageEntry = StageEntry {
+    name: "ground",
+    summary: "a forward camera's ground segmentation (Ahmed et al., Sect. 2.1.1)",
+    pose_source: None,
+    table: None,
+    asked: |_| false,
+    camera: CameraNeed::Forward,
+    check: |_| Vec::new(),
+    build: |c| {
+        let camera = camera(c)?;
+        let config = c.vision.forward.ground.clone();
+        Ok(Box::new(GroundStage {
+            segmenter: GroundSegmenter::new(&camera, 2.0 * c.body.radius_mm, config),
+            camera: camera.sensor.clone(),
+        }))
+    },
+};
+
+/// The registry's entry of the Horn-Schunck flow.
+pub const FLOW: StageEntry = StageEntry {
+    name: "flow",
+    summary: "a forward camera's Horn-Schunck flow balance (Ahmed et al., Sect. 2.1.2)",
+    pose_source: None,
+    table: None,
+    asked: |_| false,
+    camera: CameraNeed::Forward,
+    check: |_| Vec::new(),
+    build: |c| {
+        Ok(Box::new(FlowStage {
+            camera: camera(c)?.sensor.clone(),
+            config: c.vision.forward.flow.clone(),
+            previous: None,
+        }))
+    },
+};
+
+/// The registry's entry of the visual odometry (`vision.forward.visual_odometry = true`).
+pub const VISUAL_ODOMETRY: StageEntry = StageEntry {
+    name: "visual_odometry",
+    summary: "a forward camera's visual odometry: scan-line rotation, LK and NCC translation \
+              (Ahmed et al., Sect. 2.2)",
+    pose_source: None,
+    table: None,
+    asked: |c| c.vision.forward.visual_odometry,
+    camera: CameraNeed::Forward,
+    check: |c| {
+        if c.forward_camera.is_some() {
+            return Vec::new();
+        }
+        vec![ConfigProblem::new(
+            "vision.sensor",
+            "the forward camera's avoidance and visual odometry need vision's camera to be a \
+             pinhole ([robot.sensors.pinhole])",
+        )]
+    },
+    build: |c| {
+        Ok(Box::new(VisualOdometryStage::new(
+            camera(c)?,
+            &c.vision.forward,
+        )?))
+    },
+};
 
 /// Ground segmentation of every frame (Sect. 2.1.1).
 pub struct GroundStage {

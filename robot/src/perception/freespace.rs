@@ -1,10 +1,97 @@
 //! Free space in the floor region (Sect. 3.1 of the corner paper): the polar template on the
 //! floor-colour mask, eqs. (5)-(7).
 
-use super::{Belief, Percepts, Stage, image};
+use super::stage::{
+    Belief, CameraNeed, Percepts, Stage, StageEntry, calibration, image, vision_camera,
+};
 use crate::RobotError;
 use crate::boundary::Observation;
+use crate::config::RobotConfig;
+use crate::tables::{ConfigProblem, Problems};
+use omniloop_vision::freespace::PolarTemplate;
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, RadialCalibration};
+
+/// The registry's entry.
+pub const ENTRY: StageEntry = StageEntry {
+    name: "freespace",
+    summary: "free space in the floor region by the polar template, eqs. (5)-(7) (Sect. 3.1 of \
+              the corner paper)",
+    pose_source: None,
+    table: None,
+    asked: |_| false,
+    camera: CameraNeed::MirrorFloor,
+    check,
+    build: |c| {
+        let camera = vision_camera(c, "free space")?;
+        let cal = calibration(c, camera)?;
+        Ok(Box::new(FreeSpaceStage::new(
+            camera,
+            c.vision.freespace.clone(),
+            cal,
+        )?))
+    },
+};
+
+/// `[vision.freespace]`'s values, and the template on the camera's calibration when it is
+/// known.
+fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
+    let fs = &c.vision.freespace;
+    let mut p = Problems::under("vision.freespace");
+    if fs.directions < 4 {
+        p.fail(
+            "directions",
+            format!("must be >= 4 (got {})", fs.directions),
+        );
+    }
+    if fs.rings < 1 {
+        p.fail("rings", "must be >= 1");
+    }
+    p.positive("inner_mm", fs.inner_mm);
+    if fs.outer_mm.is_nan() || fs.outer_mm <= fs.inner_mm {
+        let got = format!(
+            "must exceed inner_mm = {} (got {})",
+            fs.inner_mm, fs.outer_mm
+        );
+        p.fail("outer_mm", got);
+    }
+    if fs.r_th.is_nan() || fs.r_th <= 0.0 || fs.r_th > 1.0 {
+        p.fail("r_th", format!("must lie in (0, 1] (got {})", fs.r_th));
+    }
+    if !fs.ring_edges_mm.is_empty() && !fs.ring_edges_px.is_empty() {
+        p.fail(
+            "ring_edges_px",
+            "give ring_edges_mm or ring_edges_px, not both",
+        );
+    }
+    for (key, edges) in [
+        ("ring_edges_mm", &fs.ring_edges_mm),
+        ("ring_edges_px", &fs.ring_edges_px),
+    ] {
+        if !edges.is_empty() && edges.len() != fs.rings + 1 {
+            let n = edges.len();
+            p.fail(
+                key,
+                format!("needs rings + 1 = {} values (got {n})", fs.rings + 1),
+            );
+        }
+    }
+    for k in 0..3 {
+        if fs.floor.rgb_min[k] > fs.floor.rgb_max[k] {
+            let (lo, hi) = (fs.floor.rgb_min[k], fs.floor.rgb_max[k]);
+            p.fail(
+                "floor.rgb_min",
+                format!("channel {k}: {lo} exceeds rgb_max {hi}"),
+            );
+        }
+    }
+    let cal = c.vision_camera().and_then(|cam| c.calibration(cam));
+    if let (true, Some(cal)) = (p.list.is_empty(), cal)
+        && let Err(e) = PolarTemplate::new(fs, cal)
+    {
+        p.fail("", e.to_string());
+    }
+    p.list
+}
 
 /// Detects free space in every frame of one mirror camera.
 pub struct FreeSpaceStage {

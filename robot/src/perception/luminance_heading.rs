@@ -10,13 +10,37 @@
 //! every one before it becomes a fix: the readings improve as the robot nears the checkpoint
 //! and are passed over as it leaves.
 
-use super::{Belief, Percepts, Sighting, Stage, image};
+use super::stage::{
+    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, calibration, image, vision_camera,
+};
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::estimates::{Measurement, NotFound};
 use nalgebra::Point2;
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::luminance_heading::{LuminanceCircle, LuminanceConfig};
+
+/// The registry's entry.
+pub const ENTRY: StageEntry = StageEntry {
+    name: "luminance_heading",
+    summary: "heading at the goal's checkpoints from the luminance circle (Kim, Kim and Kwon, \
+              Sect. 3)",
+    pose_source: Some("checkpoints"),
+    table: None,
+    asked: |c| !c.checkpoints().is_empty(),
+    camera: CameraNeed::Mirror,
+    check: |_| Vec::new(),
+    build: |c| {
+        let camera = vision_camera(c, "the luminance heading")?;
+        let cal = calibration(c, camera)?;
+        let (config, goal) = (c.vision.luminance_heading.clone(), c.goal.as_ref());
+        let (store, read) = goal.map_or((0.0, 0.0), |g| {
+            (g.checkpoint_store_mm, g.checkpoint_radius_mm)
+        });
+        let stage = LuminanceHeadingStage::new(camera, config, cal, c.checkpoints(), store, read)?;
+        Ok(Box::new(stage))
+    },
+};
 
 /// One checkpoint and what the robot stored there.
 struct Checkpoint {

@@ -11,11 +11,12 @@
 //! the translation. The motion is recorded, not fused: a 15 mm step measured to a few
 //! millimetres is no better than the wheels over 50 ms.
 
-use super::{Belief, Percepts, Sighting, Stage, image};
+use super::stage::{Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, image};
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::{MapLandmark, StereoRig};
 use crate::estimates::{LandmarkSighting, Measurement, MotionReading, NotFound};
+use crate::tables::ConfigProblem;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Vector2};
 use omniloop_vision::VisionError;
@@ -23,6 +24,40 @@ use omniloop_vision::omnistereo::{
     AngularProfile, FeaturePair, LandmarkRange, MirrorRim, OmnistereoConfig, RangedMark,
     StereoGeometry, densest_cluster, detect_marks, range_marks, translation_candidates,
     trilaterate,
+};
+
+/// The registry's entry.
+pub const ENTRY: StageEntry = StageEntry {
+    name: "omnistereo",
+    summary: "conical omnistereo: ranges by eq. (1), trilateration, visual compass, interframe \
+              motion (Spacek and Burbridge, Sect. 2)",
+    pose_source: Some("omnistereo"),
+    table: None,
+    asked: |c| c.control.pose_source == "omnistereo",
+    camera: CameraNeed::None,
+    check: |c| {
+        let mut p = Vec::new();
+        if let Err(e) = c.vision.omnistereo.validate() {
+            p.push(ConfigProblem::new("vision.omnistereo", e.to_string()));
+        }
+        if c.map.landmarks.is_empty() {
+            let why = "omnistereo trilateration needs landmarks: add [[world.pillars]] of \
+                       distinct colours";
+            p.push(ConfigProblem::new("control.pose_source", why));
+        }
+        p
+    },
+    build: |c| {
+        let rig = c.stereo.ok_or_else(|| {
+            RobotError::Config("pose_source \"omnistereo\" needs the robot's two cones".into())
+        })?;
+        let config = c.vision.omnistereo.clone();
+        Ok(Box::new(OmnistereoStage::new(
+            config,
+            rig,
+            &c.map.landmarks,
+        )?))
+    },
 };
 
 /// What the stage measured of its own cameras.

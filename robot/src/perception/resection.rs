@@ -17,18 +17,112 @@
 //! - with an omnidirectional camera (beyond the paper) one frame shows all three marks, read
 //!   on rings of the image instead of rows, and nothing pans.
 
-use super::{Belief, Percepts, Sighting, Stage, image};
+use super::stage::{
+    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, image, vision_camera,
+};
 use crate::RobotError;
 use crate::boundary::{ActuatorCommand, ActuatorState, Observation};
-use crate::config::{MapMark, SearchConfig};
+use crate::config::{MapMark, RobotConfig};
 use crate::estimates::{Measurement, NotFound};
+use crate::tables::{ConfigProblem, Problems};
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::resection::{
     ColumnCalibration, MarkBearing, ResectionConfig, StripePattern, find_marks, find_marks_ring,
     resect, ring_bearing_rad,
 };
+use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
+
+/// The registry's entry.
+pub const ENTRY: StageEntry = StageEntry {
+    name: "resection",
+    summary: "three-mark resection: a panning search for the striped marks, then one fix \
+              (Ishikawa, Kikuchi and Kato)",
+    pose_source: Some("resection"),
+    table: Some("resection"),
+    asked: |c| c.control.pose_source == "resection",
+    camera: CameraNeed::MirrorOrPinhole,
+    check,
+    build: |c| Ok(Box::new(build(c)?)),
+};
+
+/// `[vision.resection]`, `[control.resection]` and the map's marks.
+fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
+    let mut out = Vec::new();
+    if let Err(e) = c.vision.resection.validate() {
+        out.push(ConfigProblem::new("vision.resection", e.to_string()));
+    }
+    match c.control.table::<SearchConfig>("resection") {
+        Err(e) => out.push(e),
+        Ok(r) => {
+            let mut p = Problems::under("control.resection");
+            p.positive("pan_rate_deg_s", r.pan_rate_deg_s);
+            p.positive("move_mm", r.move_mm);
+            if !(r.central_fraction > 0.0 && r.central_fraction <= 1.0) {
+                let why = format!("must be in (0, 1] (got {})", r.central_fraction);
+                p.fail("central_fraction", why);
+            }
+            out.extend(p.list);
+        }
+    }
+    if c.map.marks.len() != 3 {
+        let why = format!(
+            "resection needs exactly three marks: name three [[world.boards]] (found {})",
+            c.map.marks.len()
+        );
+        out.push(ConfigProblem::new("control.pose_source", why));
+    }
+    out
+}
+
+/// The resection stage on vision's camera: panning with a pinhole's column calibration, or
+/// from one image of a mirror camera.
+fn build(config: &RobotConfig) -> Result<ResectionStage, RobotError> {
+    let camera = vision_camera(config, "resection")?;
+    let view = match (config.columns(camera), config.calibration(camera)) {
+        (Some(c), _) => View::Pan(c.clone()),
+        (None, Some(c)) => View::Ring(c.clone()),
+        (None, None) => {
+            return Err(RobotError::Config(format!(
+                "no column or mirror calibration for camera {camera:?}"
+            )));
+        }
+    };
+    let search = config
+        .control
+        .table("resection")
+        .map_err(|e| RobotError::Config(e.to_string()))?;
+    let vision = config.vision.resection.clone();
+    ResectionStage::new(camera, view, vision, search, &config.map.marks)
+}
+
+/// How the robot searches for the three marks (`[control.resection]`, Fig. 4 of the resection
+/// paper).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SearchConfig {
+    /// Rate of the pan from right to left, deg/s (the pan unit clips it to its limit).
+    pub pan_rate_deg_s: f64,
+    /// Sightings count toward a mark's bearing when its centre is within this fraction of the
+    /// half-width of the image from the optical axis (ours: the calibration is best there).
+    pub central_fraction: f64,
+    /// Length of the move to another observation point when a mark was not found, mm.
+    pub move_mm: f64,
+    /// Moves before the robot gives up.
+    pub max_moves: u32,
+}
+
+impl Default for SearchConfig {
+    fn default() -> Self {
+        Self {
+            pan_rate_deg_s: 60.0,
+            central_fraction: 0.5,
+            move_mm: 300.0,
+            max_moves: 3,
+        }
+    }
+}
 
 /// The stage's name in the estimates record.
 pub const NAME: &str = "resection";

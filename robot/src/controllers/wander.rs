@@ -7,16 +7,73 @@
 //! (`v^2 / (2 alpha)` plus two control periods) brings its body within `clearance_mm` of an
 //! obstacle and nearer than it is now (so a robot already close can drive away). It then stops
 //! and turns in place, left or right at random, until the way ahead is clear, and on by a
-//! random extra angle (ours; see [`crate::WanderConfig`]). The turns come from the software's
+//! random extra angle (ours; see [`WanderConfig`]). The turns come from the software's
 //! own seeded generator: a run repeats exactly.
 
 use crate::RobotError;
 use crate::boundary::BodyCommand;
-use crate::config::{RobotConfig, WanderConfig, WorldMap};
-use crate::controller::{Controller, Situation};
+use crate::config::{ControlSpec, RobotConfig, WorldMap};
+use crate::controller::{Controller, ControllerEntry, Situation, check_table, settings};
+use crate::tables::{ConfigProblem, Problems};
 use nalgebra::{Isometry2, Point2, Vector2};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
+use serde::{Deserialize, Serialize};
+
+/// The registry's entry.
+pub const ENTRY: ControllerEntry = ControllerEntry {
+    name: "wander",
+    summary: "random wandering on the map: forward until an obstacle is near, then a random turn \
+              (E4, Spacek and Burbridge, Sect. 2.1)",
+    table: Some("wander"),
+    needs_goal: false,
+    stages: &[],
+    check_table: check_wander,
+    check_use: |c| {
+        if c.map.segments.is_empty() {
+            return vec![ConfigProblem::new(
+                "control.kind",
+                "\"wander\" drives on a map of the world's walls and pillars: the world has no walls",
+            )];
+        }
+        Vec::new()
+    },
+    build: |c| Ok(Box::new(Wander::new(c)?)),
+};
+
+/// How the wandering controller drives (`[control.wander]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WanderConfig {
+    /// Gap the robot keeps between its body and the map's obstacles, mm (room for the error
+    /// of its estimate).
+    pub clearance_mm: f64,
+    /// Rate of the turns, deg/s.
+    pub turn_rate_deg_s: f64,
+    /// Once the way ahead is clear the robot turns on by a random angle up to this, degrees
+    /// (ours: without it a robot that stops turning at the first clear heading skims along
+    /// walls).
+    pub max_extra_turn_deg: f64,
+}
+
+impl Default for WanderConfig {
+    fn default() -> Self {
+        Self {
+            clearance_mm: 200.0,
+            turn_rate_deg_s: 90.0,
+            max_extra_turn_deg: 60.0,
+        }
+    }
+}
+
+/// Parses and checks `[control.wander]`.
+fn check_wander(spec: &ControlSpec) -> Vec<ConfigProblem> {
+    check_table(spec, "wander", |w: &WanderConfig, p: &mut Problems| {
+        p.positive("clearance_mm", w.clearance_mm);
+        p.positive("turn_rate_deg_s", w.turn_rate_deg_s);
+        p.non_negative("max_extra_turn_deg", w.max_extra_turn_deg);
+    })
+}
 
 /// Step along the path ahead at which the map is checked, mm.
 const STEP_MM: f64 = 10.0;
@@ -46,7 +103,7 @@ pub struct Wander {
 impl Wander {
     /// The controller of `config`'s robot, on its map.
     pub fn new(config: &RobotConfig) -> Result<Self, RobotError> {
-        let w = &config.control.wander;
+        let w: WanderConfig = settings(config, "wander")?;
         for (name, v) in [
             ("control.wander.clearance_mm", w.clearance_mm),
             ("control.wander.turn_rate_deg_s", w.turn_rate_deg_s),
@@ -65,7 +122,7 @@ impl Wander {
         let b = &config.body;
         let v = b.max_speed_mm_s;
         Ok(Self {
-            config: w.clone(),
+            config: w,
             map: config.map.clone(),
             radius_mm: b.radius_mm,
             speed_mm_s: v,
@@ -106,10 +163,7 @@ impl Wander {
     }
 
     fn turn(&self, dir: f64) -> BodyCommand {
-        BodyCommand {
-            v_mm_s: Vector2::zeros(),
-            omega_rad_s: dir * self.config.turn_rate_deg_s.to_radians(),
-        }
+        BodyCommand::turn(dir * self.config.turn_rate_deg_s.to_radians())
     }
 }
 
@@ -138,7 +192,7 @@ impl Controller for Wander {
             other => other,
         };
         match self.state {
-            State::Forward => BodyCommand::translate(Vector2::new(self.speed_mm_s, 0.0)),
+            State::Forward => BodyCommand::forward(self.speed_mm_s),
             State::Turn { dir, .. } => self.turn(dir),
         }
     }
@@ -147,7 +201,7 @@ impl Controller for Wander {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{BodySpec, ControlSpec, MapSegment, VisionSpec};
+    use crate::config::{BodySpec, MapSegment, VisionSpec};
 
     fn config() -> RobotConfig {
         let seg = |a: [f64; 2], b: [f64; 2]| MapSegment {

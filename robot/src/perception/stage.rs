@@ -1,0 +1,149 @@
+//! What a perception stage is: it reads the frames of its cameras and gives free space, fixes
+//! for the estimator, or the reason it found nothing. The stages themselves, one file each, are
+//! registered in [`crate::perception`].
+
+use crate::RobotError;
+use crate::boundary::{ActuatorCommand, Observation};
+use crate::config::RobotConfig;
+use crate::estimates::{GroundReading, LandmarkSighting, Measurement, MotionReading, NotFound};
+use crate::tables::ConfigProblem;
+use image::RgbaImage;
+use nalgebra::{Isometry2, Point2};
+use omniloop_vision::forward::{FlowBalance, OdometryStep};
+use omniloop_vision::{FreeSpace, LocalizationQuality, RadialCalibration};
+
+/// What the stages of one cycle found.
+#[derive(Debug, Clone, Default)]
+pub struct Percepts {
+    /// Free space around the robot.
+    pub freespace: Option<FreeSpace>,
+    /// Measurements for the estimator.
+    pub fixes: Vec<Sighting>,
+    /// Stages that found nothing, and why.
+    pub not_found: Vec<NotFound>,
+    /// Landmarks of the map identified and ranged.
+    pub landmarks: Vec<LandmarkSighting>,
+    /// The motion since the previous frame, as vision read it.
+    pub motion: Option<MotionReading>,
+    /// Commands to the actuators (a stage steering its camera).
+    pub actuators: Vec<ActuatorCommand>,
+    /// A point to drive to (odometry frame), when a stage needs another view.
+    pub observation_point: Option<Point2<f64>>,
+    /// A forward camera's ground segmentation.
+    pub ground: Option<GroundReading>,
+    /// A forward camera's flow balance.
+    pub flow: Option<FlowBalance>,
+    /// A forward camera's visual odometry.
+    pub visual_odometry: Option<OdometryStep>,
+}
+
+/// A measurement, the stage that made it and how good that stage judged it.
+#[derive(Debug, Clone)]
+pub struct Sighting {
+    /// The stage.
+    pub source: &'static str,
+    /// The measurement.
+    pub measurement: Measurement,
+    /// Its quality record, when the stage keeps one.
+    pub quality: Option<LocalizationQuality>,
+}
+
+/// What the estimator believes at the start of a cycle, as the stages may use it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Belief {
+    /// The predicted pose (world frame), if the robot has one.
+    pub pose: Option<Isometry2<f64>>,
+    /// Whether a fix has set it (not only the start pose and odometry).
+    pub fixed: bool,
+    /// The dead-reckoned pose in the odometry frame.
+    pub odometry_pose: Isometry2<f64>,
+}
+
+/// One perception stage.
+pub trait Stage: Send {
+    /// The stage's name in the estimates record.
+    fn name(&self) -> &'static str;
+    /// The cameras whose frames it reads.
+    fn cameras(&self) -> Vec<&str>;
+    /// The robot was carried to a place it is not told: a stage that keeps state starts
+    /// afresh.
+    fn carried(&mut self) {}
+    /// Whether it reads its cameras' frames next cycle.
+    fn wants_frames(&self) -> bool {
+        true
+    }
+    /// Processes the cycle's frames, knowing what the estimator predicts.
+    fn run(
+        &mut self,
+        obs: &Observation<'_>,
+        belief: &Belief,
+        out: &mut Percepts,
+    ) -> Result<(), RobotError>;
+}
+
+/// What a stage needs of vision's camera (so the simulator calibrates it first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CameraNeed {
+    /// Nothing of vision's camera (it names its own cameras).
+    None,
+    /// A mirror camera's image-to-floor calibration, radius to elevation at least.
+    Mirror,
+    /// A mirror camera whose image shows the floor, with its image-to-floor map.
+    MirrorFloor,
+    /// A mirror camera's calibration, or a pinhole camera's column calibration.
+    MirrorOrPinhole,
+    /// A forward pinhole camera (its intrinsics, height and tilt).
+    Forward,
+}
+
+/// A perception stage as the registry lists it: a new stage is its own file with one of these
+/// and one line in [`crate::perception::STAGES`].
+pub struct StageEntry {
+    /// Its name in the estimates record.
+    pub name: &'static str,
+    /// What it does, in one line, with the paper and section it follows.
+    pub summary: &'static str,
+    /// The `control.pose_source` under which its fixes correct the estimate, if it gives any.
+    pub pose_source: Option<&'static str>,
+    /// Its own table under `[control]`, if it has one (checked by `check`).
+    pub table: Option<&'static str>,
+    /// Whether the robot's configuration asks for it (besides a controller that reads it).
+    pub asked: fn(&RobotConfig) -> bool,
+    /// What it needs of vision's camera.
+    pub camera: CameraNeed,
+    /// Checks what it needs of the robot (its settings, the map), naming each field at fault.
+    pub check: fn(&RobotConfig) -> Vec<ConfigProblem>,
+    /// Builds it for a robot.
+    pub build: fn(&RobotConfig) -> Result<Box<dyn Stage>, RobotError>,
+}
+
+/// The calibration of camera `sensor`, or the error saying there is none.
+pub fn calibration<'a>(
+    config: &'a RobotConfig,
+    camera: &str,
+) -> Result<&'a RadialCalibration, RobotError> {
+    config.calibration(camera).ok_or_else(|| {
+        RobotError::Config(format!(
+            "no image-to-floor calibration for camera {camera:?}"
+        ))
+    })
+}
+
+/// Vision's camera (`vision.sensor`, else the robot's first), or the error naming `stage`.
+pub fn vision_camera<'a>(config: &'a RobotConfig, stage: &str) -> Result<&'a str, RobotError> {
+    config.vision_camera().ok_or_else(|| {
+        RobotError::Config(match &config.vision.sensor {
+            Some(n) => format!("vision.sensor names a camera the robot does not have: {n:?}"),
+            None => format!("{stage} needs a camera and the robot has none"),
+        })
+    })
+}
+
+/// The image of camera `sensor` this cycle, or the error naming the stage that needed it.
+pub fn image<'a>(
+    obs: &Observation<'a>,
+    sensor: &str,
+    stage: &'static str,
+) -> Result<&'a RgbaImage, RobotError> {
+    obs.image(sensor, stage)
+}
