@@ -4,12 +4,13 @@
 //! default, for the corner paper's robot and a Small-Size one) and the paper's fixed speed.
 //!
 //!     cargo bench --bench avoidance
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_control::{
     AccelLimitedDrive, AvoidanceConfig, SpeedChoice, Surroundings, VelocityAware,
 };
@@ -33,7 +34,7 @@ fn frames() -> Vec<(FreeSpace, Vector2<f64>)> {
     let s = load_scenario(&common::scenario_path("corner55_velocity_aware.toml"))
         .expect("corner scenario loads");
     let spec = &s.robot.sensors[0];
-    let sensor = spec.build().expect("sensor");
+    let sensor = spec.build();
     let cal = calibrate_sensor(spec).expect("calibration");
     let mut detector = FreeSpaceDetector::new(s.vision.freespace.clone(), &cal).expect("detector");
     let goal = s.goal.as_ref().expect("goal").point();

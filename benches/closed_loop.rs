@@ -2,11 +2,12 @@
 //! controller, physics, recording) with the CPU renderer and, when an adapter exists, the GPU.
 //!
 //!     cargo bench --bench closed_loop
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
 use omniloop::load_scenario;
-use omniloop::simulation::{RunOptions, run_scenario};
+use omniloop::{RunOptions, run_scenario};
 use omniloop_sim::RendererChoice;
 
 fn main() {

@@ -4,6 +4,7 @@
 //! cross-correlation) — on frames rendered along a straight run over the marked floor.
 //!
 //!     cargo bench --bench forward
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
@@ -33,7 +34,7 @@ fn time(reps: usize, mut f: impl FnMut(usize)) -> f64 {
 fn main() {
     let s = load_scenario(&common::scenario_path("forward_odometry.toml")).expect("scenario");
     let camera = s.forward_camera().expect("a forward camera");
-    let sensor = s.robot.sensors[0].build().expect("sensor");
+    let sensor = s.robot.sensors[0].build();
     let scene = Scene::new(&s.world, &[]);
     let mut renderer = Renderer::cpu();
     let mut noise = SensorNoise::new(1);

@@ -2,12 +2,13 @@
 //! template, eq. (5)-(7)) on a 256x220 frame of the E1 corridor, both variants of eq. (5).
 //!
 //!     cargo bench --bench freespace
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
 use nalgebra::{Isometry2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, FreeSpaceMethod};
 use std::time::Instant;
@@ -16,7 +17,7 @@ fn main() {
     let path = common::scenario_path("corner55_velocity_aware.toml");
     let s = load_scenario(&path).expect("corner scenario loads");
     let spec = &s.robot.sensors[0];
-    let sensor = spec.build().expect("sensor");
+    let sensor = spec.build();
     let cal = calibrate_sensor(spec).expect("calibration");
     let mut bodies = s.robot_bodies();
     bodies[0].start = Isometry2::new(Vector2::new(-900.0, 250.0), 0.0);

@@ -3,12 +3,13 @@
 //! pattern match, at 256x256 through the hemispherical mirror.
 //!
 //!     cargo bench --bench heading
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
 use nalgebra::{Isometry2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::luminance_heading::{LuminanceCircle, LuminanceConfig, ShiftMethod};
 use std::time::Instant;
@@ -16,7 +17,7 @@ use std::time::Instant;
 fn main() {
     let s = load_scenario(&common::scenario_path("render_spherical.toml")).expect("scenario");
     let spec = &s.robot.sensors[0];
-    let sensor = spec.build().expect("sensor");
+    let sensor = spec.build();
     let cal = calibrate_sensor(spec).expect("calibration");
     let config = LuminanceConfig::default();
     let radius = config.circle_radius_px(&cal).expect("horizontal circle");

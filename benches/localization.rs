@@ -3,13 +3,14 @@
 //! paper's method, and ours in global and tracking mode (prior 100 mm and 5 degrees off).
 //!
 //!     cargo bench --bench localization
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
 use nalgebra::{Isometry2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
-use omniloop::experiments::ExperimentSpec;
+use omniloop::experiments::places::PlacesSpec;
 use omniloop::load_scenario;
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::{FloorLocalizer, LocalizationConfig, LocalizationMethod};
 use std::time::Instant;
@@ -18,13 +19,14 @@ fn main() {
     let path = common::scenario_path("selfloc_field.toml");
     let s = load_scenario(&path).expect("E2 scenario loads");
     let spec = &s.robot.sensors[0];
-    let sensor = spec.build().expect("sensor");
+    let sensor = spec.build();
     let cal = calibrate_sensor(spec).expect("calibration");
     let mut renderer = Renderer::cpu();
     let mut noise = SensorNoise::new(1);
-    let Some(ExperimentSpec::Places(places)) = &s.experiment else {
-        panic!("selfloc_field.toml has [experiment.places]");
-    };
+    let places: PlacesSpec = s
+        .experiment
+        .parse_present("experiment", "places")
+        .expect("selfloc_field.toml has [experiment.places]");
     let mut poses: Vec<Isometry2<f64>> = places.places.iter().map(|p| p.isometry()).collect();
     for (x, y, deg) in [
         (-1250.0, -650.0, 0.0),

@@ -4,6 +4,7 @@
 //! frames (the GPU traces a batch in one dispatch).
 //!
 //!     cargo bench --bench render
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
@@ -35,14 +36,14 @@ fn main() {
     let world = World::new(&s.world, &s.robot_bodies(), 0.002).expect("world");
     let scene = Scene::of_world(&world);
     let pose = world.robot_state(0).pose;
-    let small = s.robot.sensors[0].build().expect("sensor");
+    let small = s.robot.sensors[0].build();
     let mut big_spec = s.robot.sensors[0].clone();
     big_spec.width_px = 512;
     big_spec.height_px = 512;
-    if let Some(m) = big_spec.hyperbolic.as_mut() {
+    if let omniloop_sim::optics::Optics::Hyperbolic(m) = &mut big_spec.optics {
         m.focal_px *= 2.0;
     }
-    let big = big_spec.build().expect("sensor");
+    let big = big_spec.build();
 
     let mut renderers = vec![Renderer::cpu()];
     match Renderer::new(RendererChoice::Gpu, |_| {}) {

@@ -4,12 +4,13 @@
 //! image (both rings) for comparison.
 //!
 //!     cargo bench --bench resection
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::optics::Optics;
 use omniloop_sim::{Renderer, Scene, SensorNoise};
 use omniloop_vision::resection::{
@@ -46,7 +47,7 @@ fn main() {
     let mut noise = SensorNoise::new(1);
     let pose = Isometry2::new(Vector2::new(2560.0, 1380.0), 0.0);
     // Twenty frames of a sweep, 18 degrees apart: some show a mark, most do not.
-    let mut pan = s.robot.sensors[0].build().expect("sensor");
+    let mut pan = s.robot.sensors[0].build();
     let frames: Vec<image::RgbaImage> = (0..20)
         .map(|k| {
             if let Optics::Pinhole(c) = &mut pan.optics {
@@ -79,7 +80,7 @@ fn main() {
         black_box(resect(&marks[0], &marks[1], &marks[2]).ok());
     });
     let omni_spec = &s.robot.sensors[1];
-    let omni = omni_spec.build().expect("omni sensor");
+    let omni = omni_spec.build();
     let cal = calibrate_sensor(omni_spec).expect("omni calibration");
     let image = renderer
         .render(&scene, &omni, &pose, Some(&mut noise))

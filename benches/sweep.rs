@@ -2,6 +2,7 @@
 //! worker and with one worker a core; runs per second and the speed-up (target >= 0.9 x cores).
 //!
 //!     cargo bench --bench sweep
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
 
 mod common;
 

@@ -8,7 +8,7 @@ use nalgebra::{Isometry2, Rotation2, Vector2};
 use omniloop::control::{DeadReckoning, wrap_pi};
 use omniloop::robot::*; // RobotSoftware, Observation, Outputs, RobotConfig, ...
 use omniloop::vision::{FreeSpace, FreeSpaceDetector};
-use omniloop::{Runner, Summary, load_scenario, output::write_run};
+use omniloop::{Runner, Summary, load_scenario, report::write_run};
 
 const LOOKAHEAD_MM: f64 = 450.0; // how far the chosen corridor must be open
 const MARGIN_MM: f64 = 90.0; // the gap kept between body and obstacles

@@ -1,37 +1,28 @@
 //! omniloop: a closed-loop testbed where a simulated omnidirectional robot sees the world
 //! through a catadioptric camera and drives itself.
 //!
-//! This crate is the simulator's side of the loop: the scenario schema and its validation
-//! ([`scenario`], [`load`]), the loop that renders the robot's cameras, hands its software
-//! (`omniloop-robot`) what its sensors give and applies its commands ([`simulation`]), the
-//! sensors and actuators it simulates ([`cameras`], [`odometry`]), the truth-side scores
-//! ([`score`]), the experiments with their replays ([`experiments`]), what a run writes
-//! ([`record`], [`output`]) and the figures ([`topview`], [`charts`]). The world lives in `omniloop-sim`,
-//! image processing in `omniloop-vision`, controllers in `omniloop-control`.
+//! This crate is the simulator's side of the loop, in layers that import downward only:
+//! - [`scenario`]: the schema of a scenario file, its rules, parsing with located problems;
+//! - [`run`]: the loop that renders the robot's cameras, hands its software what its sensors
+//!   give and applies its commands ([`Simulation`]), the simulated sensors, the truth-side
+//!   scores and the records of a run;
+//! - [`report`]: a run's files and figures;
+//! - [`experiments`]: the registered experiments, which drive the loop, with their replays;
+//!   [`run_scenario`], [`Runner`] and [`load_scenario`];
+//! - [`sweep`]: many runs over a grid of values and seeds.
+//!
+//! The robot's software is anything that implements [`robot::RobotSoftware`]; the world lives
+//! in `omniloop-sim`, image processing in [`vision`], motion and avoidance in [`control`].
 
-pub mod calibrate;
-pub mod cameras;
-pub mod charts;
-pub mod column_calibration;
 pub mod experiments;
-pub mod load;
-pub mod odometry;
-pub mod output;
-pub mod pilot;
-pub mod record;
-pub mod runner;
+pub mod report;
+pub mod run;
 pub mod scenario;
-pub mod score;
-pub mod simulation;
 pub mod sweep;
-pub mod topview;
-pub mod validate;
 
-pub use load::{LoadError, Problem, load_scenario, parse_scenario};
-pub use record::{Summary, TrajectoryRow};
-pub use runner::Runner;
-pub use scenario::Scenario;
-pub use simulation::{RunOptions, RunOutput, Simulation, run_scenario};
+pub use experiments::{Runner, load_scenario, parse_scenario, run_scenario};
+pub use run::{RunOptions, RunOutput, Simulation, Summary, TrajectoryRow};
+pub use scenario::{LoadError, Problem, Scenario};
 
 /// Motion models and the avoidance controllers.
 pub use omniloop_control as control;

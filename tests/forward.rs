@@ -2,6 +2,7 @@
 //! Caparrelli): both avoidance methods among eight obstacles for a minute, the scan line's turns
 //! on the square of Fig. 8, the legs of Fig. 10 by Lucas-Kanade and by cross-correlation;
 //! scenario errors.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 mod common;
 

@@ -1,10 +1,11 @@
 //! End-to-end checks of the foundation: scenario files, the loop, determinism, the drive limit
 //! and contacts.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 mod common;
 
 use common::{bin, omniloop, scenario, scenario_path, tmp};
-use omniloop::record::write_trajectory_csv;
+use omniloop::run::record::write_trajectory_csv;
 use omniloop::{LoadError, load_scenario, parse_scenario, run_scenario};
 use std::path::{Path, PathBuf};
 
@@ -135,6 +136,33 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             "script_unknown_key",
             format!("{BASE}\n[control.script]\nspeed = 3.0\n"),
             ":11:1: field `control.script.speed`: unknown field `speed`",
+        ),
+        // A sensor's optics are one typed value, checked once where the file is parsed, and each
+        // mirror checks its own numbers.
+        (
+            "two_optics",
+            format!(
+                "{BASE}\n[[robot.sensors]]\nname = \"omni\"\n[robot.sensors.pinhole]\n\
+                 focal_px = 100.0\nheight_mm = 150.0\n[robot.sensors.spherical]\nradius_mm = 30.0\n\
+                 camera_distance_mm = 200.0\nfocal_px = 400.0\nlens_height_mm = 300.0\n"
+            ),
+            ":10:1: field `robot.sensors[0]`: sensor \"omni\": a sensor needs exactly one of the \
+             tables hyperbolic, conical, spherical, pinhole (found spherical, pinhole)",
+        ),
+        (
+            "no_optics",
+            format!("{BASE}\n[[robot.sensors]]\nname = \"omni\"\n"),
+            ":10:1: field `robot.sensors[0]`: sensor \"omni\": a sensor needs exactly one of the \
+             tables hyperbolic, conical, spherical, pinhole (found none)",
+        ),
+        (
+            "hyperbola_c",
+            format!(
+                "{BASE}\n[[robot.sensors]]\nname = \"omni\"\n[robot.sensors.hyperbolic]\n\
+                 a_mm = 12.129\nb_mm = 15.65\nc_mm = 25.0\nfocal_px = 479.37\n\
+                 focus_height_mm = 205.08\nrim_radius_mm = 30.0\n"
+            ),
+            ":15:1: field `robot.sensors[0].hyperbolic.c_mm`: must equal sqrt(a^2 + b^2)",
         ),
         (
             "unknown_control_table",

@@ -1,13 +1,14 @@
 //! E3 end to end: heading error from a luminance circle through the hemispherical mirror, at
 //! the checkpoint of the room and off it.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 mod common;
 
 use common::{cpu, scenario};
 use nalgebra::{Isometry2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
 use omniloop::experiments::heading::heading_results;
 use omniloop::run_scenario;
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::luminance_heading::{LuminanceConfig, near_ring};
 
@@ -67,7 +68,7 @@ fn the_inner_circle_tells_which_way_something_stands_near() {
     // -2300), 700 mm wide, has its face 250 mm from a robot at (1200, -1700): seen toward -y.
     let s = scenario("heading_room.toml");
     let spec = &s.robot.sensors[0];
-    let sensor = spec.build().unwrap();
+    let sensor = spec.build();
     let cal = calibrate_sensor(spec).unwrap();
     let config = LuminanceConfig::default();
     let mut renderer = Renderer::cpu();

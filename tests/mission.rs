@@ -1,12 +1,13 @@
 //! The robot's software behind its sensor boundary: its mission moves on where its own
 //! estimate says a target is reached, never where the truth does.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 mod common;
 
 use common::{cpu, scenario};
 use nalgebra::{Point2, Vector2};
-use omniloop::odometry::OdometrySpec;
 use omniloop::run_scenario;
+use omniloop::scenario::OdometrySpec;
 
 /// The odometry over-reads every distance by this fraction, and has no other error.
 const SCALE_BIAS: f64 = 0.15;

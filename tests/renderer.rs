@@ -1,11 +1,12 @@
 //! End-to-end checks of the catadioptric renderer: the hyperbolic mirror's image-to-floor map
 //! against the paper's f(R), the calibration fit, conical omnistereo range (eqs. (1)-(2) of
 //! Spacek and Burbridge), GPU/CPU agreement and golden images of the render examples.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 use nalgebra::{Isometry2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
 use omniloop::load_scenario;
-use omniloop::simulation::render_snapshot;
+use omniloop::run::render_snapshot;
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::optics::HyperbolicMirror;
 use omniloop_sim::render::SensorRays;
 use omniloop_sim::{
@@ -38,7 +39,7 @@ fn paper_f_inverse(r_mm: f64) -> f64 {
 fn every_pixel_of_the_corner_mirror_sees_the_floor_where_the_papers_f_says() {
     // The renderer's own scene rays, pixel by pixel: the floor point a pixel at image radius R
     // sees must image back, through the paper's f, within 0.5 px of R.
-    let sensor = SensorSpec::corner_paper("omni").build().unwrap();
+    let sensor = SensorSpec::corner_paper("omni").build();
     let mut worst: f64 = 0.0;
     let mut n = 0;
     for v in 0..sensor.height_px {
@@ -80,7 +81,7 @@ fn rendered_floor_edges_lie_between_the_pixels_the_papers_f_puts_them() {
         floor_rects: rects,
         ..Layout::default()
     };
-    let sensor = SensorSpec::corner_paper("omni").build().unwrap();
+    let sensor = SensorSpec::corner_paper("omni").build();
     let scene = Scene::new(&layout, &[]);
     let mut r = Renderer::cpu();
     let pose = Isometry2::new(Vector2::zeros(), 0.0);
@@ -180,8 +181,8 @@ fn measure(img: &image::RgbaImage) -> (f64, f64) {
 
 #[test]
 fn conical_omnistereo_range_follows_eqs_1_and_2() {
-    let lower = cone("lower", 100.0).build().unwrap();
-    let upper = cone("upper", 250.0).build().unwrap();
+    let lower = cone("lower", 100.0).build();
+    let upper = cone("upper", 250.0).build();
     let (d, big_r, s) = (100.0, 30.0, 150.0);
     let mut r = Renderer::cpu();
     for range in [1000.0, 1500.0, 2000.0, 3000.0] {
@@ -266,7 +267,7 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
         let scene = Scene::of_world(&world);
         let pose = world.robot_state(0).pose;
         for spec in &s.robot.sensors {
-            let sensor = spec.build().unwrap();
+            let sensor = spec.build();
             let mut r = Renderer::cpu();
             let culled = r.render_packed(&scene, &sensor, &pose).unwrap().to_vec();
             let rays = SensorRays::new(&sensor);
@@ -348,7 +349,7 @@ fn a_gpu_batch_equals_its_frames_traced_one_by_one() {
         let scene = Scene::of_world(&world);
         let pose = world.robot_state(0).pose;
         for spec in &s.robot.sensors {
-            frames.push((scene.clone(), spec.build().unwrap(), pose));
+            frames.push((scene.clone(), spec.build(), pose));
         }
     }
     assert!(frames.len() >= 6, "{} frames", frames.len());

@@ -1,14 +1,15 @@
 //! E2 end to end: floor-region self-localization at the six places, the error map over the
 //! whole field in both modes, and localization in the loop across the field and through its
 //! corners.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 mod common;
 
 use common::{cpu, omniloop, scenario, tmp};
-use omniloop::experiments::ExperimentSpec;
 use omniloop::experiments::localization_map::mode_stats;
+use omniloop::experiments::places::PlacesSpec;
 use omniloop::experiments::places::{place_results, places_table};
-use omniloop::record::Summary;
+use omniloop::run::record::Summary;
 use omniloop::run_scenario;
 use omniloop::scenario::PoseSpec;
 use omniloop_vision::LocalizationMethod;
@@ -21,13 +22,12 @@ fn every_place_within_30_mm_and_1_degree(
 ) -> Summary {
     let mut s = scenario("selfloc_field.toml");
     s.vision.localization.method = method;
-    if let (Some(ExperimentSpec::Places(spec)), Some(p)) = (&mut s.experiment, places) {
+    let mut spec: PlacesSpec = s.experiment.parse_present("experiment", "places").unwrap();
+    if let Some(p) = places {
         spec.places = p;
+        s.experiment.set("places", &spec).unwrap();
     }
-    let n = match &s.experiment {
-        Some(ExperimentSpec::Places(spec)) => spec.places.len(),
-        _ => panic!("selfloc_field.toml is E2"),
-    };
+    let n = spec.places.len();
     let out = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
     let places = place_results(&out.summary);
     assert_eq!(places.len(), n);

@@ -1,5 +1,6 @@
 //! `omniloop sweep` interrupted: alone in its binary, so that its signal meets no other test's
 //! processes.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 mod common;
 

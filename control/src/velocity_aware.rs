@@ -94,15 +94,6 @@ impl VelocityAware {
     /// robot takes if the next cycle finds nothing admissible. Each is sampled every
     /// `prediction_step_s`, and every obstacle must keep the clearance from each segment between
     /// samples.
-    pub fn path_is_clear(&self, v_now: Vec2, v_b: Vec2, obstacles: &[Vec2]) -> bool {
-        let c = self.radius_mm + self.config.margin_mm;
-        let obstacles: Vec<Obstacle> = obstacles
-            .iter()
-            .map(|&p| Obstacle { p, c2: c * c })
-            .collect();
-        self.clear_among(v_now, v_b, &obstacles)
-    }
-
     fn clear_among(&self, v_now: Vec2, v_b: Vec2, obstacles: &[Obstacle]) -> bool {
         let t_a = self.drive.settle_time_s(v_now, v_b);
         let period_brake =

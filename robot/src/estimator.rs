@@ -214,7 +214,9 @@ impl PoseEstimator {
         h: f64,
         dh: f64,
     ) -> Result<FixOutcome, String> {
-        let p = self.estimate().expect("callers checked the pose is known");
+        let Some(p) = self.estimate() else {
+            return Err("the pose is unknown: a partial fix cannot set it".to_string());
+        };
         let here = p.translation.vector;
         let target = position.unwrap_or(here);
         self.gate((target - here).norm(), dh)?;

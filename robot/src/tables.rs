@@ -88,17 +88,29 @@ impl Tables {
         section: &str,
         name: &str,
     ) -> Result<T, ConfigProblem> {
-        let Some(value) = self.0.get(name) else {
-            return Ok(T::default());
-        };
-        serde_path_to_error::deserialize(value.clone()).map_err(|e| {
-            let inner = e.path().to_string();
-            let field = match inner.as_str() {
-                "." | "" => format!("{section}.{name}"),
-                path => format!("{section}.{name}.{path}"),
-            };
-            ConfigProblem::new(field, e.into_inner().message().trim().to_string())
-        })
+        match self.0.get(name) {
+            None => Ok(T::default()),
+            Some(value) => deserialize(value, section, name),
+        }
+    }
+
+    /// Table `name` of section `section` parsed as `T`, which must be written; the problem
+    /// names the field that does not parse, or the table when it is missing.
+    pub fn parse_present<T: DeserializeOwned>(
+        &self,
+        section: &str,
+        name: &str,
+    ) -> Result<T, ConfigProblem> {
+        let value = self
+            .0
+            .get(name)
+            .ok_or_else(|| ConfigProblem::new(format!("{section}.{name}"), "missing"))?;
+        deserialize(value, section, name)
+    }
+
+    /// Whether no table is written.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
     }
 
     /// The names of the tables written.
@@ -113,4 +125,20 @@ impl Tables {
         self.0.insert(name.to_string(), v);
         Ok(())
     }
+}
+
+/// `value`, table `name` of section `section`, as `T`; the problem names the field at fault.
+fn deserialize<T: DeserializeOwned>(
+    value: &toml::Value,
+    section: &str,
+    name: &str,
+) -> Result<T, ConfigProblem> {
+    serde_path_to_error::deserialize(value.clone()).map_err(|e| {
+        let inner = e.path().to_string();
+        let field = match inner.as_str() {
+            "." | "" => format!("{section}.{name}"),
+            path => format!("{section}.{name}.{path}"),
+        };
+        ConfigProblem::new(field, e.into_inner().message().trim().to_string())
+    })
 }

@@ -101,7 +101,7 @@ mod tests {
 
     #[test]
     fn the_corner_mirror_horizon_is_near_114_px() {
-        let s = SensorSpec::corner_paper("omni").build().unwrap();
+        let s = SensorSpec::corner_paper("omni").build();
         let map = trace_radial_map(&s, 0.25).unwrap();
         // A - B sqrt(C + R^2) = 0 at R = sqrt((A/B)^2 - C).
         let expected = ((10.12f64 / 2.054e-2).powi(2) - 2.298e5).sqrt();
@@ -123,8 +123,7 @@ mod tests {
     #[test]
     fn a_conical_mirror_that_sees_no_floor_still_has_its_elevations() {
         let spec = SensorSpec {
-            hyperbolic: None,
-            conical: Some(crate::optics::ConicalMirror {
+            optics: crate::optics::Optics::Conical(crate::optics::ConicalMirror {
                 radius_mm: 30.0,
                 tip_distance_mm: 100.0,
                 focal_px: 300.0,
@@ -133,7 +132,7 @@ mod tests {
             }),
             ..SensorSpec::corner_paper("cone")
         };
-        let map = trace_radial_map(&spec.build().unwrap(), 0.25).unwrap();
+        let map = trace_radial_map(&spec.build(), 0.25).unwrap();
         assert!(map.samples.is_empty() && map.horizon_px == 0.0);
         assert!(map.elevation.len() > 10);
     }
@@ -143,8 +142,7 @@ mod tests {
         let spec = SensorSpec {
             width_px: 256,
             height_px: 256,
-            hyperbolic: None,
-            spherical: Some(crate::optics::SphericalMirror {
+            optics: crate::optics::Optics::Spherical(crate::optics::SphericalMirror {
                 radius_mm: 30.0,
                 camera_distance_mm: 150.0,
                 focal_px: 530.0,
@@ -152,7 +150,7 @@ mod tests {
             }),
             ..SensorSpec::corner_paper("hemi")
         };
-        let map = trace_radial_map(&spec.build().unwrap(), 0.25).unwrap();
+        let map = trace_radial_map(&spec.build(), 0.25).unwrap();
         let e = &map.elevation;
         assert!((e[0][1] + std::f64::consts::FRAC_PI_2).abs() < 1e-6);
         assert!(

@@ -10,7 +10,8 @@
 //! they are mitred too while the mitre stays short, else each piece runs on squarely past the
 //! corner by the thickness (the outside of a convex corner is never floor).
 
-use crate::layout::{FloorRect, Rgb};
+use crate::color::Rgb;
+use crate::floor_rect::FloorRect;
 use crate::shapes::{Solid, SolidShape};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;

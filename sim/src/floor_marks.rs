@@ -1,7 +1,7 @@
 //! Marks painted on the floor: squares and discs of their own colour (the dark marks a forward
 //! camera tracks for visual odometry), given one by one or scattered over an area at random.
 
-use crate::layout::Rgb;
+use crate::color::Rgb;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};

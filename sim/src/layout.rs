@@ -2,26 +2,13 @@
 //! pillars. Scenario files embed these types directly; [`Layout::solids`] turns them into the
 //! one list of solid shapes that both the physics world and the renderer use.
 
+use crate::color::Rgb;
 use crate::corridor::Corridor;
 use crate::floor_marks::{FloorMark, MarkScatter};
+use crate::floor_rect::FloorRect;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Point2, Vector2};
 use serde::{Deserialize, Serialize};
-
-/// An 8-bit RGB colour, written `[r, g, b]` in scenario files.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Rgb(pub [u8; 3]);
-
-impl Rgb {
-    /// Components scaled to 0..1.
-    pub fn to_unit(self) -> [f32; 3] {
-        [
-            self.0[0] as f32 / 255.0,
-            self.0[1] as f32 / 255.0,
-            self.0[2] as f32 / 255.0,
-        ]
-    }
-}
 
 /// The playing floor of the RoboCup Small-Size field (Fig. 6 of the corner paper, with the
 /// project's choices for goals, walls and lines). The field centre is the world origin, its long
@@ -161,30 +148,6 @@ impl FieldSpec {
         let r = (p.x * p.x + p.y * p.y).sqrt();
         let circle = (r - self.centre_circle_radius_mm).abs() <= w / 2.0;
         boundary || centre_line || circle
-    }
-}
-
-/// A rectangle of floor colour (for floors other than the field, e.g. corridors).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FloorRect {
-    /// Centre of the rectangle.
-    pub center_mm: [f64; 2],
-    /// Full side lengths along its own x and y axes.
-    pub size_mm: [f64; 2],
-    /// Rotation of its x axis from the world x axis.
-    #[serde(default)]
-    pub angle_deg: f64,
-}
-
-impl FloorRect {
-    /// Does the rectangle contain `p` (boundary included)?
-    pub fn contains(&self, p: Point2<f64>) -> bool {
-        let (s, c) = self.angle_deg.to_radians().sin_cos();
-        let d = p - Point2::from(self.center_mm);
-        let lx = c * d.x + s * d.y;
-        let ly = -s * d.x + c * d.y;
-        lx.abs() <= self.size_mm[0] / 2.0 && ly.abs() <= self.size_mm[1] / 2.0
     }
 }
 

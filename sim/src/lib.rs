@@ -3,8 +3,10 @@
 //! omnidirectional robots.
 
 pub mod calibration;
+pub mod color;
 pub mod corridor;
 pub mod floor_marks;
+pub mod floor_rect;
 pub mod layout;
 pub mod optics;
 pub mod render;
@@ -12,9 +14,11 @@ pub mod sensor;
 pub mod shapes;
 pub mod world;
 
+pub use color::Rgb;
 pub use corridor::Corridor;
 pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
-pub use layout::{Board, Cube, FieldSpec, FloorRect, Layout, Pillar, Rgb, Wall};
+pub use floor_rect::FloorRect;
+pub use layout::{Board, Cube, FieldSpec, Layout, Pillar, Wall};
 pub use render::{FrameRequest, RenderError, Renderer, RendererChoice, Scene, SensorNoise};
 pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};

@@ -1,49 +1,123 @@
 //! Sensors mounted on a robot: image size, principal point, noise and optics.
 
-use crate::SimError;
 use crate::optics::{ConicalMirror, HyperbolicMirror, Optics, PinholeCamera, SphericalMirror};
 use serde::{Deserialize, Serialize};
 
-/// A sensor as written in a scenario (`[[robot.sensors]]`): exactly one of the optics tables
-/// `hyperbolic`, `conical`, `spherical`, `pinhole` is given.
+/// A sensor as written in a scenario (`[[robot.sensors]]`), with its optics as one typed value:
+/// in the file, exactly one of the tables `hyperbolic`, `conical`, `spherical`, `pinhole`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "RawSensorSpec", into = "RawSensorSpec")]
 pub struct SensorSpec {
     /// Name the sensor is referred to by (`--sensor NAME`).
     pub name: String,
     /// Image width.
-    #[serde(default = "default_width")]
     pub width_px: u32,
     /// Image height.
-    #[serde(default = "default_height")]
     pub height_px: u32,
     /// Principal point (default: the image centre).
-    #[serde(default)]
     pub principal_point_px: Option<[f64; 2]>,
     /// Standard deviation of the Gaussian noise added to each channel of each pixel, in levels
     /// of 255.
-    #[serde(default = "default_noise")]
     pub noise_sigma: f64,
     /// Grey levels the camera delivers (e.g. 16 for the resection paper's digitizer): the image
     /// becomes grey, its luminance quantised to this many levels spread over 0..255, after the
     /// noise. Default: colour, 256 levels a channel.
-    #[serde(default)]
     pub grey_levels: Option<u32>,
     /// Position of the sensor's axis on the robot (x forward, y left).
-    #[serde(default)]
     pub mount_mm: [f64; 2],
-    /// Single-viewpoint hyperboloidal mirror.
+    /// Its optics: a mirror under which the camera looks up, or a pinhole camera.
+    pub optics: Optics,
+}
+
+/// A sensor as the file writes it: the optics as four optional tables, of which exactly one
+/// must be given; turned into a [`SensorSpec`] once, when the scenario is parsed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSensorSpec {
+    name: String,
+    #[serde(default = "default_width")]
+    width_px: u32,
+    #[serde(default = "default_height")]
+    height_px: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    principal_point_px: Option<[f64; 2]>,
+    #[serde(default = "default_noise")]
+    noise_sigma: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    grey_levels: Option<u32>,
     #[serde(default)]
-    pub hyperbolic: Option<HyperbolicMirror>,
-    /// Conical mirror.
-    #[serde(default)]
-    pub conical: Option<ConicalMirror>,
-    /// Spherical (hemispherical) mirror.
-    #[serde(default)]
-    pub spherical: Option<SphericalMirror>,
-    /// Pinhole camera.
-    #[serde(default)]
-    pub pinhole: Option<PinholeCamera>,
+    mount_mm: [f64; 2],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    hyperbolic: Option<HyperbolicMirror>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    conical: Option<ConicalMirror>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    spherical: Option<SphericalMirror>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pinhole: Option<PinholeCamera>,
+}
+
+impl TryFrom<RawSensorSpec> for SensorSpec {
+    type Error = String;
+
+    fn try_from(r: RawSensorSpec) -> Result<Self, String> {
+        let mut given: Vec<Optics> = Vec::new();
+        given.extend(r.hyperbolic.map(Optics::Hyperbolic));
+        given.extend(r.conical.map(Optics::Conical));
+        given.extend(r.spherical.map(Optics::Spherical));
+        given.extend(r.pinhole.map(Optics::Pinhole));
+        let optics = match given.len() {
+            1 => given.remove(0),
+            _ => {
+                let names: Vec<&str> = given.iter().map(Optics::kind).collect();
+                let found = if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                };
+                return Err(format!(
+                    "sensor {:?}: a sensor needs exactly one of the tables hyperbolic, conical, \
+                     spherical, pinhole (found {found})",
+                    r.name
+                ));
+            }
+        };
+        Ok(Self {
+            name: r.name,
+            width_px: r.width_px,
+            height_px: r.height_px,
+            principal_point_px: r.principal_point_px,
+            noise_sigma: r.noise_sigma,
+            grey_levels: r.grey_levels,
+            mount_mm: r.mount_mm,
+            optics,
+        })
+    }
+}
+
+impl From<SensorSpec> for RawSensorSpec {
+    fn from(s: SensorSpec) -> Self {
+        let mut r = Self {
+            name: s.name,
+            width_px: s.width_px,
+            height_px: s.height_px,
+            principal_point_px: s.principal_point_px,
+            noise_sigma: s.noise_sigma,
+            grey_levels: s.grey_levels,
+            mount_mm: s.mount_mm,
+            hyperbolic: None,
+            conical: None,
+            spherical: None,
+            pinhole: None,
+        };
+        match s.optics {
+            Optics::Hyperbolic(m) => r.hyperbolic = Some(m),
+            Optics::Conical(m) => r.conical = Some(m),
+            Optics::Spherical(m) => r.spherical = Some(m),
+            Optics::Pinhole(c) => r.pinhole = Some(c),
+        }
+        r
+    }
 }
 
 fn default_width() -> u32 {
@@ -67,61 +141,16 @@ impl SensorSpec {
             noise_sigma: 4.0,
             grey_levels: None,
             mount_mm: [0.0, 0.0],
-            hyperbolic: Some(HyperbolicMirror::corner_paper()),
-            conical: None,
-            spherical: None,
-            pinhole: None,
+            optics: Optics::Hyperbolic(HyperbolicMirror::corner_paper()),
         }
-    }
-
-    /// The names of the optics tables present.
-    pub fn optics_present(&self) -> Vec<&'static str> {
-        let mut v = Vec::new();
-        if self.hyperbolic.is_some() {
-            v.push("hyperbolic");
-        }
-        if self.conical.is_some() {
-            v.push("conical");
-        }
-        if self.spherical.is_some() {
-            v.push("spherical");
-        }
-        if self.pinhole.is_some() {
-            v.push("pinhole");
-        }
-        v
     }
 
     /// Resolves the description into a sensor.
-    pub fn build(&self) -> Result<Sensor, SimError> {
-        let present = self.optics_present();
-        if present.len() != 1 {
-            return Err(SimError::Invalid(format!(
-                "sensor {:?} needs exactly one of hyperbolic, conical, spherical, pinhole \
-                 (found {})",
-                self.name,
-                if present.is_empty() {
-                    "none".to_string()
-                } else {
-                    present.join(", ")
-                }
-            )));
-        }
-        let optics = if let Some(m) = &self.hyperbolic {
-            Optics::Hyperbolic(m.clone())
-        } else if let Some(m) = &self.conical {
-            Optics::Conical(m.clone())
-        } else if let Some(m) = &self.spherical {
-            Optics::Spherical(m.clone())
-        } else if let Some(c) = &self.pinhole {
-            Optics::Pinhole(c.clone())
-        } else {
-            unreachable!("one optics table is present")
-        };
+    pub fn build(&self) -> Sensor {
         let [cx, cy] = self
             .principal_point_px
             .unwrap_or([self.width_px as f64 / 2.0, self.height_px as f64 / 2.0]);
-        Ok(Sensor {
+        Sensor {
             name: self.name.clone(),
             width_px: self.width_px,
             height_px: self.height_px,
@@ -130,8 +159,8 @@ impl SensorSpec {
             noise_sigma: self.noise_sigma,
             grey_levels: self.grey_levels,
             mount_mm: self.mount_mm,
-            optics,
-        })
+            optics: self.optics.clone(),
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 //! height), with the exact 2-D distance and ray-cast queries used for clearance and free-space
 //! ground truth.
 
-use crate::layout::Rgb;
+use crate::color::Rgb;
 use nalgebra::{Point2, Vector2};
 
 /// The footprint of a solid.

@@ -10,7 +10,8 @@
 //! speculative contacts a few millimetres before touching).
 
 use crate::SimError;
-use crate::layout::{Layout, Rgb};
+use crate::color::Rgb;
+use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::{AccelLimitedDrive, DifferentialDrive, VelocityCommand};
@@ -212,16 +213,6 @@ impl World {
     /// The static solids (walls, cubes, pillars) in world coordinates.
     pub fn solids(&self) -> &[Solid] {
         &self.solids
-    }
-
-    /// Number of robots.
-    pub fn robot_count(&self) -> usize {
-        self.robots.len()
-    }
-
-    /// The body description of robot `i`.
-    pub fn robot_spec(&self, i: usize) -> &RobotBodySpec {
-        &self.robots[i].spec
     }
 
     /// Simulated time since the start.

@@ -2,12 +2,13 @@
 //! corner of any angle and width to a goal; the turn is measured along the first leg. Its replay, `corner55`, runs the
 //! 55-degree corner with both avoidance controllers.
 
-use super::{Experiment, Metrics, Replay, ReplayContext, ReplayRun, write_text};
-use crate::record::{Summary, TrajectoryRow};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::replay::{Replay, ReplayContext, ReplayRun, write_text};
+use crate::report::topview::{Marker, Panel, PathLayer, draw_panels};
+use crate::run::RunOutput;
+use crate::run::record::{Summary, TrajectoryRow};
+use crate::scenario::Checker;
 use crate::scenario::{PoseSpec, Scenario};
-use crate::simulation::RunOutput;
-use crate::topview::{Marker, Panel, PathLayer, draw_panels};
-use crate::validate::Checker;
 use nalgebra::{Point2, Vector2};
 use omniloop_robot::GoalSpec;
 use omniloop_sim::{Corridor, Rgb};
@@ -80,7 +81,7 @@ impl CornerSpec {
 
     /// Builds the corner into the scenario: its corridor, and the start and goal unless the
     /// scenario gives its own.
-    pub(crate) fn prepare(&self, s: &mut Scenario) {
+    fn prepare(&self, s: &mut Scenario) {
         s.world.corridors.push(self.corridor());
         s.robot.start.get_or_insert(PoseSpec {
             x_mm: -self.leg1_mm,
@@ -93,7 +94,7 @@ impl CornerSpec {
         }
     }
 
-    pub(crate) fn validate(&self, c: &mut Checker) {
+    fn validate(&self, c: &mut Checker) {
         let p = "experiment.corner";
         if !(self.angle_deg > 0.0 && self.angle_deg < 180.0) {
             c.fail(
@@ -121,6 +122,27 @@ impl CornerSpec {
                 ),
             );
         }
+    }
+}
+
+/// The registry's entry: `[experiment.corner]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "corner",
+    summary: "E1 of the corner paper (Sect. 5.1): a corridor corner, its turn metrics",
+    setup: |t| setup::<CornerSpec>(t, "corner"),
+};
+
+impl ExperimentSetup for CornerSpec {
+    fn prepare(&self, s: &mut Scenario) {
+        CornerSpec::prepare(self, s);
+    }
+
+    fn check(&self, _s: &Scenario, c: &mut Checker) {
+        self.validate(c);
+    }
+
+    fn procedure(&self, _s: &Scenario) -> Box<dyn Experiment> {
+        Box::new(Corner)
     }
 }
 

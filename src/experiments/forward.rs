@@ -4,12 +4,13 @@
 //! turns, Lucas-Kanade and cross-correlation the straight runs). Its replay, `forward`, runs
 //! both avoidance methods for a minute, the square of Fig. 8 and the two tests of Fig. 10.
 
-use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
-use crate::charts::{Chart, Series, Style, charts_png};
-use crate::output::write_run;
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::replay::{Replay, ReplayContext, write_text};
+use crate::report::charts::{Chart, Series, Style, charts_png};
+use crate::report::output::write_run;
+use crate::run::{OutputFile, RunError, RunOutput};
+use crate::scenario::Checker;
 use crate::scenario::Scenario;
-use crate::simulation::{OutputFile, RunError, RunOutput};
-use crate::validate::Checker;
 use nalgebra::{Isometry2, Vector2};
 use omniloop_control::wrap_pi;
 use omniloop_robot::Estimates;
@@ -28,7 +29,7 @@ const SCRIPT: &str = "script";
 pub struct ForwardSpec {}
 
 impl ForwardSpec {
-    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Checker) {
         let kind = s.control.kind.as_str();
         if AVOIDANCE.contains(&kind) || (kind == SCRIPT && s.vision.forward.visual_odometry) {
         } else if kind == SCRIPT {
@@ -51,6 +52,23 @@ impl ForwardSpec {
                 "experiment.forward's robot is a differential-drive robot: add [robot.differential]",
             );
         }
+    }
+}
+
+/// The registry's entry: `[experiment.forward]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "forward",
+    summary: "E6 of Ahmed, Saatchi and Caparrelli: a forward camera's avoidance or visual odometry",
+    setup: |t| setup::<ForwardSpec>(t, "forward"),
+};
+
+impl ExperimentSetup for ForwardSpec {
+    fn check(&self, s: &Scenario, c: &mut Checker) {
+        self.validate(s, c);
+    }
+
+    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
+        Box::new(Forward::new(s))
     }
 }
 
@@ -307,7 +325,7 @@ pub const PAPER_LEGS_IN: [(f64, f64, f64); 4] = [
     (9.5, 8.3, 8.6),
 ];
 
-fn moves_of(summary: &crate::record::Summary) -> Vec<MoveResult> {
+fn moves_of(summary: &crate::run::Summary) -> Vec<MoveResult> {
     summary
         .experiment
         .get("moves")

@@ -5,12 +5,13 @@
 //! directions), and reads its heading error from each frame, or N/A. Its replay, `heading`,
 //! runs it in the 8 m x 6 m room.
 
-use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
-use crate::charts::{Chart, Series, Style, charts_png};
-use crate::record::Summary;
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::replay::{Replay, ReplayContext, write_text};
+use crate::report::charts::{Chart, Series, Style, charts_png};
+use crate::run::record::Summary;
+use crate::run::{OutputFile, RunError, RunOutput, Simulation};
+use crate::scenario::Checker;
 use crate::scenario::{PoseSpec, Scenario};
-use crate::simulation::{OutputFile, RunError, RunOutput, Simulation};
-use crate::validate::Checker;
 use nalgebra::{Isometry2, Vector2};
 use omniloop_sim::SimError;
 use omniloop_vision::luminance_heading::{LuminanceCircle, LuminanceConfig, ShiftMethod};
@@ -65,7 +66,7 @@ pub const DIRECTIONS: [(&str, [f64; 2]); 4] = [
 ];
 
 impl HeadingSpec {
-    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Checker) {
         let at = "experiment.heading";
         c.pose_in_world(
             &format!("{at}.checkpoint"),
@@ -91,6 +92,31 @@ impl HeadingSpec {
                 "the robot needs a mirror camera (add a [[robot.sensors]] table)",
             );
         }
+    }
+}
+
+/// The registry's entry: `[experiment.heading]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "heading",
+    summary: "E3 of Kim, Kim and Kwon (Sect. 4): heading error from a luminance circle at a checkpoint",
+    setup: |t| setup::<HeadingSpec>(t, "heading"),
+};
+
+impl ExperimentSetup for HeadingSpec {
+    fn check(&self, s: &Scenario, c: &mut Checker) {
+        self.validate(s, c);
+    }
+
+    fn takes_frames(&self) -> bool {
+        true
+    }
+
+    fn table(&self, summary: &Summary) -> Option<String> {
+        Some(heading_table(summary))
+    }
+
+    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
+        Box::new(Heading::new(self, &s.vision.luminance_heading))
     }
 }
 
@@ -422,7 +448,10 @@ fn heading_csv(h: &Heading) -> String {
 
 /// Figs. 6-12 in four panels: the reference circle as a polar plot; the readings of each
 /// turn frame by frame; the sweep's error; the translations' readings, N/A marked.
-fn heading_figure(h: &Heading, summary: &Summary) -> Result<Vec<u8>, crate::topview::FigureError> {
+fn heading_figure(
+    h: &Heading,
+    summary: &Summary,
+) -> Result<Vec<u8>, crate::report::topview::FigureError> {
     const COLOURS: [[u8; 3]; 4] = [[30, 80, 220], [220, 60, 30], [20, 150, 60], [150, 60, 180]];
     let method = h.config.method;
     let n = h.reference.len().max(1);

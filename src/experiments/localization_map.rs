@@ -6,12 +6,12 @@
 //! with the reason. `omniloop replay selfloc` runs it after E2 and writes `selfloc_map.png`
 //! (the figure a user looks at first) and `selfloc_map.csv` (one row per place and mode).
 
-use super::{Experiment, Metrics};
-use crate::record::Summary;
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use crate::report::topview::{Mark, Panel, Spots, panels_png};
+use crate::run::record::Summary;
+use crate::run::{OutputFile, RunError, RunOutput, Simulation};
+use crate::scenario::Checker;
 use crate::scenario::Scenario;
-use crate::simulation::{OutputFile, RunError, RunOutput, Simulation};
-use crate::topview::{Mark, Panel, Spots, panels_png};
-use crate::validate::Checker;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::wrap_pi;
 use omniloop_sim::SimError;
@@ -55,7 +55,7 @@ impl Default for MapSpec {
 }
 
 impl MapSpec {
-    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Checker) {
         let at = "experiment.localization_map";
         if !(self.spacing_mm.is_finite() && self.spacing_mm >= 20.0) {
             c.fail(
@@ -93,6 +93,27 @@ impl MapSpec {
                 "no grid point leaves the robot's body clear of the walls and obstacles",
             );
         }
+    }
+}
+
+/// The registry's entry: `[experiment.localization_map]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "localization_map",
+    summary: "the self-localization error map: a grid over the whole floor region, both modes",
+    setup: |t| setup::<MapSpec>(t, "localization_map"),
+};
+
+impl ExperimentSetup for MapSpec {
+    fn check(&self, s: &Scenario, c: &mut Checker) {
+        self.validate(s, c);
+    }
+
+    fn table(&self, summary: &Summary) -> Option<String> {
+        Some(map_table(summary))
+    }
+
+    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
+        Box::new(LocalizationMap::new(self, s.vision.localization.method))
     }
 }
 
@@ -603,7 +624,7 @@ fn map_figure(
     scenario: &Scenario,
     summary: &Summary,
     entries: &[MapEntry],
-) -> Result<Vec<u8>, crate::topview::FigureError> {
+) -> Result<Vec<u8>, crate::report::topview::FigureError> {
     // Far enough from the grid point to tell the headings apart, near enough to stay by it.
     const OFFSET_MM: f64 = 45.0;
     let panels: Vec<Panel<'_>> = Mode::ALL

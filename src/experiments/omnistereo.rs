@@ -5,13 +5,14 @@
 //! compass's rotation and the interframe translation since the previous frame. Its replay,
 //! `omnistereo`, runs `scenarios/omnistereo_arena.toml`.
 
-use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
-use crate::charts::{Chart, Series, Style, charts_png};
-use crate::record::Summary;
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::replay::{Replay, ReplayContext, write_text};
+use crate::report::charts::{Chart, Series, Style, charts_png};
+use crate::run::record::Summary;
+use crate::run::score::quantile;
+use crate::run::{OutputFile, RunError, RunOutput};
+use crate::scenario::Checker;
 use crate::scenario::Scenario;
-use crate::score::quantile;
-use crate::simulation::{OutputFile, RunError, RunOutput};
-use crate::validate::Checker;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::wrap_pi;
 use omniloop_robot::Measurement;
@@ -34,7 +35,7 @@ fn default_band() -> [f64; 2] {
 }
 
 impl OmnistereoSpec {
-    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Checker) {
         let [a, b] = self.range_band_mm;
         if !(a >= 0.0 && b > a) {
             c.fail(
@@ -49,6 +50,27 @@ impl OmnistereoSpec {
                  \"omnistereo\"",
             );
         }
+    }
+}
+
+/// The registry's entry: `[experiment.omnistereo]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "omnistereo",
+    summary: "E4 of Spacek and Burbridge (Sect. 2): conical omnistereo range, trilateration, compass, interframe motion",
+    setup: |t| setup::<OmnistereoSpec>(t, "omnistereo"),
+};
+
+impl ExperimentSetup for OmnistereoSpec {
+    fn check(&self, s: &Scenario, c: &mut Checker) {
+        self.validate(s, c);
+    }
+
+    fn table(&self, summary: &Summary) -> Option<String> {
+        Some(omnistereo_table(summary))
+    }
+
+    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
+        Box::new(Omnistereo::new(self, s))
     }
 }
 
@@ -263,7 +285,7 @@ fn frames_csv(s: &Scores) -> String {
 }
 
 /// Range error against distance; trilateration, compass and interframe errors per frame.
-fn figure(e: &Omnistereo, s: &Scores) -> Result<Vec<u8>, crate::topview::FigureError> {
+fn figure(e: &Omnistereo, s: &Scores) -> Result<Vec<u8>, crate::report::topview::FigureError> {
     let frames = s.frames.max(1) as f64;
     let per_frame = |v: &[(usize, f64)]| v.iter().map(|&(k, x)| (k as f64, x)).collect();
     let top = |v: &[(usize, f64)], floor: f64| 1.1 * v.iter().map(|x| x.1).fold(floor, f64::max);

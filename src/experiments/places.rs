@@ -3,14 +3,15 @@
 //! frames with fresh sensor noise; each place is scored by its RMS errors. Its replay,
 //! `selfloc`, runs the six places on the Small-Size field.
 
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
 use super::localization_map::map_table;
-use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
-use crate::output::write_run;
-use crate::record::Summary;
+use super::replay::{Replay, ReplayContext, write_text};
+use crate::report::output::write_run;
+use crate::report::topview::{Marker, Panel, PathLayer, draw_panels};
+use crate::run::record::Summary;
+use crate::run::{RunError, RunOutput, Simulation};
+use crate::scenario::Checker;
 use crate::scenario::{PoseSpec, Scenario};
-use crate::simulation::{RunError, RunOutput, Simulation};
-use crate::topview::{Marker, Panel, PathLayer, draw_panels};
-use crate::validate::Checker;
 use anyhow::Context;
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::wrap_pi;
@@ -39,7 +40,7 @@ fn default_frames_per_place() -> u32 {
 }
 
 impl PlacesSpec {
-    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Checker) {
         if self.places.is_empty() {
             c.fail("experiment.places.places", "needs at least one place");
         }
@@ -61,6 +62,27 @@ impl PlacesSpec {
                  \"localization\"",
             );
         }
+    }
+}
+
+/// The registry's entry: `[experiment.places]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "places",
+    summary: "E2 of the corner paper (Sect. 5.2): self-localization at places on the field",
+    setup: |t| setup::<PlacesSpec>(t, "places"),
+};
+
+impl ExperimentSetup for PlacesSpec {
+    fn check(&self, s: &Scenario, c: &mut Checker) {
+        self.validate(s, c);
+    }
+
+    fn table(&self, summary: &Summary) -> Option<String> {
+        Some(places_table(summary))
+    }
+
+    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
+        Box::new(Places::new(self, s.vision.localization.method))
     }
 }
 

@@ -5,13 +5,14 @@
 //! moment of the fix. Its replay, `resection`, runs the ten places of Table 1 and a place
 //! behind a cabinet with the panning camera, then again with an omnidirectional camera.
 
-use super::{Experiment, Metrics, Replay, ReplayContext, write_text};
-use crate::output::write_run;
-use crate::record::Summary;
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::replay::{Replay, ReplayContext, write_text};
+use crate::report::output::write_run;
+use crate::report::topview::{Mark, Marker, Panel, Spots, panels_png};
+use crate::run::record::Summary;
+use crate::run::{OutputFile, RunError, RunOutput, Simulation};
+use crate::scenario::Checker;
 use crate::scenario::{PoseSpec, Scenario};
-use crate::simulation::{OutputFile, RunError, RunOutput, Simulation};
-use crate::topview::{Mark, Marker, Panel, Spots, panels_png};
-use crate::validate::Checker;
 use nalgebra::Point2;
 use omniloop_control::wrap_pi;
 use omniloop_robot::Measurement;
@@ -35,7 +36,7 @@ fn default_timeout() -> f64 {
 }
 
 impl ResectionSpec {
-    pub(crate) fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Checker) {
         if self.places.is_empty() {
             c.fail("experiment.resection.places", "needs at least one place");
         }
@@ -55,6 +56,27 @@ impl ResectionSpec {
                  \"resection\"",
             );
         }
+    }
+}
+
+/// The registry's entry: `[experiment.resection]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "resection",
+    summary: "E5 of Ishikawa, Kikuchi and Kato: three-mark resection at places",
+    setup: |t| setup::<ResectionSpec>(t, "resection"),
+};
+
+impl ExperimentSetup for ResectionSpec {
+    fn check(&self, s: &Scenario, c: &mut Checker) {
+        self.validate(s, c);
+    }
+
+    fn table(&self, summary: &Summary) -> Option<String> {
+        Some(resection_table(&[summary]))
+    }
+
+    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
+        Box::new(Resection::new(self, s))
     }
 }
 
@@ -212,7 +234,7 @@ fn figure(
     s: &Scenario,
     camera: &str,
     results: &[PlaceResult],
-) -> Result<Vec<u8>, crate::topview::FigureError> {
+) -> Result<Vec<u8>, crate::report::topview::FigureError> {
     let mm = |c: [f64; 2]| Point2::new(c[0] * 10.0, c[1] * 10.0);
     let markers = results
         .iter()

@@ -1,11 +1,11 @@
 //! `sweep.png`: a metric's mean over the seeds, as a heat map over the first two swept keys
 //! (averaged over any further ones), a line over the one swept key, or a line over the seeds.
 
-use super::Plan;
+use super::plan::Plan;
 use super::report::{Aggregate, Row, aggregates};
 use super::set::value_text;
-use crate::charts::{Chart, Series, Style, charts_png};
-use crate::topview::{FigureError, png_bytes, register_font};
+use crate::report::charts::{Chart, Series, Style, charts_png};
+use crate::report::topview::{FigureError, png_bytes, register_font};
 use plotters::prelude::*;
 
 /// The figure of `metric` (`success_rate` or a column of `sweep.csv`).
@@ -257,6 +257,7 @@ fn heat_map(plan: &Plan, aggs: &[Aggregate], metric: &str) -> Result<Vec<u8>, Fi
         }
         root.present().map_err(|e| fail(e.to_string()))?;
     }
-    let img = image::RgbImage::from_raw(w, h, buf).expect("buffer size matches the image");
+    let img = image::RgbImage::from_raw(w, h, buf)
+        .ok_or_else(|| fail("the drawing buffer does not match the image size".into()))?;
     png_bytes("sweep.png", &img)
 }

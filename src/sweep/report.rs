@@ -2,8 +2,9 @@
 //! its `summary.json`, the error if any) and `sweep.md` (one row a combination: runs, success
 //! rate, contacts, mean and worst of the main metrics).
 
+use super::plan::{Plan, describe};
 use super::set::value_text;
-use super::{Outcome, Plan, describe};
+use super::workers::Outcome;
 use serde_json::Value as Json;
 use std::fmt::Write as _;
 
@@ -186,18 +187,17 @@ const LESS_IS_WORSE: [&str; 2] = ["min_clearance_mm", "cycles_per_s"];
 pub fn aggregates(rows: &[Row]) -> Vec<Aggregate> {
     let mut out: Vec<Aggregate> = Vec::new();
     for r in rows {
-        if out.last().is_none_or(|a| a.combination != r.combination) {
-            out.push(Aggregate {
+        match out.last_mut() {
+            Some(a) if a.combination == r.combination => a.rows.push(r.clone()),
+            _ => out.push(Aggregate {
                 combination: r.combination,
                 runs: 0,
                 errors: 0,
                 success_rate: 0.0,
                 contacts: 0,
-                rows: Vec::new(),
-            });
+                rows: vec![r.clone()],
+            }),
         }
-        let a = out.last_mut().expect("pushed above");
-        a.rows.push(r.clone());
     }
     for a in &mut out {
         let ran: Vec<&Row> = a
@@ -313,8 +313,8 @@ mod tests {
     #[test]
     fn failed_and_unstarted_runs_keep_their_rows() {
         let scenario = crate::Scenario::from_toml("[robot]\n").expect("a bare scenario parses");
-        let set = super::super::Set::parse("robot.max_speed_mm_s=400").unwrap();
-        let job = |index| super::super::Job {
+        let set = crate::sweep::set::Set::parse("robot.max_speed_mm_s=400").unwrap();
+        let job = |index| crate::sweep::plan::Job {
             index,
             combination: 0,
             values: set.values.clone(),

@@ -205,7 +205,7 @@ fn parse_value(text: &str) -> Result<Vec<Value>, String> {
         return Ok(range);
     }
     match toml::from_str::<Table>(&format!("v = {text}")) {
-        Ok(mut t) => Ok(vec![t.remove("v").expect("parsed the key v")]),
+        Ok(mut t) => Ok(t.remove("v").into_iter().collect()),
         Err(_)
             if text.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
                 && text

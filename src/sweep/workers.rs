@@ -3,10 +3,11 @@
 //! every worker is busy each renders on its own thread, and a thread left idle (the last runs of
 //! a sweep) helps the others render, so the cores are neither oversubscribed nor left waiting.
 
-use super::{Job, Plan};
-use crate::output::write_run;
-use crate::record::Summary;
-use crate::simulation::{RunOptions, run_scenario};
+use super::plan::{Job, Plan};
+use crate::experiments::run_scenario;
+use crate::report::output::write_run;
+use crate::run::RunOptions;
+use crate::run::record::Summary;
 use omniloop_sim::render::{BatchHandle, BatchServer, GpuRenderer};
 use omniloop_sim::{RenderError, RendererChoice};
 use std::path::PathBuf;

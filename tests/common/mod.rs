@@ -1,7 +1,9 @@
 //! Helpers shared by the end-to-end tests.
 #![allow(dead_code)]
+// Helpers of tests: a broken fixture stops the test where it breaks.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use omniloop::simulation::RunOptions;
+use omniloop::run::RunOptions;
 use omniloop::{Scenario, load_scenario};
 use omniloop_sim::RendererChoice;
 use std::ffi::OsStr;

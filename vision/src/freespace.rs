@@ -120,13 +120,6 @@ pub struct FreeSpace {
     pub clear_points: Vec<Point2<f64>>,
 }
 
-impl FreeSpace {
-    /// Whether direction j is free all through the template.
-    pub fn is_clear(&self, j: usize, rings: usize) -> bool {
-        self.a[j] >= rings
-    }
-}
-
 const NONE: u16 = u16::MAX;
 
 /// The polar template laid on the image.
@@ -315,16 +308,6 @@ impl PolarTemplate {
     /// Ring edges on the floor.
     pub fn edges_mm(&self) -> &[f64] {
         &self.edges_mm
-    }
-
-    /// Cell index of pixel `(x, y)` of the image, if it lies inside a cell.
-    pub fn cell_at(&self, x: usize, y: usize) -> Option<(usize, usize)> {
-        let [x0, y0, x1, y1] = self.bbox;
-        if x < x0 || y < y0 || x >= x1 || y >= y1 {
-            return None;
-        }
-        let c = self.cells[(y - y0) * (x1 - x0) + (x - x0)];
-        (c != NONE).then(|| (c as usize / self.directions, c as usize % self.directions))
     }
 }
 

@@ -8,7 +8,8 @@
 //! `h1 - h2 = v s / (r + d)`, which is eq. (1) `r = v s / (h1 - h2) - d`, and the rim images at
 //! `r_m = v R / (d + R)`, eq. (2) `v = (d / R + 1) r_m`.
 
-use super::{Ray, reflect};
+use super::problems::Problems;
+use super::ray::{Ray, reflect};
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -34,6 +35,20 @@ fn default_apex() -> f64 {
 }
 
 impl ConicalMirror {
+    /// Its numbers that break a rule: the key and why.
+    pub fn problems(&self) -> Vec<(&'static str, String)> {
+        let mut p = Problems::default();
+        if !(self.apex_angle_deg > 0.0 && self.apex_angle_deg < 180.0) {
+            let why = format!("must lie in (0, 180) (got {})", self.apex_angle_deg);
+            p.fail("apex_angle_deg", why);
+        }
+        p.positive("radius_mm", self.radius_mm);
+        p.positive("tip_distance_mm", self.tip_distance_mm);
+        p.positive("focal_px", self.focal_px);
+        p.positive("lens_height_mm", self.lens_height_mm);
+        p.0
+    }
+
     /// The scene ray for image coordinates `(X, Y)`; `None` outside the rim.
     pub fn scene_ray(&self, x_px: f64, y_px: f64) -> Option<Ray> {
         let k = (self.apex_angle_deg.to_radians() / 2.0).tan();

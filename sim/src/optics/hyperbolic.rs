@@ -6,7 +6,8 @@
 //! the floor. For such a mirror the image-to-floor map has the form
 //! `r = f(R) = R / (A - B sqrt(C + R^2))` (Sect. 5 of the corner paper, model of Yagi [6]).
 
-use super::{Ray, reflect, solve_quadratic};
+use super::problems::Problems;
+use super::ray::{Ray, reflect, solve_quadratic};
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -30,6 +31,35 @@ pub struct HyperbolicMirror {
 }
 
 impl HyperbolicMirror {
+    /// Its numbers that break a rule: the key and why.
+    pub fn problems(&self) -> Vec<(&'static str, String)> {
+        let mut p = Problems::default();
+        for (k, v) in [
+            ("a_mm", self.a_mm),
+            ("b_mm", self.b_mm),
+            ("c_mm", self.c_mm),
+            ("focal_px", self.focal_px),
+            ("focus_height_mm", self.focus_height_mm),
+            ("rim_radius_mm", self.rim_radius_mm),
+        ] {
+            p.positive(k, v);
+        }
+        let exact = self.a_mm.hypot(self.b_mm);
+        if (self.c_mm - exact).abs() > 1e-3 * exact {
+            let got = self.c_mm;
+            let why =
+                format!("must equal sqrt(a^2 + b^2) = {exact:.4} mm to within 0.1% (got {got})");
+            p.fail("c_mm", why);
+        }
+        if self.focus_height_mm <= 2.0 * exact {
+            p.fail(
+                "focus_height_mm",
+                "puts the camera (2 c below the focus) under the floor",
+            );
+        }
+        p.0
+    }
+
     /// The mirror reconstructed from the corner paper's calibration (`docs/experiments.md`):
     /// f = sqrt(C) = 479.37 px, b/c = 0.79040, c = 19.8 mm, viewpoint 205.08 mm above the floor.
     pub fn corner_paper() -> Self {

@@ -1,7 +1,8 @@
 //! A plain pinhole camera on the robot, panned about the vertical and tilted about its own
 //! horizontal axis (for forward-looking experiments).
 
-use super::Ray;
+use super::problems::Problems;
+use super::ray::Ray;
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -29,6 +30,27 @@ fn default_pan_rate() -> f64 {
 }
 
 impl PinholeCamera {
+    /// Its numbers that break a rule: the key and why.
+    pub fn problems(&self) -> Vec<(&'static str, String)> {
+        let mut p = Problems::default();
+        p.positive("focal_px", self.focal_px);
+        p.positive("height_mm", self.height_mm);
+        p.positive("pan_rate_limit_deg_s", self.pan_rate_limit_deg_s);
+        if self.pan_deg.is_nan() || self.pan_deg.abs() > 180.0 {
+            p.fail(
+                "pan_deg",
+                format!("must lie in [-180, 180] (got {})", self.pan_deg),
+            );
+        }
+        if self.tilt_deg.is_nan() || self.tilt_deg.abs() > 90.0 {
+            p.fail(
+                "tilt_deg",
+                format!("must lie in [-90, 90] (got {})", self.tilt_deg),
+            );
+        }
+        p.0
+    }
+
     /// Forward, right and up unit vectors of the camera in the robot frame.
     pub fn basis(&self) -> [Vector3<f64>; 3] {
         let (sp, cp) = self.pan_deg.to_radians().sin_cos();

@@ -3,7 +3,8 @@
 //! A ball of radius `radius_mm` with its centre `camera_distance_mm` above the camera's pinhole;
 //! the camera sees its lower half. Non-central: the scene rays do not share a viewpoint.
 
-use super::{Ray, reflect, solve_quadratic};
+use super::problems::Problems;
+use super::ray::{Ray, reflect, solve_quadratic};
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -22,6 +23,22 @@ pub struct SphericalMirror {
 }
 
 impl SphericalMirror {
+    /// Its numbers that break a rule: the key and why.
+    pub fn problems(&self) -> Vec<(&'static str, String)> {
+        let mut p = Problems::default();
+        p.positive("radius_mm", self.radius_mm);
+        p.positive("focal_px", self.focal_px);
+        p.positive("lens_height_mm", self.lens_height_mm);
+        if self.camera_distance_mm.is_nan() || self.camera_distance_mm <= self.radius_mm {
+            let (r, d) = (self.radius_mm, self.camera_distance_mm);
+            p.fail(
+                "camera_distance_mm",
+                format!("must exceed radius_mm = {r} (got {d})"),
+            );
+        }
+        p.0
+    }
+
     /// The scene ray for image coordinates `(X, Y)`; `None` when the camera ray misses the ball.
     pub fn scene_ray(&self, x_px: f64, y_px: f64) -> Option<Ray> {
         let d = Vector3::new(x_px, y_px, self.focal_px).normalize();

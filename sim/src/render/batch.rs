@@ -4,8 +4,9 @@
 //! hands each run its image. Runs that render in the same cycle so share the GPU's fixed cost
 //! per dispatch; a frame's image is the one it would get alone.
 
+use super::error::RenderError;
 use super::gpu::{FrameRequest, GpuRenderer};
-use super::{RenderError, Scene};
+use super::scene::Scene;
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};

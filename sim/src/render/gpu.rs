@@ -7,7 +7,7 @@
 //! One [`GpuRenderer`] owns its device, pipeline and buffers; buffers grow when a batch needs more
 //! room and are reused otherwise.
 
-use super::RenderError;
+use super::error::RenderError;
 use super::scene::{
     BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals,
 };

@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod cpu;
+pub mod error;
 pub mod gpu;
 pub mod noise;
 pub mod scene;
@@ -10,6 +11,7 @@ pub mod trace;
 
 pub use batch::{BatchClient, BatchHandle, BatchServer};
 pub use cpu::{CpuRenderer, SensorRays};
+pub use error::RenderError;
 pub use gpu::{FrameRequest, GpuRenderer};
 pub use noise::SensorNoise;
 pub use scene::Scene;
@@ -19,18 +21,9 @@ use image::RgbaImage;
 use nalgebra::Isometry2;
 use std::str::FromStr;
 
-/// Why rendering is not possible.
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    /// No GPU adapter (hardware or software driver) was found.
-    #[error(
-        "no GPU adapter found ({0}); on Debian/Ubuntu install Mesa's software Vulkan driver with \
-         `sudo apt-get install mesa-vulkan-drivers libvulkan1`, or use --renderer cpu"
-    )]
-    NoAdapter(String),
-    /// The device failed.
-    #[error("GPU device error: {0}")]
-    Device(String),
+/// The CPU renderer's name, with its threads.
+fn cpu_name() -> String {
+    format!("cpu (rayon, {} threads)", rayon::current_num_threads())
 }
 
 /// Which renderer to use.
@@ -98,7 +91,7 @@ impl Renderer {
             },
         };
         let name = match &backend {
-            Backend::Cpu(_) => format!("cpu (rayon, {} threads)", rayon::current_num_threads()),
+            Backend::Cpu(_) => cpu_name(),
             Backend::Gpu(g) => g.adapter_name().to_string(),
             Backend::Shared(_) => "shared GPU (batched)".to_string(),
         };
@@ -123,7 +116,12 @@ impl Renderer {
 
     /// The CPU renderer.
     pub fn cpu() -> Self {
-        Self::new(RendererChoice::Cpu, |_| {}).expect("the CPU renderer always opens")
+        Self {
+            backend: Backend::Cpu(CpuRenderer::new()),
+            name: cpu_name(),
+            rays: Vec::new(),
+            pixels: Vec::new(),
+        }
     }
 
     /// Name of the renderer: the adapter for the GPU, `cpu (...)` otherwise.

@@ -4,8 +4,9 @@
 //!
 //! Both tracers, the WGSL one and the CPU reference, read exactly these arrays.
 
+use crate::color::Rgb;
 use crate::floor_marks::MarkShape;
-use crate::layout::{Layout, Rgb};
+use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use crate::world::World;
 use bytemuck::{Pod, Zeroable};

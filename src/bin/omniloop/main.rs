@@ -4,10 +4,11 @@ use anyhow::{Context, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::{Isometry2, Vector2};
-use omniloop::calibrate::calibrate_sensor;
-use omniloop::experiments::{REPLAYS, ReplayContext, replay};
-use omniloop::output::{default_out_dir, write_run};
-use omniloop::simulation::{RunOptions, render_snapshot};
+use omniloop::experiments::registry::setup_of;
+use omniloop::experiments::{REPLAYS, ReplayContext, parse_scenario, replay, run_dyn};
+use omniloop::report::output::{default_out_dir, write_run};
+use omniloop::run::{RunOptions, render_snapshot};
+use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop::sweep::Seeds;
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice};
@@ -181,11 +182,10 @@ fn styled_bar(total: u64, quiet: bool, template: &str) -> ProgressBar {
         return ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
     }
     let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template(template)
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
+    // The templates are the program's own; one that does not parse keeps the default style.
+    if let Ok(style) = ProgressStyle::with_template(template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
     bar
 }
 
@@ -231,7 +231,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 print!("{DEFAULT_SCENARIO}");
                 return Ok(());
             }
-            let path = scenario.expect("clap requires a scenario");
+            let Some(path) = scenario else {
+                bail!("omniloop run needs a scenario file (or --print-default)");
+            };
             let mut s = load(&path)?;
             if let Some(seed) = seed {
                 s.seed = seed;
@@ -241,7 +243,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 renderer,
                 save_frames_every: save_frames,
                 frames_dir: save_frames.map(|_| dir.join("frames")),
-                shared_gpu: None,
+                ..RunOptions::default()
             };
             let bar = progress_bar(s.max_cycles(), quiet);
             bar.set_prefix(s.name.clone());
@@ -255,7 +257,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             bar.finish_and_clear();
             write_run(&dir, &s, &output)?;
             let m = &output.summary;
-            if let Some(table) = s.experiment.as_ref().and_then(|e| e.table(m)) {
+            let experiment = setup_of(&s).ok().flatten();
+            if let Some(table) = experiment.and_then(|e| e.table(m)) {
                 print!("{table}");
                 println!("results in {}", dir.display());
                 return Ok(());
@@ -349,6 +352,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 seed,
                 progress: &mut progress,
                 notice: &mut notice,
+                load: parse_scenario,
+                run: run_dyn,
             })?;
             bar.finish_and_clear();
             print!("{table}");

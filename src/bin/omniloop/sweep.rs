@@ -8,7 +8,7 @@ use omniloop::sweep::{
     PlanError, Seeds, Set, SweepOptions, known_metric, plan, rows, run_jobs, shared_gpu,
     write_outputs,
 };
-use omniloop::{LoadError, output::default_out_dir};
+use omniloop::{LoadError, report::default_out_dir};
 use omniloop_sim::RendererChoice;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};

@@ -68,7 +68,11 @@ impl FloorLocalizer {
                 break;
             }
         }
-        let (rms, used, lines) = fit.expect("at least one iteration ran");
+        let Some((rms, used, lines)) = fit else {
+            return Localization::NotLocalized(
+                "no iteration of the fit ran (max_iterations is 0)".into(),
+            );
+        };
         let frame = FieldFrame { centre, psi };
         let (chosen, other, by_goals) = self.choose(img, &frame, hint);
         Localization::Localized(PoseEstimate {

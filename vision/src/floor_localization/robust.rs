@@ -212,7 +212,7 @@ impl FloorLocalizer {
     ) -> Result<(FieldFrame, Step, usize), String> {
         let start = FieldFrame::of_pose(prior);
         let direct = self.refine(points, model, start, self.config.max_iterations);
-        if let Some((_, step, iterations)) = &direct {
+        if let Some(found @ (_, step, iterations)) = &direct {
             let q = quality(
                 step,
                 points.len(),
@@ -221,7 +221,7 @@ impl FloorLocalizer {
                 LocalizationMode::Tracking,
             );
             if self.rejection(&q).is_none() {
-                return Ok(direct.expect("checked"));
+                return Ok(found.clone());
             }
         }
         let near_prior = |f: &FieldFrame| {

@@ -10,10 +10,11 @@
 //! of once per frame (ours: at 6 mm a frame and about 0.3 px of error per match, consecutive
 //! frames read a 240 mm leg to about 2%; 1 restores the paper's way).
 
+use super::camera::ForwardCamera;
+use super::grey::Grey;
 use super::harris::{HarrisConfig, harris_corners};
 use super::lk::{LkConfig, track_lk};
 use super::ncc::{NccConfig, match_ncc};
-use super::{ForwardCamera, Grey};
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use serde::{Deserialize, Serialize};
 

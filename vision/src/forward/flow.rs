@@ -5,7 +5,7 @@
 //! over the 2x2x2 cube of two frames; the local averages `u_bar`, `v_bar` use their 3x3 kernel
 //! (1/6 at the sides, 1/12 at the corners). Each iteration applies eqs. (1)-(2) everywhere.
 
-use super::Grey;
+use super::grey::Grey;
 use imageproc::kernel::Kernel;
 use serde::{Deserialize, Serialize};
 

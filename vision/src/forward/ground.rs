@@ -13,7 +13,8 @@
 //! off the centre line but in the robot's way stops it too. The sides' clearances are the mean
 //! run of ground over the left and the right half.
 
-use super::{ForwardCamera, Grey};
+use super::camera::ForwardCamera;
+use super::grey::Grey;
 use image::{GrayImage, Luma};
 use imageproc::distance_transform::Norm;
 use nalgebra::Point2;

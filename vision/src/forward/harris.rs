@@ -2,7 +2,7 @@
 //! `R = det(M) - k trace(M)^2` of the structure tensor `M`, the Gaussian-weighted sum of the
 //! products of the image gradients, kept at local maxima above a fraction of the strongest.
 
-use super::Grey;
+use super::grey::Grey;
 use imageproc::kernel::Kernel;
 use serde::{Deserialize, Serialize};
 

@@ -6,7 +6,7 @@
 //! feature moves near the bottom of the image between two frames stay within reach.
 
 use super::flow::reduce;
-use super::{Grey, bilinear};
+use super::grey::{Grey, bilinear};
 use serde::{Deserialize, Serialize};
 
 /// Settings of the tracker (`[vision.forward.odometry.lk]`).
@@ -49,11 +49,13 @@ pub fn pyramid(img: &Grey, levels: u32, sigma_px: f32) -> Vec<Grey> {
     } else {
         img.clone()
     };
-    let mut out = vec![base];
+    let mut out = Vec::with_capacity(levels.max(1) as usize);
+    let mut level = base;
     for _ in 1..levels.max(1) {
-        let next = reduce(out.last().expect("the pyramid has its base"), 2);
-        out.push(next);
+        let next = reduce(&level, 2);
+        out.push(std::mem::replace(&mut level, next));
     }
+    out.push(level);
     out
 }
 

@@ -9,7 +9,7 @@
 //! window of the second; the best `C` wins. The paper keeps whole pixels; we refine the peak by
 //! a parabola through its neighbours along each axis (ours).
 
-use super::Grey;
+use super::grey::Grey;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the matcher (`[vision.forward.odometry.ncc]`).

@@ -5,10 +5,11 @@
 //! scan line") also predicts where each feature went, which starts the tracker and centres the
 //! matcher's search.
 
+use super::camera::ForwardCamera;
 use super::features::{FeatureConfig, FeatureMotion, FeatureTracks};
+use super::grey::Grey;
 use super::lk::pyramid;
 use super::scanline::{ScanLine, ScanLineConfig};
-use super::{ForwardCamera, Grey};
 use crate::VisionError;
 use serde::{Deserialize, Serialize};
 

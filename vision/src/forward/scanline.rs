@@ -9,7 +9,8 @@
 //! shift of the profile and `alpha` (eq. (5)) is the bin's angular width, from the camera's
 //! intrinsics and tilt. An untilted camera's bins are its columns, as in the paper.
 
-use super::{ForwardCamera, Grey, bilinear};
+use super::camera::ForwardCamera;
+use super::grey::{Grey, bilinear};
 use crate::VisionError;
 use serde::{Deserialize, Serialize};
 

@@ -12,7 +12,8 @@
 //! `|l| <= max_rotation_deg`; a parabola through the peak and its neighbours gives the
 //! fraction of a sample. Rings of stronger contrast weigh more (the profiles are not scaled).
 
-use super::{MirrorRim, below, positive};
+use super::numbers::{below, positive};
+use super::rim::MirrorRim;
 use crate::VisionError;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};

@@ -17,7 +17,7 @@
 //! convergence: a minority of outliers, however far, never moves the estimate, and a cluster of
 //! outliers wins only by outweighing the true one.
 
-use super::wrap;
+use super::numbers::wrap;
 use crate::VisionError;
 use nalgebra::Vector2;
 
@@ -76,11 +76,6 @@ pub fn translation_candidates(pairs: &[FeaturePair], rotation_rad: f64) -> Vec<C
 /// Combines the solutions robustly (see the module's description); `k` is the agreement
 /// radius in units of the expected error.
 pub fn densest_cluster(candidates: &[Candidate], k: f64) -> Result<Translation, VisionError> {
-    if candidates.is_empty() {
-        return Err(VisionError::NotFound(
-            "no feature seen in both frames: no translation".into(),
-        ));
-    }
     let w = |c: &Candidate| 1.0 / (c.sigma_mm * c.sigma_mm).max(1e-9);
     let agree = |a: &Candidate, b: &Candidate| {
         (a.t_mm - b.t_mm).norm() <= k * (a.sigma_mm.powi(2) + b.sigma_mm.powi(2)).sqrt()
@@ -92,15 +87,18 @@ pub fn densest_cluster(candidates: &[Candidate], k: f64) -> Result<Translation, 
             .map(w)
             .sum::<f64>()
     };
-    let seed = candidates
-        .iter()
-        .map(|c| (c, support(c)))
-        .fold(None::<(&Candidate, f64)>, |best, (c, s)| match best {
+    let best = candidates.iter().map(|c| (c, support(c))).fold(
+        None::<(&Candidate, f64)>,
+        |best, (c, s)| match best {
             Some((_, b)) if b >= s => best,
             _ => Some((c, s)),
-        })
-        .map(|(c, _)| *c)
-        .expect("candidates is not empty");
+        },
+    );
+    let Some((&seed, _)) = best else {
+        return Err(VisionError::NotFound(
+            "no feature seen in both frames: no translation".into(),
+        ));
+    };
     let first: Vec<&Candidate> = candidates.iter().filter(|c| agree(&seed, c)).collect();
     let mean = weighted_mean(&first, w);
     let second: Vec<&Candidate> = candidates

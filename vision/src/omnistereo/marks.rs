@@ -15,7 +15,8 @@
 //! Pixels are sampled at their centres, so without more columns the edge is known to within the
 //! pixel spacing along the axis.
 
-use super::{MirrorRim, below, positive, wrap};
+use super::numbers::{below, positive, wrap};
+use super::rim::MirrorRim;
 use crate::VisionError;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};

@@ -5,12 +5,14 @@
 //! same azimuth: the cones are coaxial), where `d` is the distance from the lens to the cone's
 //! tip, `s` the distance between the two mirrors and `v` the distance of the image behind the
 //! lens. Eq. (2): `v = (d / R + 1) r_m`, with `R` the mirror's radius and `r_m` its radius in the
-//! image ([`super::MirrorRim`]): the calibration that converts pixels to millimetres.
+//! image ([`super::rim::MirrorRim`]): the calibration that converts pixels to millimetres.
 //!
 //! One pixel of disparity moves the range by `(r + d)^2 / (v s)`: the error grows with the
 //! square of the range.
 
-use super::{ColourMark, MirrorRim};
+use super::marks::ColourMark;
+use super::numbers::{positive, wrap};
+use super::rim::MirrorRim;
 use crate::VisionError;
 
 /// The two cones and the camera behind them.
@@ -40,7 +42,7 @@ impl StereoGeometry {
             ("tip_distance_mm", tip_distance_mm),
             ("separation_mm", separation_mm),
         ] {
-            super::positive(name, value)?;
+            positive(name, value)?;
         }
         if rims.is_empty() {
             return Err(VisionError::NotFound(
@@ -121,7 +123,7 @@ pub fn range_marks(
             unranged.push((lo.label, format!("no disparity ({h1:.1} - {h2:.1} px)")));
             continue;
         };
-        let mean = lo.bearing_rad + 0.5 * super::wrap(up.bearing_rad - lo.bearing_rad);
+        let mean = lo.bearing_rad + 0.5 * wrap(up.bearing_rad - lo.bearing_rad);
         ranged.push(RangedMark {
             label: lo.label,
             bearing_rad: mean,

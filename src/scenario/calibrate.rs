@@ -34,7 +34,7 @@ pub fn calibrate_sensor(spec: &SensorSpec) -> Result<RadialCalibration, SimError
 }
 
 fn trace(spec: &SensorSpec) -> Result<RadialCalibration, SimError> {
-    let sensor = spec.build()?;
+    let sensor = spec.build();
     let map = trace_radial_map(&sensor, CALIBRATION_STEP_PX)?;
     let fit = match sensor.optics {
         Optics::Hyperbolic(_) => {

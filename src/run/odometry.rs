@@ -1,38 +1,13 @@
 //! The robot's wheel odometry as a sensor: the true body velocity and rotation rate with the
 //! encoders' systematic errors and seeded Gaussian noise, drawn on the simulator's side.
 
+use crate::scenario::OdometrySpec;
 use nalgebra::{Rotation2, Vector2};
 use omniloop_robot::OdometryReading;
 use omniloop_sim::RobotState;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use rand_distr::StandardNormal;
-use serde::{Deserialize, Serialize};
-
-/// The errors of the robot's wheel odometry (`[odometry]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct OdometrySpec {
-    /// Standard deviation of the relative error of each velocity component.
-    pub speed_noise_frac: f64,
-    /// Standard deviation of the rotation-rate error, rad/s.
-    pub omega_noise_rad_s: f64,
-    /// Systematic scale error of the measured speed (e.g. a wheel radius off by this fraction).
-    pub scale_bias_frac: f64,
-    /// Systematic rotation-rate error (gyro bias, wheel slip), rad/s.
-    pub omega_bias_rad_s: f64,
-}
-
-impl Default for OdometrySpec {
-    fn default() -> Self {
-        Self {
-            speed_noise_frac: 0.01,
-            omega_noise_rad_s: 0.0,
-            scale_bias_frac: 0.0,
-            omega_bias_rad_s: 0.0,
-        }
-    }
-}
 
 /// Makes the readings of one robot's wheel encoders.
 #[derive(Debug)]

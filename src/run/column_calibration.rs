@@ -4,7 +4,8 @@
 //! levels; [`ColumnCalibration::measure`] finds the axis column and the focal length in them.
 //! Nothing is read from the optics.
 
-use crate::simulation::{RunError, sensor_noise_seed};
+use super::cameras::sensor_noise_seed;
+use super::error::RunError;
 use nalgebra::Isometry2;
 use omniloop_sim::optics::Optics;
 use omniloop_sim::{Board, Layout, Renderer, Rgb, Scene, SensorNoise, SensorSpec, SimError};
@@ -15,7 +16,7 @@ const SIDE_STRIPES: usize = 60;
 
 /// Measures the column calibration of the pinhole camera `spec` (noise drawn from `seed`).
 pub fn calibrate_columns(spec: &SensorSpec, seed: u64) -> Result<ColumnCalibration, RunError> {
-    let mut sensor = spec.build()?;
+    let mut sensor = spec.build();
     let Optics::Pinhole(cam) = &mut sensor.optics else {
         return Err(SimError::Invalid(format!(
             "sensor {:?} is not a pinhole camera: its columns have no single bearing",

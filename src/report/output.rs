@@ -1,10 +1,10 @@
 //! Writing a run's results: `summary.json`, `trajectory.csv`, `estimates.jsonl` and
 //! `topview.png`.
 
-use crate::record::{write_estimates_jsonl, write_trajectory_csv};
+use super::topview::{Marker, PathLayer, draw_topview};
+use crate::run::RunOutput;
+use crate::run::record::{write_estimates_jsonl, write_trajectory_csv};
 use crate::scenario::Scenario;
-use crate::simulation::RunOutput;
-use crate::topview::{Marker, PathLayer, draw_topview};
 use anyhow::Context;
 use nalgebra::Point2;
 use std::fs::File;

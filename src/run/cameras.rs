@@ -1,14 +1,19 @@
 //! The robot's cameras on the simulator's side: the renderer, each camera's optics and seeded
 //! noise, and the pan units of pinhole cameras, which the robot commands.
 
+use super::error::RunError;
 use crate::scenario::Scenario;
-use crate::simulation::{RunError, sensor_noise_seed};
 use image::RgbaImage;
 use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
 use omniloop_sim::optics::Optics;
 use omniloop_sim::render::BatchHandle;
 use omniloop_sim::{Renderer, RendererChoice, Scene, Sensor, SensorNoise, World};
 use std::f64::consts::PI;
+
+/// The seed of sensor `index`'s noise, derived from the run's seed.
+pub fn sensor_noise_seed(seed: u64, index: usize) -> u64 {
+    seed ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
 
 /// A pan unit: turns its camera about the vertical at up to its rate limit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -96,11 +101,11 @@ impl Cameras {
         let mut cameras = Vec::with_capacity(specs.len());
         for (i, spec) in specs.iter().enumerate() {
             let pan = spec
-                .pinhole
-                .as_ref()
+                .optics
+                .pinhole()
                 .map(|p| PanUnit::new(p.pan_deg.to_radians(), p.pan_rate_limit_deg_s.to_radians()));
             cameras.push(Camera {
-                sensor: spec.build()?,
+                sensor: spec.build(),
                 noise: SensorNoise::new(sensor_noise_seed(scenario.seed, i)),
                 pan,
                 live: all || wanted.contains(&spec.name),

@@ -30,7 +30,7 @@ pub enum FigureError {
 }
 
 static FONT: Once = Once::new();
-const FONT_BYTES: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+const FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 pub(crate) fn register_font() {
     FONT.call_once(|| {
@@ -426,7 +426,8 @@ fn render_panels(
         }
         root.present().map_err(|e| fail(e.to_string()))?;
     }
-    Ok(image::RgbImage::from_raw(total_w, height, buf).expect("buffer size matches the image"))
+    image::RgbImage::from_raw(total_w, height, buf)
+        .ok_or_else(|| fail("the drawing buffer does not match the image size".into()))
 }
 
 /// Draws one panel into a PNG `width` pixels wide.

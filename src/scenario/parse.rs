@@ -1,8 +1,10 @@
-//! Loading a scenario file: TOML parsing, schema, validation, with every problem located by
-//! file, line, column and field.
+//! Parsing a scenario: TOML, schema, the rules, with every problem located by file, line,
+//! column and field. The experiments' own preparation and checks come in as arguments from
+//! the layer that knows them ([`crate::experiments::parse_scenario`]).
 
-use crate::scenario::Scenario;
-use crate::validate::{FieldPath, PathSeg, validate};
+use super::check::{Checker, FieldPath, PathSeg};
+use super::rules::validate;
+use super::schema::Scenario;
 use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -52,8 +54,13 @@ pub enum LoadError {
     },
 }
 
-/// Reads, parses and validates a scenario file. The scenario's name defaults to the file stem.
-pub fn load_scenario(path: &Path) -> Result<Scenario, LoadError> {
+/// Reads, parses and validates a scenario file with the experiments' `prepare` and `check`
+/// (see [`parse_scenario_with`]). The scenario's name defaults to the file stem.
+pub fn load_scenario_with(
+    path: &Path,
+    prepare: impl FnOnce(&mut Scenario),
+    check: impl FnOnce(&Scenario, &mut Checker),
+) -> Result<Scenario, LoadError> {
     let text = std::fs::read_to_string(path).map_err(|source| LoadError::Io {
         file: path.to_path_buf(),
         source,
@@ -62,11 +69,19 @@ pub fn load_scenario(path: &Path) -> Result<Scenario, LoadError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    parse_scenario(&text, path, &stem)
+    parse_scenario_with(&text, path, &stem, prepare, check)
 }
 
-/// Parses and validates scenario text; `file` is used in messages only.
-pub fn parse_scenario(text: &str, file: &Path, default_name: &str) -> Result<Scenario, LoadError> {
+/// Parses and validates scenario text; `file` is used in messages only. `prepare` builds what
+/// the scenario's experiment owns into it before the rules run (the corner's corridor); `check`
+/// adds the experiment's own rules.
+pub fn parse_scenario_with(
+    text: &str,
+    file: &Path,
+    default_name: &str,
+    prepare: impl FnOnce(&mut Scenario),
+    check: impl FnOnce(&Scenario, &mut Checker),
+) -> Result<Scenario, LoadError> {
     let doc = DeTable::parse(text).ok();
     let locate = |span: Option<Range<usize>>| -> (usize, usize) {
         span.map(|s| line_col(text, s.start)).unwrap_or((1, 1))
@@ -97,9 +112,7 @@ pub fn parse_scenario(text: &str, file: &Path, default_name: &str) -> Result<Sce
         scenario.name = default_name.to_string();
     }
     // An experiment may build part of the world (the corner's corridor, start and goal).
-    if let Some(e) = scenario.experiment.clone() {
-        e.prepare(&mut scenario);
-    }
+    prepare(&mut scenario);
     // Paths in a scenario are relative to its file.
     if let Some(f) = scenario
         .vision
@@ -110,7 +123,10 @@ pub fn parse_scenario(text: &str, file: &Path, default_name: &str) -> Result<Sce
         let dir = file.parent().unwrap_or(Path::new(""));
         scenario.vision.calibration_file = Some(dir.join(f));
     }
-    let violations = validate(&scenario);
+    let mut violations = validate(&scenario);
+    let mut c = Checker::new();
+    check(&scenario, &mut c);
+    violations.extend(c.into_violations());
     if violations.is_empty() {
         return Ok(scenario);
     }
@@ -229,7 +245,7 @@ y_mm = 0.0
 "#;
 
     fn problems(text: &str) -> Vec<Problem> {
-        match parse_scenario(text, Path::new("t.toml"), "t") {
+        match parse_scenario_with(text, Path::new("t.toml"), "t", |_| {}, |_, _| {}) {
             Err(LoadError::Invalid { problems }) => problems,
             other => panic!("expected problems, got {other:?}"),
         }
@@ -237,7 +253,7 @@ y_mm = 0.0
 
     #[test]
     fn a_minimal_scenario_is_valid_and_named_after_its_file() {
-        let s = parse_scenario(GOOD, Path::new("t.toml"), "t").unwrap();
+        let s = parse_scenario_with(GOOD, Path::new("t.toml"), "t", |_| {}, |_, _| {}).unwrap();
         assert_eq!(s.name, "t");
         assert_eq!(s.robot.radius_mm, 90.0);
     }

@@ -1,140 +1,13 @@
-//! Validation of a parsed scenario: every rule a value must satisfy, checked once, each
-//! failure naming the dotted path of the field it concerns.
+//! The rules a parsed scenario must satisfy, checked once, each failure naming the dotted path
+//! of the field it concerns (each experiment adds its own through its registry entry).
 
-use crate::scenario::{PilotChoice, PoseSpec, Scenario};
+use super::check::{Checker, Violation};
+use super::schema::{PilotChoice, Scenario};
 use nalgebra::Point2;
 use omniloop_robot::controllers::{self, CONTROLLERS};
 use omniloop_robot::perception::{self, CameraNeed, STAGES};
-use omniloop_robot::{ConfigProblem, ControllerEntry, RobotConfig, StageEntry};
+use omniloop_robot::{ControllerEntry, RobotConfig, StageEntry};
 use omniloop_sim::{Layout, SensorSpec};
-use std::fmt;
-
-/// One step of a path into the scenario document.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum PathSeg {
-    /// A table key.
-    Key(String),
-    /// An array index.
-    Index(usize),
-}
-
-/// A dotted path into the document, e.g. `world.cubes[2].size_mm`.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
-pub struct FieldPath(pub Vec<PathSeg>);
-
-impl FieldPath {
-    /// Parses `a.b[3].c`.
-    pub fn parse(s: &str) -> Self {
-        let mut segs = Vec::new();
-        for part in s.split('.') {
-            let mut rest = part;
-            if let Some(i) = rest.find('[') {
-                segs.push(PathSeg::Key(rest[..i].to_string()));
-                rest = &rest[i..];
-                while let Some(end) = rest.find(']') {
-                    if let Ok(n) = rest[1..end].parse() {
-                        segs.push(PathSeg::Index(n));
-                    }
-                    rest = &rest[end + 1..];
-                }
-            } else if !rest.is_empty() {
-                segs.push(PathSeg::Key(rest.to_string()));
-            }
-        }
-        Self(segs)
-    }
-}
-
-impl fmt::Display for FieldPath {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, s) in self.0.iter().enumerate() {
-            match s {
-                PathSeg::Key(k) if i == 0 => write!(f, "{k}")?,
-                PathSeg::Key(k) => write!(f, ".{k}")?,
-                PathSeg::Index(n) => write!(f, "[{n}]")?,
-            }
-        }
-        Ok(())
-    }
-}
-
-/// A value that breaks a rule.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Violation {
-    /// The field.
-    pub path: FieldPath,
-    /// What is wrong.
-    pub message: String,
-}
-
-/// Collects the violations of a scenario (experiments check their own sections with it).
-pub(crate) struct Checker {
-    out: Vec<Violation>,
-}
-
-impl Checker {
-    pub(crate) fn fail(&mut self, path: impl AsRef<str>, message: impl Into<String>) {
-        self.out.push(Violation {
-            path: FieldPath::parse(path.as_ref()),
-            message: message.into(),
-        });
-    }
-
-    pub(crate) fn positive(&mut self, path: impl AsRef<str>, v: f64) {
-        if !(v.is_finite() && v > 0.0) {
-            self.fail(path, format!("must be a finite number > 0 (got {v})"));
-        }
-    }
-
-    pub(crate) fn finite(&mut self, path: impl AsRef<str>, v: f64) {
-        if !v.is_finite() {
-            self.fail(path, format!("must be a finite number (got {v})"));
-        }
-    }
-
-    pub(crate) fn pose_in_world(
-        &mut self,
-        path: &str,
-        pose: &PoseSpec,
-        radius: f64,
-        world: &Layout,
-    ) {
-        self.finite(format!("{path}.x_mm"), pose.x_mm);
-        self.finite(format!("{path}.y_mm"), pose.y_mm);
-        self.finite(format!("{path}.heading_deg"), pose.heading_deg);
-        let p = pose.point();
-        if !world.is_floor(p) {
-            let noun = if path.ends_with("start") {
-                "start"
-            } else {
-                "place"
-            };
-            self.fail(
-                format!("{path}.x_mm"),
-                format!(
-                    "{noun} ({}, {}) mm is outside the floor region",
-                    pose.x_mm, pose.y_mm
-                ),
-            );
-            return;
-        }
-        let nearest = world
-            .solids()
-            .iter()
-            .map(|s| s.shape.distance_mm(p))
-            .min_by(f64::total_cmp);
-        if let Some(d) = nearest.filter(|&d| radius > 0.0 && d < radius) {
-            self.fail(
-                format!("{path}.x_mm"),
-                format!(
-                    "a robot of radius {radius} mm at ({}, {}) overlaps an obstacle \
-                     ({d:.1} mm from its centre)",
-                    pose.x_mm, pose.y_mm
-                ),
-            );
-        }
-    }
-}
 
 fn in_floor(world: &Layout, p: Point2<f64>) -> bool {
     world.is_floor(p)
@@ -142,7 +15,7 @@ fn in_floor(world: &Layout, p: Point2<f64>) -> bool {
 
 /// Every rule the scenario breaks (empty when it is valid).
 pub fn validate(s: &Scenario) -> Vec<Violation> {
-    let mut c = Checker { out: Vec::new() };
+    let mut c = Checker::new();
     let r = &s.run;
     c.positive("run.duration_s", r.duration_s);
     c.positive("run.control_period_s", r.control_period_s);
@@ -311,24 +184,17 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             }
         }
     }
-    if let Some(e) = &s.experiment {
-        e.validate(s, &mut c);
+    if s.experiment.0.len() > 1 {
+        let names: Vec<&str> = s.experiment.names().collect();
+        c.fail(
+            "experiment",
+            format!(
+                "a scenario belongs to one experiment (found {})",
+                names.join(", ")
+            ),
+        );
     }
     c.out
-}
-
-impl Checker {
-    fn problems(&mut self, list: Vec<ConfigProblem>) {
-        for p in list {
-            let dup = self
-                .out
-                .iter()
-                .any(|v| v.path.to_string() == p.field && v.message == p.message);
-            if !dup {
-                self.fail(p.field, p.message);
-            }
-        }
-    }
 }
 
 /// The robot's software: its controller and pose source by their registered names, their
@@ -493,7 +359,7 @@ fn software_config(
             return None;
         }
     };
-    if sensors[index].pinhole.is_some() || sensors[index].optics_present().len() != 1 {
+    if sensors[index].optics.pinhole().is_some() {
         c.fail(
             "vision.sensor",
             format!(
@@ -511,7 +377,7 @@ fn software_config(
                 return None;
             }
         },
-        None => match crate::calibrate::calibrate_sensor(&sensors[index]) {
+        None => match super::calibrate::calibrate_sensor(&sensors[index]) {
             Ok(cal) => cal,
             Err(e) => {
                 c.fail(format!("robot.sensors[{index}]"), e.to_string());
@@ -566,7 +432,7 @@ fn check_resection_camera(c: &mut Checker, s: &Scenario) {
             format!("resection sees through a camera: {e}"),
         ),
         Ok(i) => {
-            if let Some(cam) = &s.robot.sensors[i].pinhole
+            if let Some(cam) = s.robot.sensors[i].optics.pinhole()
                 && cam.tilt_deg != 0.0
             {
                 c.fail(
@@ -615,106 +481,7 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
             format!("must be 2..=256 (got {n})"),
         );
     }
-    let present = s.optics_present();
-    if present.len() != 1 {
-        c.fail(
-            p,
-            format!(
-                "a sensor needs exactly one of the tables hyperbolic, conical, spherical, \
-                 pinhole (found {})",
-                if present.is_empty() {
-                    "none".to_string()
-                } else {
-                    present.join(", ")
-                }
-            ),
-        );
-    }
-    if let Some(m) = &s.hyperbolic {
-        let q = format!("{p}.hyperbolic");
-        for (k, v) in [
-            ("a_mm", m.a_mm),
-            ("b_mm", m.b_mm),
-            ("c_mm", m.c_mm),
-            ("focal_px", m.focal_px),
-            ("focus_height_mm", m.focus_height_mm),
-            ("rim_radius_mm", m.rim_radius_mm),
-        ] {
-            c.positive(format!("{q}.{k}"), v);
-        }
-        let exact = m.a_mm.hypot(m.b_mm);
-        if (m.c_mm - exact).abs() > 1e-3 * exact {
-            c.fail(
-                format!("{q}.c_mm"),
-                format!(
-                    "must equal sqrt(a^2 + b^2) = {exact:.4} mm to within 0.1% (got {})",
-                    m.c_mm
-                ),
-            );
-        }
-        if m.focus_height_mm <= 2.0 * exact {
-            c.fail(
-                format!("{q}.focus_height_mm"),
-                "puts the camera (2 c below the focus) under the floor",
-            );
-        }
-    }
-    if let Some(m) = &s.conical {
-        let q = format!("{p}.conical");
-        if !(m.apex_angle_deg > 0.0 && m.apex_angle_deg < 180.0) {
-            c.fail(
-                format!("{q}.apex_angle_deg"),
-                format!("must lie in (0, 180) (got {})", m.apex_angle_deg),
-            );
-        }
-        c.positive(format!("{q}.radius_mm"), m.radius_mm);
-        c.positive(format!("{q}.tip_distance_mm"), m.tip_distance_mm);
-        c.positive(format!("{q}.focal_px"), m.focal_px);
-        c.positive(format!("{q}.lens_height_mm"), m.lens_height_mm);
-    }
-    if let Some(m) = &s.spherical {
-        let q = format!("{p}.spherical");
-        c.positive(format!("{q}.radius_mm"), m.radius_mm);
-        c.positive(format!("{q}.focal_px"), m.focal_px);
-        c.positive(format!("{q}.lens_height_mm"), m.lens_height_mm);
-        if m.camera_distance_mm.is_nan() || m.camera_distance_mm <= m.radius_mm {
-            c.fail(
-                format!("{q}.camera_distance_mm"),
-                format!(
-                    "must exceed radius_mm = {} (got {})",
-                    m.radius_mm, m.camera_distance_mm
-                ),
-            );
-        }
-    }
-    if let Some(m) = &s.pinhole {
-        let q = format!("{p}.pinhole");
-        c.positive(format!("{q}.focal_px"), m.focal_px);
-        c.positive(format!("{q}.height_mm"), m.height_mm);
-        c.positive(format!("{q}.pan_rate_limit_deg_s"), m.pan_rate_limit_deg_s);
-        if m.pan_deg.is_nan() || m.pan_deg.abs() > 180.0 {
-            c.fail(
-                format!("{q}.pan_deg"),
-                format!("must lie in [-180, 180] (got {})", m.pan_deg),
-            );
-        }
-        if m.tilt_deg.is_nan() || m.tilt_deg.abs() > 90.0 {
-            c.fail(
-                format!("{q}.tilt_deg"),
-                format!("must lie in [-90, 90] (got {})", m.tilt_deg),
-            );
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn paths_round_trip() {
-        for s in ["robot.radius_mm", "world.cubes[2].size_mm", "a[1][2].b"] {
-            assert_eq!(FieldPath::parse(s).to_string(), s);
-        }
+    for (key, why) in s.optics.problems() {
+        c.fail(format!("{p}.{key}"), why);
     }
 }

@@ -2,57 +2,25 @@
 //! its sensors give, apply its commands, step the world, and record the truth beside what the
 //! robot believes.
 
-use crate::calibrate::calibrate_sensor;
-use crate::cameras::Cameras;
-use crate::column_calibration::calibrate_columns;
-use crate::experiments;
-use crate::odometry::WheelOdometry;
-use crate::pilot::Pilot;
-use crate::record::{Summary, TrajectoryRow};
+use super::cameras::{Cameras, sensor_noise_seed};
+use super::column_calibration::calibrate_columns;
+use super::error::RunError;
+use super::odometry::WheelOdometry;
+use super::pilot::Pilot;
+use super::record::{Summary, TrajectoryRow};
+use super::score::TruthScore;
+use crate::scenario::calibrate::calibrate_sensor;
 use crate::scenario::{PilotChoice, Scenario};
-use crate::score::TruthScore;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
 use omniloop_robot::{
     Estimates, FixOutcome, Observation, Robot, RobotConfig, RobotError, RobotSoftware,
 };
 use omniloop_sim::render::BatchHandle;
-use omniloop_sim::{RenderError, Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
+use omniloop_sim::{Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
+use omniloop_vision::RadialCalibration;
 use omniloop_vision::resection::ColumnCalibration;
-use omniloop_vision::{RadialCalibration, VisionError};
 use std::path::PathBuf;
-use std::time::Instant;
-
-/// Why a run could not be carried out.
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// The world could not be built.
-    #[error(transparent)]
-    Sim(#[from] SimError),
-    /// The simulator's pilot could not be built.
-    #[error("control: {0}")]
-    Control(#[from] omniloop_control::ControlError),
-    /// The renderer could not open or render.
-    #[error(transparent)]
-    Render(#[from] RenderError),
-    /// A calibration file could not be used.
-    #[error("vision: {0}")]
-    Vision(#[from] VisionError),
-    /// The robot's software could not be built or failed.
-    #[error("robot: {0}")]
-    Robot(#[from] RobotError),
-    /// The robot commanded an actuator it does not have.
-    #[error("actuator: {0}")]
-    Actuator(String),
-    /// A frame could not be written.
-    #[error("writing frame {path}: {source}")]
-    Frame {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: image::ImageError,
-    },
-}
 
 /// How to run a scenario (what the command line adds to the scenario file).
 #[derive(Debug, Clone, Default)]
@@ -65,11 +33,9 @@ pub struct RunOptions {
     pub frames_dir: Option<PathBuf>,
     /// A GPU shared with other runs, its frames traced in batches (overrides `renderer`).
     pub shared_gpu: Option<BatchHandle>,
-}
-
-/// The seed of sensor `index`'s noise, derived from the run's seed.
-pub fn sensor_noise_seed(seed: u64, index: usize) -> u64 {
-    seed ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+    /// The experimenter takes frames of vision's camera (the camera is rendered and calibrated
+    /// whatever the robot's software reads); the scenario's experiment sets it.
+    pub takes_frames: bool,
 }
 
 /// Everything a run produced.
@@ -98,8 +64,11 @@ pub struct OutputFile {
 
 /// The calibrations of the cameras the robot's vision uses: the scenario's file, or the
 /// camera's traced map.
-fn calibrations(scenario: &Scenario) -> Result<Vec<RadialCalibration>, RunError> {
-    if !scenario.needs_calibration() {
+fn calibrations(
+    scenario: &Scenario,
+    takes_frames: bool,
+) -> Result<Vec<RadialCalibration>, RunError> {
+    if !(scenario.needs_calibration() || takes_frames) {
         return Ok(Vec::new());
     }
     let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
@@ -169,7 +138,7 @@ impl Simulation {
             &scenario.robot_bodies(),
             scenario.run.physics_step_s,
         )?;
-        let calibrations = calibrations(scenario)?;
+        let calibrations = calibrations(scenario, options.takes_frames)?;
         let robot = software(&scenario.robot_config(calibrations.clone(), columns(scenario)?))?;
         let r = &scenario.robot;
         let pilot = match (&scenario.goal, scenario.run.pilot) {
@@ -197,7 +166,7 @@ impl Simulation {
         let cameras = Cameras::open(
             scenario,
             &robot.cameras(),
-            options.save_frames_every.is_some() || scenario.experiment_takes_frames(),
+            options.save_frames_every.is_some() || options.takes_frames,
             options.renderer,
             options.shared_gpu.as_ref(),
             notice,
@@ -476,48 +445,6 @@ fn localization_fixes(records: &[Estimates]) -> Option<usize> {
     localizes.then(|| records.iter().map(used).sum())
 }
 
-/// Runs a validated scenario to its end by its experiment's procedure (driving to the goal
-/// when it names none), calling `progress(cycle, total)` along the way. The summary's
-/// `wall_time_s` covers the whole run, set-up included (calibration, opening the renderer);
-/// its `cycles_per_s` covers the control cycles alone.
-pub fn run_scenario(
-    scenario: &Scenario,
-    options: &RunOptions,
-    notice: impl FnOnce(&str),
-    progress: impl FnMut(u64, u64),
-) -> Result<RunOutput, RunError> {
-    run_scenario_with(scenario, options, builtin_software, notice, progress)
-}
-
-/// [`run_scenario`] with the robot's software that `software` builds.
-pub fn run_scenario_with(
-    scenario: &Scenario,
-    options: &RunOptions,
-    software: impl FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
-    notice: impl FnOnce(&str),
-    mut progress: impl FnMut(u64, u64),
-) -> Result<RunOutput, RunError> {
-    let start = Instant::now();
-    if let Some(dir) = &options.frames_dir {
-        std::fs::create_dir_all(dir).map_err(|e| RunError::Frame {
-            path: dir.clone(),
-            source: image::ImageError::IoError(e),
-        })?;
-    }
-    let mut sim = Simulation::with_software(scenario, options, software, notice)?;
-    let mut experiment = experiments::procedure(scenario);
-    let loop_start = Instant::now();
-    experiment.run(&mut sim, &mut progress)?;
-    let loop_s = loop_start.elapsed().as_secs_f64();
-    let mut out = sim.finish(start.elapsed().as_secs_f64());
-    if loop_s > 0.0 {
-        out.summary.cycles_per_s = out.summary.cycles as f64 / loop_s;
-    }
-    out.summary.experiment = experiment.metrics(&out);
-    out.files = experiment.files(scenario, &out)?;
-    Ok(out)
-}
-
 /// Renders what sensor `sensor` of the robot under test sees when the robot stands at `pose`
 /// (the scenario's start when `None`) and every other robot at its start, with the sensor's
 /// noise drawn as the first frame of a run would be, or clean when `noise` is false.
@@ -536,7 +463,7 @@ pub fn render_snapshot(
         bodies[0].start = p;
     }
     let world = World::new(&scenario.world, &bodies, scenario.run.physics_step_s)?;
-    let sensor = scenario.robot.sensors[index].build()?;
+    let sensor = scenario.robot.sensors[index].build();
     let scene = Scene::of_world(&world);
     let mut noise_source = noise.then(|| SensorNoise::new(sensor_noise_seed(scenario.seed, index)));
     Ok(renderer.render(

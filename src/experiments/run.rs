@@ -1,9 +1,15 @@
-//! Running a scenario with any robot software: the library's way in for a user's robot.
+//! Running a scenario by its experiment's procedure, with the built-in robot software or any
+//! other ([`Runner`]: the library's way in for a user's robot), and loading scenario files
+//! with every experiment's own checks.
 
-use crate::scenario::Scenario;
-use crate::simulation::{RunError, RunOptions, RunOutput, builtin_software, run_scenario_with};
+use super::experiment::Drive;
+use super::registry::{self, setup_of};
+use crate::run::{RunError, RunOptions, RunOutput, Simulation, builtin_software};
+use crate::scenario::{LoadError, Scenario};
 use omniloop_robot::{RobotConfig, RobotError, RobotSoftware};
 use omniloop_sim::RendererChoice;
+use std::path::Path;
+use std::time::Instant;
 
 /// Builds the robot's software from what the robot is told.
 type SoftwareFactory<'a> =
@@ -50,7 +56,7 @@ pub struct Runner<'a> {
 }
 
 impl<'a> Runner<'a> {
-    /// A run of a validated scenario (see [`crate::load_scenario`]) with the built-in robot
+    /// A run of a validated scenario (see [`load_scenario`]) with the built-in robot
     /// software, the renderer chosen automatically, the scenario's seed, no progress shown.
     pub fn new(scenario: &Scenario) -> Self {
         Self {
@@ -119,4 +125,80 @@ impl<'a> Runner<'a> {
             self.progress,
         )
     }
+}
+
+/// Runs a validated scenario to its end by its experiment's procedure (driving to the goal
+/// when it names none), calling `progress(cycle, total)` along the way. The summary's
+/// `wall_time_s` covers the whole run, set-up included (calibration, opening the renderer);
+/// its `cycles_per_s` covers the control cycles alone.
+pub fn run_scenario(
+    scenario: &Scenario,
+    options: &RunOptions,
+    notice: impl FnOnce(&str),
+    progress: impl FnMut(u64, u64),
+) -> Result<RunOutput, RunError> {
+    run_scenario_with(scenario, options, builtin_software, notice, progress)
+}
+
+/// [`run_scenario`] with the robot's software that `software` builds.
+pub fn run_scenario_with(
+    scenario: &Scenario,
+    options: &RunOptions,
+    software: impl FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
+    notice: impl FnOnce(&str),
+    mut progress: impl FnMut(u64, u64),
+) -> Result<RunOutput, RunError> {
+    let start = Instant::now();
+    if let Some(dir) = &options.frames_dir {
+        std::fs::create_dir_all(dir).map_err(|e| RunError::Frame {
+            path: dir.clone(),
+            source: image::ImageError::IoError(e),
+        })?;
+    }
+    let setup = setup_of(scenario).map_err(|p| RunError::Scenario(p.to_string()))?;
+    let mut options = options.clone();
+    options.takes_frames |= setup.as_ref().is_some_and(|e| e.takes_frames());
+    let mut sim = Simulation::with_software(scenario, &options, software, notice)?;
+    let mut experiment = match &setup {
+        Some(e) => e.procedure(scenario),
+        None => Box::new(Drive),
+    };
+    let loop_start = Instant::now();
+    experiment.run(&mut sim, &mut progress)?;
+    let loop_s = loop_start.elapsed().as_secs_f64();
+    let mut out = sim.finish(start.elapsed().as_secs_f64());
+    if loop_s > 0.0 {
+        out.summary.cycles_per_s = out.summary.cycles as f64 / loop_s;
+    }
+    out.summary.experiment = experiment.metrics(&out);
+    out.files = experiment.files(scenario, &out)?;
+    Ok(out)
+}
+
+/// [`run_scenario`] with its callbacks as trait objects (the replays' runner).
+pub fn run_dyn(
+    scenario: &Scenario,
+    options: &RunOptions,
+    notice: &mut dyn FnMut(&str),
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<RunOutput, RunError> {
+    run_scenario(scenario, options, notice, progress)
+}
+
+/// Reads, parses and validates a scenario file, its experiment's section included (each
+/// problem located by file, line, column and field). Its name defaults to the file stem.
+pub fn load_scenario(path: &Path) -> Result<Scenario, LoadError> {
+    crate::scenario::load_scenario_with(path, registry::prepare, registry::check)
+}
+
+/// Parses and validates scenario text, its experiment's section included; `file` is used in
+/// messages only.
+pub fn parse_scenario(text: &str, file: &Path, default_name: &str) -> Result<Scenario, LoadError> {
+    crate::scenario::parse_scenario_with(
+        text,
+        file,
+        default_name,
+        registry::prepare,
+        registry::check,
+    )
 }

@@ -1,6 +1,6 @@
 //! Charts: x-y plots of lines and dots in a grid of panels, drawn with plotters into a PNG.
 
-use crate::topview::{FigureError, png_bytes, register_font};
+use super::topview::{FigureError, png_bytes, register_font};
 use plotters::prelude::*;
 
 /// How a series is drawn.
@@ -70,7 +70,8 @@ pub fn charts_png(
         }
         root.present().map_err(|e| fail(e.to_string()))?;
     }
-    let img = image::RgbImage::from_raw(w, h, buf).expect("buffer size matches the image");
+    let img = image::RgbImage::from_raw(w, h, buf)
+        .ok_or_else(|| fail("the drawing buffer does not match the image size".into()))?;
     png_bytes(name, &img)
 }
 

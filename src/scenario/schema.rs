@@ -1,16 +1,14 @@
-//! Scenario files: the schema of the TOML a user writes, with defaults, and its validation.
+//! Scenario files: the schema of the TOML a user writes, with its defaults.
 //!
-//! Every table rejects unknown keys. Parsing and validation errors name the file, the line
-//! and column, and the dotted path of the field ([`crate::scenario_error`]).
+//! Every table rejects unknown keys, but for the tables that registered parts own and check
+//! themselves (`[control.*]` of controllers and stages, `[experiment.NAME]`).
 
-use crate::experiments::ExperimentSpec;
-use crate::odometry::OdometrySpec;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::DifferentialDrive;
 use omniloop_robot::perception::CameraNeed;
 use omniloop_robot::{
     BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StageEntry,
-    StereoRig, VisionSpec, WorldMap, stages_of,
+    StereoRig, Tables, VisionSpec, WorldMap, stages_of,
 };
 use omniloop_sim::{Layout, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
@@ -54,10 +52,11 @@ pub struct Scenario {
     /// The errors of the robot's wheel odometry.
     #[serde(default)]
     pub odometry: OdometrySpec,
-    /// The experiment this scenario belongs to (`[experiment.NAME]`): its procedure and
-    /// metrics. Without one, the robot drives until the goal or the time is up.
-    #[serde(default)]
-    pub experiment: Option<ExperimentSpec>,
+    /// The experiment this scenario belongs to (`[experiment.NAME]`, a registered experiment
+    /// that parses its own table): its procedure and metrics. Without one, the robot drives
+    /// until the goal or the time is up.
+    #[serde(default, skip_serializing_if = "Tables::is_empty")]
+    pub experiment: Tables,
 }
 
 fn default_seed() -> u64 {
@@ -243,6 +242,31 @@ fn default_other_rgb() -> Rgb {
     Rgb([200, 40, 160])
 }
 
+/// The errors of the robot's wheel odometry (`[odometry]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OdometrySpec {
+    /// Standard deviation of the relative error of each velocity component.
+    pub speed_noise_frac: f64,
+    /// Standard deviation of the rotation-rate error, rad/s.
+    pub omega_noise_rad_s: f64,
+    /// Systematic scale error of the measured speed (e.g. a wheel radius off by this fraction).
+    pub scale_bias_frac: f64,
+    /// Systematic rotation-rate error (gyro bias, wheel slip), rad/s.
+    pub omega_bias_rad_s: f64,
+}
+
+impl Default for OdometrySpec {
+    fn default() -> Self {
+        Self {
+            speed_noise_frac: 0.01,
+            omega_noise_rad_s: 0.0,
+            scale_bias_frac: 0.0,
+            omega_bias_rad_s: 0.0,
+        }
+    }
+}
+
 impl Scenario {
     /// Parses a scenario from TOML text (no validation; see [`crate::load_scenario`]).
     pub fn from_toml(text: &str) -> Result<Self, toml::de::Error> {
@@ -355,8 +379,8 @@ impl Scenario {
     /// focal length, height, tilt and mount (design constants of a forward camera).
     pub fn forward_camera(&self) -> Option<ForwardCamera> {
         let s = self.sensor(self.vision.sensor.as_deref()).ok()?;
-        let p = s.pinhole.as_ref()?;
-        let built = s.build().ok()?;
+        let p = s.optics.pinhole()?;
+        let built = s.build();
         Some(ForwardCamera {
             sensor: s.name.clone(),
             width_px: s.width_px,
@@ -444,7 +468,7 @@ impl Scenario {
                 .iter()
                 .find(|s| s.name == name)
                 .ok_or_else(|| (field.clone(), format!("the robot has no sensor {name:?}")))?;
-            let m = s.conical.as_ref().ok_or_else(|| {
+            let m = s.optics.conical().ok_or_else(|| {
                 (
                     field.clone(),
                     format!("sensor {name:?} is not a conical mirror"),
@@ -503,7 +527,7 @@ impl Scenario {
     /// Whether vision's camera is a pinhole.
     fn vision_is_pinhole(&self) -> bool {
         self.sensor(self.vision.sensor.as_deref())
-            .is_ok_and(|s| s.pinhole.is_some())
+            .is_ok_and(|s| s.optics.pinhole().is_some())
     }
 
     /// Whether the robot's software reads bearings from a pinhole camera's columns (which it
@@ -521,14 +545,12 @@ impl Scenario {
             CameraNeed::MirrorOrPinhole => !pinhole,
             CameraNeed::None | CameraNeed::Forward => false,
         };
-        self.stages().iter().any(mirror) || self.experiment_takes_frames()
+        self.stages().iter().any(mirror)
     }
 
-    /// Whether the scenario's experiment takes camera frames itself.
-    pub fn experiment_takes_frames(&self) -> bool {
-        self.experiment
-            .as_ref()
-            .is_some_and(ExperimentSpec::takes_frames)
+    /// The name of the experiment the scenario belongs to, if any.
+    pub fn experiment_name(&self) -> Option<&str> {
+        self.experiment.names().next()
     }
 
     /// Where the robot under test starts (validation makes sure it is given).

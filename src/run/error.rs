@@ -1,0 +1,40 @@
+//! Why a run could not be carried out.
+
+use omniloop_robot::RobotError;
+use omniloop_sim::{RenderError, SimError};
+use omniloop_vision::VisionError;
+use std::path::PathBuf;
+
+/// Why a run could not be carried out.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The world could not be built.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+    /// The simulator's pilot could not be built.
+    #[error("control: {0}")]
+    Control(#[from] omniloop_control::ControlError),
+    /// The renderer could not open or render.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// A calibration file could not be used.
+    #[error("vision: {0}")]
+    Vision(#[from] VisionError),
+    /// The robot's software could not be built or failed.
+    #[error("robot: {0}")]
+    Robot(#[from] RobotError),
+    /// The robot commanded an actuator it does not have.
+    #[error("actuator: {0}")]
+    Actuator(String),
+    /// The scenario's experiment section does not parse (a scenario not checked first).
+    #[error("scenario: {0}")]
+    Scenario(String),
+    /// A frame could not be written.
+    #[error("writing frame {path}: {source}")]
+    Frame {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: image::ImageError,
+    },
+}

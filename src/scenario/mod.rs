@@ -1,0 +1,18 @@
+//! The scenario layer: the schema of a scenario file ([`schema`]), the rules it must satisfy
+//! ([`rules`], with the [`check`] types that name a field at fault), parsing with located
+//! problems ([`parse`]), and the traced calibration of its mirror cameras ([`calibrate`]).
+//! It knows nothing of running: everything above imports it.
+
+pub mod calibrate;
+pub mod check;
+pub mod parse;
+pub mod rules;
+pub mod schema;
+
+pub use check::{Checker, FieldPath, PathSeg, Violation};
+pub use parse::{LoadError, Problem, load_scenario_with, parse_scenario_with};
+pub use rules::validate;
+pub use schema::{
+    DifferentialSpec, OdometrySpec, OtherRobotSpec, PilotChoice, PoseSpec, RobotSpec, RunSpec,
+    Scenario,
+};

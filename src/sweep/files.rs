@@ -1,0 +1,33 @@
+//! A sweep's files: `sweep.csv`, `sweep.md` and `sweep.png`.
+
+use super::plan::Plan;
+use super::plot;
+use super::report::{self, Row};
+use std::path::Path;
+
+/// Writes `sweep.csv`, `sweep.md` (after `header`) and `sweep.png` of `metric` into `dir`;
+/// returns the markdown.
+pub fn write_outputs(
+    dir: &Path,
+    plan: &Plan,
+    rows: &[Row],
+    metric: &str,
+    header: &str,
+) -> anyhow::Result<String> {
+    use anyhow::Context;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let write = |name: &str, bytes: &[u8]| {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))
+    };
+    write("sweep.csv", report::csv(plan, rows).as_bytes())?;
+    let md = report::markdown(plan, rows, header);
+    write("sweep.md", md.as_bytes())?;
+    write("sweep.png", &plot::sweep_png(plan, rows, metric)?)?;
+    Ok(md)
+}
+
+/// Whether `metric` can be plotted: `success_rate` or a numeric column some run has.
+pub fn known_metric(rows: &[Row], metric: &str) -> bool {
+    metric == "success_rate" || rows.iter().any(|r| r.number(metric).is_some())
+}
