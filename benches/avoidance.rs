@@ -36,7 +36,8 @@ fn frames() -> Vec<(FreeSpace, Vector2<f64>)> {
     let spec = &s.robot.sensors[0];
     let sensor = spec.build();
     let cal = calibrate_sensor(spec).expect("calibration");
-    let mut detector = FreeSpaceDetector::new(s.vision.freespace.clone(), &cal).expect("detector");
+    let mut detector = FreeSpaceDetector::new(s.vision.table("freespace").expect("settings"), &cal)
+        .expect("detector");
     let goal = s.goal.as_ref().expect("goal").point();
     let mut renderer = Renderer::cpu();
     let mut noise = SensorNoise::new(1);

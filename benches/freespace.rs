@@ -39,7 +39,7 @@ fn main() {
     for method in [FreeSpaceMethod::Count, FreeSpaceMethod::Labeling] {
         let config = FreeSpaceConfig {
             method,
-            ..s.vision.freespace.clone()
+            ..s.vision.table("freespace").expect("settings")
         };
         let mut d = FreeSpaceDetector::new(config, &cal).expect("detector");
         for _ in 0..20 {

@@ -65,7 +65,7 @@ fn main() {
         .map(|&(_, method, _)| {
             let config = LocalizationConfig {
                 method,
-                ..s.vision.localization.clone()
+                ..s.vision.table("localization").expect("settings")
             };
             FloorLocalizer::new(config, &cal).expect("localizer")
         })

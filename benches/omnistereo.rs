@@ -13,7 +13,7 @@ use omniloop::load_scenario;
 use omniloop_robot::perception::{Belief, OmnistereoStage, Percepts, Stage};
 use omniloop_robot::{Frame, Observation};
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
-use omniloop_vision::omnistereo::{AngularProfile, MirrorRim, detect_marks};
+use omniloop_vision::omnistereo::{AngularProfile, MirrorRim, OmnistereoConfig, detect_marks};
 use std::time::Instant;
 
 /// Median and 90th percentile of `t`, ms.
@@ -51,9 +51,8 @@ fn main() {
                 .collect()
         })
         .collect();
-    let mut stage =
-        OmnistereoStage::new(config.vision.omnistereo.clone(), rig, &config.map.landmarks)
-            .expect("stage");
+    let settings = config.vision.table("omnistereo").expect("settings");
+    let mut stage = OmnistereoStage::new(settings, rig, &config.map.landmarks).expect("stage");
     let belief = Belief {
         pose: None,
         fixed: false,
@@ -98,7 +97,7 @@ fn main() {
         .map(|i| MirrorRim::measure(i).expect("rim"))
         .collect();
     let palette: Vec<[u8; 3]> = config.map.landmarks.iter().map(|l| l.rgb).collect();
-    let vision = &config.vision.omnistereo;
+    let vision: &OmnistereoConfig = &config.vision.table("omnistereo").expect("settings");
     let (mut marks, mut compass) = (Vec::new(), Vec::new());
     for _ in 0..20 {
         for imgs in &frames {

@@ -29,7 +29,7 @@ impl GapFollower {
         let cal = c.calibration(camera).ok_or_else(|| missing("a mirror"))?;
         let goal = c.goal.as_ref().ok_or_else(|| missing("a [goal]"))?.point();
         Ok(Self {
-            detector: FreeSpaceDetector::new(c.vision.freespace.clone(), cal)?,
+            detector: FreeSpaceDetector::new(c.vision.table("freespace")?, cal)?,
             camera: camera.to_string(),
             start: c.start,
             odometry: DeadReckoning::new(),

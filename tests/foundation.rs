@@ -164,6 +164,25 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             ),
             ":15:1: field `robot.sensors[0].hyperbolic.c_mm`: must equal sqrt(a^2 + b^2)",
         ),
+        // So are the perception stages' `[vision.*]` tables, written or not for a stage that
+        // runs.
+        (
+            "unknown_vision_table",
+            format!("{BASE}\n[vision.freespce]\ndirections = 8\n"),
+            ":10:9: field `vision.freespce`: unknown field `freespce`, expected one of sensor, \
+             calibration_file, omnistereo, resection, forward, freespace, localization, \
+             luminance_heading",
+        ),
+        (
+            "vision_value",
+            format!("{BASE}\n[vision.freespace]\ndirections = 2\n"),
+            ":11:1: field `vision.freespace.directions`: must be >= 4 (got 2)",
+        ),
+        (
+            "vision_unknown_key",
+            format!("{BASE}\n[vision.localization]\nmethd = \"robust\"\n"),
+            ":11:1: field `vision.localization.methd`: unknown field `methd`",
+        ),
         (
             "unknown_control_table",
             format!("{BASE}\n[control.avodance]\nmargin_mm = 1.0\n"),

@@ -31,11 +31,12 @@ fn detected_free_distances_match_the_ray_cast_world_within_a_ring() {
     let cal = calibrate_sensor(spec).unwrap();
     let mut renderer = Renderer::cpu();
     let mut noise = SensorNoise::new(sensor_noise_seed(s.seed, 0));
-    let mut count = FreeSpaceDetector::new(s.vision.freespace.clone(), &cal).unwrap();
+    let config: omniloop_vision::FreeSpaceConfig = s.vision.table("freespace").unwrap();
+    let mut count = FreeSpaceDetector::new(config.clone(), &cal).unwrap();
     let mut labeling = FreeSpaceDetector::new(
         omniloop_vision::FreeSpaceConfig {
             method: FreeSpaceMethod::Labeling,
-            ..s.vision.freespace.clone()
+            ..config
         },
         &cal,
     )

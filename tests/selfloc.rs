@@ -12,7 +12,7 @@ use omniloop::experiments::places::{place_results, places_table};
 use omniloop::run::record::Summary;
 use omniloop::run_scenario;
 use omniloop::scenario::PoseSpec;
-use omniloop_vision::LocalizationMethod;
+use omniloop_vision::{LocalizationConfig, LocalizationMethod};
 
 /// Runs E2's scenario with `method` at `places` (all six of E2 when `None`) and checks every
 /// place: all frames localized, within 30 mm and 1 degree RMS, no ambiguity error.
@@ -21,7 +21,9 @@ fn every_place_within_30_mm_and_1_degree(
     places: Option<Vec<PoseSpec>>,
 ) -> Summary {
     let mut s = scenario("selfloc_field.toml");
-    s.vision.localization.method = method;
+    let mut config: LocalizationConfig = s.vision.table("localization").unwrap();
+    config.method = method;
+    s.vision.tables.set("localization", &config).unwrap();
     let mut spec: PlacesSpec = s.experiment.parse_present("experiment", "places").unwrap();
     if let Some(p) = places {
         spec.places = p;

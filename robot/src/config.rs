@@ -3,11 +3,9 @@
 
 use crate::tables::{ConfigProblem, Tables};
 use nalgebra::{Isometry2, Point2};
-use omniloop_vision::forward::{FlowConfig, ForwardCamera, GroundConfig, OdometryConfig};
-use omniloop_vision::luminance_heading::LuminanceConfig;
-use omniloop_vision::omnistereo::OmnistereoConfig;
-use omniloop_vision::resection::{ColumnCalibration, ResectionConfig, StripePattern};
-use omniloop_vision::{FreeSpaceConfig, LocalizationConfig, RadialCalibration};
+use omniloop_vision::RadialCalibration;
+use omniloop_vision::forward::ForwardCamera;
+use omniloop_vision::resection::{ColumnCalibration, StripePattern};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -58,41 +56,28 @@ impl ControlSpec {
 }
 
 /// Image processing settings (`[vision]`).
+///
+/// `sensor` and `calibration_file` are vision's camera; the other tables (`[vision.freespace]`,
+/// `[vision.localization]`, ...) belong to the registered perception stages
+/// ([`crate::perception::STAGES`]), which parse and check them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
+#[serde(default)]
 pub struct VisionSpec {
     /// The camera whose images vision uses (default: the robot's first).
     pub sensor: Option<String>,
     /// A calibration table written by `omniloop calibrate` (relative to the scenario file);
     /// default: traced from the sensor's optics at start.
     pub calibration_file: Option<PathBuf>,
-    /// Free-space detection (Sect. 3.1 of the corner paper).
-    pub freespace: FreeSpaceConfig,
-    /// Self-localization from the floor region (Sect. 4 of the corner paper).
-    pub localization: LocalizationConfig,
-    /// Heading from a luminance circle (Kim, Kim and Kwon, Sect. 3).
-    pub luminance_heading: LuminanceConfig,
-    /// Conical omnistereo: range, trilateration, visual compass and interframe motion
-    /// (Spacek and Burbridge).
-    pub omnistereo: OmnistereoConfig,
-    /// Striped-mark recognition for resection (Ishikawa, Kikuchi and Kato).
-    pub resection: ResectionConfig,
-    /// A forward camera's avoidance and visual odometry (Ahmed, Saatchi and Caparrelli).
-    pub forward: ForwardVisionConfig,
+    /// The registered stages' own tables.
+    #[serde(flatten)]
+    pub tables: Tables,
 }
 
-/// A forward camera's image processing (`[vision.forward]`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
-pub struct ForwardVisionConfig {
-    /// Run the visual odometry (scan-line rotation, LK and NCC translation) every frame.
-    pub visual_odometry: bool,
-    /// Ground segmentation.
-    pub ground: GroundConfig,
-    /// Horn-Schunck flow.
-    pub flow: FlowConfig,
-    /// Visual odometry.
-    pub odometry: OdometryConfig,
+impl VisionSpec {
+    /// Table `name` of `[vision]` as its owner's settings (their defaults when not written).
+    pub fn table<T: DeserializeOwned + Default>(&self, name: &str) -> Result<T, ConfigProblem> {
+        self.tables.parse("vision", name)
+    }
 }
 
 /// The goal point, reached through optional waypoints (`[goal]`), in the world (field) frame.

@@ -78,14 +78,7 @@ pub fn check_table<T: serde::de::DeserializeOwned + Default>(
     name: &str,
     check: impl FnOnce(&T, &mut crate::tables::Problems),
 ) -> Vec<ConfigProblem> {
-    match spec.table::<T>(name) {
-        Ok(t) => {
-            let mut p = crate::tables::Problems::under(&format!("control.{name}"));
-            check(&t, &mut p);
-            p.list
-        }
-        Err(e) => vec![e],
-    }
+    spec.tables.check("control", name, check)
 }
 
 /// Parses table `name` of `[control]` as `T`: its problem, if it does not parse.

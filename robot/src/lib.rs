@@ -33,8 +33,8 @@ pub use boundary::{
     RobotSoftware,
 };
 pub use config::{
-    BodySpec, ControlSpec, ForwardVisionConfig, GoalSpec, MapLandmark, MapMark, MapSegment,
-    ODOMETRY, RobotConfig, StereoRig, VisionSpec, WorldMap,
+    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, ODOMETRY, RobotConfig,
+    StereoRig, VisionSpec, WorldMap,
 };
 pub use controller::{Controller, ControllerEntry};
 pub use controllers::CONTROLLERS;
@@ -44,6 +44,7 @@ pub use estimates::{
 };
 pub use estimator::PoseEstimator;
 pub use mission::Mission;
+pub use perception::forward::ForwardVisionConfig;
 pub use perception::{STAGES, StageEntry};
 pub use robot::{Robot, stages_of};
 pub use tables::{ConfigProblem, Tables};
@@ -71,4 +72,11 @@ pub enum RobotError {
         /// The stage that needed it.
         stage: &'static str,
     },
+}
+
+impl From<ConfigProblem> for RobotError {
+    /// A settings table that does not parse, naming its field.
+    fn from(p: ConfigProblem) -> Self {
+        Self::Config(p.to_string())
+    }
 }

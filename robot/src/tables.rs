@@ -108,6 +108,24 @@ impl Tables {
         deserialize(value, section, name)
     }
 
+    /// Parses table `name` of section `section` and runs `check` on it: the problems of either,
+    /// each naming its field.
+    pub fn check<T: DeserializeOwned + Default>(
+        &self,
+        section: &str,
+        name: &str,
+        check: impl FnOnce(&T, &mut Problems),
+    ) -> Vec<ConfigProblem> {
+        match self.parse::<T>(section, name) {
+            Ok(t) => {
+                let mut p = Problems::under(&format!("{section}.{name}"));
+                check(&t, &mut p);
+                p.list
+            }
+            Err(e) => vec![e],
+        }
+    }
+
     /// Whether no table is written.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()

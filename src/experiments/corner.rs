@@ -5,8 +5,8 @@
 use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
 use super::replay::{Replay, ReplayContext, ReplayRun, write_text};
 use crate::report::topview::{Marker, Panel, PathLayer, draw_panels};
-use crate::run::RunOutput;
 use crate::run::record::{Summary, TrajectoryRow};
+use crate::run::{RunError, RunOutput};
 use crate::scenario::Checker;
 use crate::scenario::{PoseSpec, Scenario};
 use nalgebra::{Point2, Vector2};
@@ -141,8 +141,8 @@ impl ExperimentSetup for CornerSpec {
         self.validate(c);
     }
 
-    fn procedure(&self, _s: &Scenario) -> Box<dyn Experiment> {
-        Box::new(Corner)
+    fn procedure(&self, _s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        Ok(Box::new(Corner))
     }
 }
 

@@ -71,7 +71,7 @@ pub trait ExperimentSetup {
     }
 
     /// Its procedure and metrics for scenario `s`.
-    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment>;
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError>;
 }
 
 /// An experiment as the registry lists it: a new experiment is its own file with one of these

@@ -13,8 +13,8 @@ use crate::scenario::Checker;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Vector2};
 use omniloop_control::wrap_pi;
-use omniloop_robot::Estimates;
 use omniloop_robot::controllers::script::{Move, ScriptConfig};
+use omniloop_robot::{Estimates, ForwardVisionConfig};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -31,7 +31,11 @@ pub struct ForwardSpec {}
 impl ForwardSpec {
     fn validate(&self, s: &Scenario, c: &mut Checker) {
         let kind = s.control.kind.as_str();
-        if AVOIDANCE.contains(&kind) || (kind == SCRIPT && s.vision.forward.visual_odometry) {
+        let odometry = s
+            .vision
+            .table::<ForwardVisionConfig>("forward")
+            .is_ok_and(|f| f.visual_odometry);
+        if AVOIDANCE.contains(&kind) || (kind == SCRIPT && odometry) {
         } else if kind == SCRIPT {
             c.fail(
                 "vision.forward.visual_odometry",
@@ -67,8 +71,8 @@ impl ExperimentSetup for ForwardSpec {
         self.validate(s, c);
     }
 
-    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
-        Box::new(Forward::new(s))
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        Ok(Box::new(Forward::new(s)))
     }
 }
 

@@ -115,8 +115,9 @@ impl ExperimentSetup for HeadingSpec {
         Some(heading_table(summary))
     }
 
-    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
-        Box::new(Heading::new(self, &s.vision.luminance_heading))
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        let config = s.vision.table("luminance_heading")?;
+        Ok(Box::new(Heading::new(self, &config)))
     }
 }
 

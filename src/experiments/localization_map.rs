@@ -15,7 +15,9 @@ use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::wrap_pi;
 use omniloop_sim::SimError;
-use omniloop_vision::{FloorLocalizer, Localization, LocalizationMethod, LocalizationQuality};
+use omniloop_vision::{
+    FloorLocalizer, Localization, LocalizationConfig, LocalizationMethod, LocalizationQuality,
+};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -112,8 +114,9 @@ impl ExperimentSetup for MapSpec {
         Some(map_table(summary))
     }
 
-    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
-        Box::new(LocalizationMap::new(self, s.vision.localization.method))
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        let config: LocalizationConfig = s.vision.table("localization")?;
+        Ok(Box::new(LocalizationMap::new(self, config)))
     }
 }
 
@@ -256,16 +259,16 @@ impl Band {
 /// The procedure and metrics of the map.
 pub struct LocalizationMap {
     spec: MapSpec,
-    method: LocalizationMethod,
+    config: LocalizationConfig,
     entries: Vec<MapEntry>,
 }
 
 impl LocalizationMap {
-    /// The map `spec` describes, localizing with `method`.
-    pub fn new(spec: &MapSpec, method: LocalizationMethod) -> Self {
+    /// The map `spec` describes, localizing with the settings `config`.
+    pub fn new(spec: &MapSpec, config: LocalizationConfig) -> Self {
         Self {
             spec: spec.clone(),
-            method,
+            config,
             entries: Vec::new(),
         }
     }
@@ -343,8 +346,8 @@ impl Experiment for LocalizationMap {
         let cal = sim.vision_calibration().cloned().ok_or_else(|| {
             SimError::Invalid("the localization map needs the robot's vision camera".into())
         })?;
-        let mut global = FloorLocalizer::new(s.vision.localization.clone(), &cal)?;
-        let mut tracking = FloorLocalizer::new(s.vision.localization.clone(), &cal)?;
+        let mut global = FloorLocalizer::new(self.config.clone(), &cal)?;
+        let mut tracking = FloorLocalizer::new(self.config.clone(), &cal)?;
         let mut rng = StdRng::seed_from_u64(prior_seed(s.seed));
         let points = grid(&self.spec, &s);
         let total = (points.len() * self.spec.headings_deg.len()) as u64;
@@ -383,7 +386,7 @@ impl Experiment for LocalizationMap {
     fn metrics(&self, _out: &RunOutput) -> Metrics {
         let mut keys = Metrics::new();
         let settings = MapSettings {
-            method: self.method,
+            method: self.config.method,
             spec: self.spec.clone(),
         };
         keys.insert(

@@ -69,8 +69,8 @@ impl ExperimentSetup for OmnistereoSpec {
         Some(omnistereo_table(summary))
     }
 
-    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
-        Box::new(Omnistereo::new(self, s))
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        Ok(Box::new(Omnistereo::new(self, s)))
     }
 }
 

@@ -16,7 +16,7 @@ use anyhow::Context;
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::wrap_pi;
 use omniloop_robot::Measurement;
-use omniloop_vision::LocalizationMethod;
+use omniloop_vision::{LocalizationConfig, LocalizationMethod};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -81,8 +81,9 @@ impl ExperimentSetup for PlacesSpec {
         Some(places_table(summary))
     }
 
-    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
-        Box::new(Places::new(self, s.vision.localization.method))
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        let config: LocalizationConfig = s.vision.table("localization")?;
+        Ok(Box::new(Places::new(self, config.method)))
     }
 }
 

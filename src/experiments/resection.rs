@@ -75,8 +75,8 @@ impl ExperimentSetup for ResectionSpec {
         Some(resection_table(&[summary]))
     }
 
-    fn procedure(&self, s: &Scenario) -> Box<dyn Experiment> {
-        Box::new(Resection::new(self, s))
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        Ok(Box::new(Resection::new(self, s)))
     }
 }
 

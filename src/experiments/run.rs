@@ -160,7 +160,7 @@ pub fn run_scenario_with(
     options.takes_frames |= setup.as_ref().is_some_and(|e| e.takes_frames());
     let mut sim = Simulation::with_software(scenario, &options, software, notice)?;
     let mut experiment = match &setup {
-        Some(e) => e.procedure(scenario),
+        Some(e) => e.procedure(scenario)?,
         None => Box::new(Drive),
     };
     let loop_start = Instant::now();

@@ -1,6 +1,6 @@
 //! Why a run could not be carried out.
 
-use omniloop_robot::RobotError;
+use omniloop_robot::{ConfigProblem, RobotError};
 use omniloop_sim::{RenderError, SimError};
 use omniloop_vision::VisionError;
 use std::path::PathBuf;
@@ -37,4 +37,11 @@ pub enum RunError {
         /// The cause.
         source: image::ImageError,
     },
+}
+
+impl From<ConfigProblem> for RunError {
+    /// A settings table that does not parse (a scenario not checked first).
+    fn from(p: ConfigProblem) -> Self {
+        Self::Scenario(p.to_string())
+    }
 }

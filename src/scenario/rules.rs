@@ -246,6 +246,7 @@ fn check_software(c: &mut Checker, s: &Scenario) {
         return;
     }
     check_tables(c, s, controller);
+    check_vision_tables(c, s);
     let stages = s.stages();
     check_world_for(c, s, &stages);
     let Some(config) = software_config(c, s, &stages) else {
@@ -293,25 +294,50 @@ fn check_tables(c: &mut Checker, s: &Scenario, chosen: &ControllerEntry) {
             c.problems((owner.check_table)(spec));
             checked.push(name);
         } else if !STAGES.iter().any(|e| e.table == Some(name)) {
-            let mut known = vec!["kind", "pose_source", "localization_gain"];
             let tables = CONTROLLERS.iter().filter_map(|e| e.table);
-            for t in tables.chain(STAGES.iter().filter_map(|e| e.table)) {
-                if !known.contains(&t) {
-                    known.push(t);
-                }
-            }
-            c.fail(
-                format!("control.{name}"),
-                format!(
-                    "unknown field `{name}`, expected one of {}",
-                    known.join(", ")
-                ),
-            );
+            let tables = tables.chain(STAGES.iter().filter_map(|e| e.table));
+            let keys = ["kind", "pose_source", "localization_gain"];
+            unknown_table(c, "control", name, &keys, tables);
         }
     }
     if chosen.table.is_none_or(|t| !checked.contains(&t)) {
         c.problems((chosen.check_table)(spec));
     }
+}
+
+/// Every table written under `[vision]` belongs to a registered stage, which checks its values
+/// (a table stages share is checked once), whether or not the stage runs.
+fn check_vision_tables(c: &mut Checker, s: &Scenario) {
+    for name in s.vision.tables.names() {
+        if let Some(owner) = STAGES.iter().find(|e| e.vision_table == Some(name)) {
+            c.problems((owner.check_vision)(&s.vision));
+        } else {
+            let tables = STAGES.iter().filter_map(|e| e.vision_table);
+            unknown_table(c, "vision", name, &["sensor", "calibration_file"], tables);
+        }
+    }
+}
+
+/// Table `name` of `section` is no registered part's: the problem lists the section's own
+/// `keys` and the registered `tables`.
+fn unknown_table<'a>(
+    c: &mut Checker,
+    section: &str,
+    name: &str,
+    keys: &[&'a str],
+    tables: impl Iterator<Item = &'a str>,
+) {
+    let mut known = keys.to_vec();
+    for t in tables {
+        if !known.contains(&t) {
+            known.push(t);
+        }
+    }
+    let why = format!(
+        "unknown field `{name}`, expected one of {}",
+        known.join(", ")
+    );
+    c.fail(format!("{section}.{name}"), why);
 }
 
 /// What the stages need of the world that the robot is not told (its map holds the rest).

@@ -13,6 +13,7 @@ use omniloop_robot::{
 use omniloop_sim::{Layout, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::forward::ForwardCamera;
+use omniloop_vision::omnistereo::OmnistereoConfig;
 use omniloop_vision::resection::{ColumnCalibration, StripePattern};
 use serde::{Deserialize, Serialize};
 
@@ -459,7 +460,10 @@ impl Scenario {
 
     /// The omnistereo rig of `vision.omnistereo`'s two sensors, or the field at fault and why.
     pub fn stereo_rig(&self) -> Result<StereoRig, (String, String)> {
-        let o = &self.vision.omnistereo;
+        let o: OmnistereoConfig = self
+            .vision
+            .table("omnistereo")
+            .map_err(|e| (e.field, e.message))?;
         let cone = |key: &str, name: &str| {
             let field = format!("vision.omnistereo.{key}");
             let s = self

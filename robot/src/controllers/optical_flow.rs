@@ -4,6 +4,8 @@
 use super::segmentation::{ForwardDriveConfig, needs_forward_camera};
 use crate::boundary::BodyCommand;
 use crate::controller::{Controller, ControllerEntry, Situation, parses, settings};
+use crate::perception::forward::ForwardVisionConfig;
+use crate::perception::stage::vision_settings;
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -18,7 +20,9 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     build: |c| {
         Ok(Box::new(FlowAvoidance {
             drive: settings(c, "forward")?,
-            threshold_px: c.vision.forward.flow.threshold_px,
+            threshold_px: vision_settings::<ForwardVisionConfig>(c, "forward")?
+                .flow
+                .threshold_px,
             turn: None,
             settle: 0,
         }))

@@ -6,12 +6,12 @@
 
 use super::stage::{
     Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, calibration, image, vision_camera,
+    vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
-use crate::config::RobotConfig;
 use crate::estimates::{Measurement, NotFound};
-use crate::tables::{ConfigProblem, Problems};
+use crate::tables::Problems;
 use omniloop_vision::{FloorLocalizer, Localization, LocalizationConfig, RadialCalibration};
 
 /// The registry's entry.
@@ -20,22 +20,25 @@ pub const ENTRY: StageEntry = StageEntry {
     summary: "self-localization from the shape of the floor region (Sect. 4 of the corner paper)",
     pose_source: Some("localization"),
     table: None,
+    vision_table: Some(TABLE),
+    check_vision: |v| v.tables.check("vision", TABLE, check),
     asked: |c| c.control.pose_source == "localization",
     camera: CameraNeed::MirrorFloor,
-    check,
+    check: |_| Vec::new(),
     build: |c| {
         let camera = vision_camera(c, "self-localization")?;
         let cal = calibration(c, camera)?;
-        let config = c.vision.localization.clone();
+        let config = vision_settings(c, TABLE)?;
         Ok(Box::new(FloorLocalizationStage::new(camera, config, cal)?))
     },
 };
 
+/// The stage's settings table, `[vision.localization]`.
+const TABLE: &str = "localization";
+
 /// `[vision.localization]`'s values.
-fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
-    let l = &c.vision.localization;
+fn check(l: &LocalizationConfig, p: &mut Problems) {
     let f = &l.field;
-    let mut p = Problems::under("vision.localization");
     p.positive("field.a1_mm", f.a1_mm);
     if f.a2_mm.is_nan() || f.a2_mm <= f.a1_mm {
         p.fail(
@@ -72,7 +75,6 @@ fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
     if l.max_iterations == 0 {
         p.fail("max_iterations", "must be >= 1");
     }
-    p.list
 }
 
 /// Localizes the robot in every frame of one mirror camera.

@@ -1,16 +1,17 @@
 //! A forward camera's stages (Ahmed, Saatchi and Caparrelli): ground segmentation and
 //! Horn-Schunck flow for avoidance, scan-line and feature visual odometry.
 
-use super::stage::{Belief, CameraNeed, Percepts, Stage, StageEntry, image};
+use super::stage::{Belief, CameraNeed, Percepts, Stage, StageEntry, image, vision_settings};
 use crate::RobotError;
 use crate::boundary::Observation;
-use crate::config::RobotConfig;
+use crate::config::{RobotConfig, VisionSpec};
 use crate::estimates::GroundReading;
 use crate::tables::ConfigProblem;
 use omniloop_vision::forward::{
-    FlowBalance, FlowConfig, ForwardCamera, ForwardOdometry, Grey, GroundSegmenter, grey,
-    horn_schunck, reduce,
+    FlowBalance, FlowConfig, ForwardCamera, ForwardOdometry, Grey, GroundConfig, GroundSegmenter,
+    OdometryConfig, grey, horn_schunck, reduce,
 };
+use serde::{Deserialize, Serialize};
 
 /// The forward camera the stages read, or the error saying vision's camera is not one.
 fn camera(c: &RobotConfig) -> Result<ForwardCamera, RobotError> {
@@ -22,18 +23,48 @@ fn camera(c: &RobotConfig) -> Result<ForwardCamera, RobotError> {
     })
 }
 
+/// A forward camera's image processing (`[vision.forward]`), shared by its three stages.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct ForwardVisionConfig {
+    /// Run the visual odometry (scan-line rotation, LK and NCC translation) every frame.
+    pub visual_odometry: bool,
+    /// Ground segmentation.
+    pub ground: GroundConfig,
+    /// Horn-Schunck flow.
+    pub flow: FlowConfig,
+    /// Visual odometry.
+    pub odometry: OdometryConfig,
+}
+
+/// The table the three stages share.
+const TABLE: &str = "forward";
+
+/// `[vision.forward]`'s settings.
+fn settings(c: &RobotConfig) -> Result<ForwardVisionConfig, RobotError> {
+    vision_settings(c, TABLE)
+}
+
+/// `[vision.forward]` parses.
+fn check_vision(v: &VisionSpec) -> Vec<ConfigProblem> {
+    v.tables
+        .check::<ForwardVisionConfig>("vision", TABLE, |_, _| {})
+}
+
 /// The registry's entry of the ground segmentation.
 pub const GROUND: StageEntry = StageEntry {
     name: "ground",
     summary: "a forward camera's ground segmentation (Ahmed et al., Sect. 2.1.1)",
     pose_source: None,
     table: None,
+    vision_table: Some(TABLE),
+    check_vision,
     asked: |_| false,
     camera: CameraNeed::Forward,
     check: |_| Vec::new(),
     build: |c| {
         let camera = camera(c)?;
-        let config = c.vision.forward.ground.clone();
+        let config = settings(c)?.ground;
         Ok(Box::new(GroundStage {
             segmenter: GroundSegmenter::new(&camera, 2.0 * c.body.radius_mm, config),
             camera: camera.sensor.clone(),
@@ -47,13 +78,15 @@ pub const FLOW: StageEntry = StageEntry {
     summary: "a forward camera's Horn-Schunck flow balance (Ahmed et al., Sect. 2.1.2)",
     pose_source: None,
     table: None,
+    vision_table: Some(TABLE),
+    check_vision,
     asked: |_| false,
     camera: CameraNeed::Forward,
     check: |_| Vec::new(),
     build: |c| {
         Ok(Box::new(FlowStage {
             camera: camera(c)?.sensor.clone(),
-            config: c.vision.forward.flow.clone(),
+            config: settings(c)?.flow,
             previous: None,
         }))
     },
@@ -66,7 +99,9 @@ pub const VISUAL_ODOMETRY: StageEntry = StageEntry {
               (Ahmed et al., Sect. 2.2)",
     pose_source: None,
     table: None,
-    asked: |c| c.vision.forward.visual_odometry,
+    vision_table: Some(TABLE),
+    check_vision,
+    asked: |c| settings(c).is_ok_and(|f| f.visual_odometry),
     camera: CameraNeed::Forward,
     check: |c| {
         if c.forward_camera.is_some() {
@@ -81,7 +116,7 @@ pub const VISUAL_ODOMETRY: StageEntry = StageEntry {
     build: |c| {
         Ok(Box::new(VisualOdometryStage::new(
             camera(c)?,
-            &c.vision.forward,
+            settings(c)?.odometry,
         )?))
     },
 };
@@ -164,13 +199,10 @@ pub struct VisualOdometryStage {
 }
 
 impl VisualOdometryStage {
-    fn new(
-        camera: ForwardCamera,
-        config: &crate::config::ForwardVisionConfig,
-    ) -> Result<Self, RobotError> {
+    fn new(camera: ForwardCamera, config: OdometryConfig) -> Result<Self, RobotError> {
         Ok(Self {
             camera: camera.sensor.clone(),
-            odometry: ForwardOdometry::new(camera, config.odometry.clone())?,
+            odometry: ForwardOdometry::new(camera, config)?,
         })
     }
 }

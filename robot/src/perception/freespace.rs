@@ -3,6 +3,7 @@
 
 use super::stage::{
     Belief, CameraNeed, Percepts, Stage, StageEntry, calibration, image, vision_camera,
+    vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
@@ -18,25 +19,48 @@ pub const ENTRY: StageEntry = StageEntry {
               the corner paper)",
     pose_source: None,
     table: None,
+    vision_table: Some(TABLE),
+    check_vision: |v| v.tables.check("vision", TABLE, check_values),
     asked: |_| false,
     camera: CameraNeed::MirrorFloor,
     check,
     build: |c| {
         let camera = vision_camera(c, "free space")?;
         let cal = calibration(c, camera)?;
-        Ok(Box::new(FreeSpaceStage::new(
-            camera,
-            c.vision.freespace.clone(),
-            cal,
-        )?))
+        let config = vision_settings(c, TABLE)?;
+        Ok(Box::new(FreeSpaceStage::new(camera, config, cal)?))
     },
 };
 
-/// `[vision.freespace]`'s values, and the template on the camera's calibration when it is
-/// known.
+/// The stage's settings table, `[vision.freespace]`.
+const TABLE: &str = "freespace";
+
+/// The polar template on vision's camera's calibration, when the settings are good and the
+/// calibration known.
 fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
-    let fs = &c.vision.freespace;
+    let cal = c.vision_camera().and_then(|cam| c.calibration(cam));
+    let fs = c.vision.table::<FreeSpaceConfig>(TABLE);
+    let (Some(cal), Ok(fs)) = (cal, fs) else {
+        return Vec::new();
+    };
+    if !check_vision_values(&fs).is_empty() {
+        return Vec::new();
+    }
+    match PolarTemplate::new(&fs, cal) {
+        Ok(_) => Vec::new(),
+        Err(e) => vec![ConfigProblem::new("vision.freespace", e.to_string())],
+    }
+}
+
+/// `[vision.freespace]`'s values, each problem naming its field.
+fn check_vision_values(fs: &FreeSpaceConfig) -> Vec<ConfigProblem> {
     let mut p = Problems::under("vision.freespace");
+    check_values(fs, &mut p);
+    p.list
+}
+
+/// `[vision.freespace]`'s values.
+fn check_values(fs: &FreeSpaceConfig, p: &mut Problems) {
     if fs.directions < 4 {
         p.fail(
             "directions",
@@ -84,13 +108,6 @@ fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
             );
         }
     }
-    let cal = c.vision_camera().and_then(|cam| c.calibration(cam));
-    if let (true, Some(cal)) = (p.list.is_empty(), cal)
-        && let Err(e) = PolarTemplate::new(fs, cal)
-    {
-        p.fail("", e.to_string());
-    }
-    p.list
 }
 
 /// Detects free space in every frame of one mirror camera.

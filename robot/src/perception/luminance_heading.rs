@@ -12,6 +12,7 @@
 
 use super::stage::{
     Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, calibration, image, vision_camera,
+    vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
@@ -27,13 +28,18 @@ pub const ENTRY: StageEntry = StageEntry {
               Sect. 3)",
     pose_source: Some("checkpoints"),
     table: None,
+    vision_table: Some("luminance_heading"),
+    check_vision: |v| {
+        v.tables
+            .check::<LuminanceConfig>("vision", "luminance_heading", |_, _| {})
+    },
     asked: |c| !c.checkpoints().is_empty(),
     camera: CameraNeed::Mirror,
     check: |_| Vec::new(),
     build: |c| {
         let camera = vision_camera(c, "the luminance heading")?;
         let cal = calibration(c, camera)?;
-        let (config, goal) = (c.vision.luminance_heading.clone(), c.goal.as_ref());
+        let (config, goal) = (vision_settings(c, "luminance_heading")?, c.goal.as_ref());
         let (store, read) = goal.map_or((0.0, 0.0), |g| {
             (g.checkpoint_store_mm, g.checkpoint_radius_mm)
         });

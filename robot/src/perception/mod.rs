@@ -64,3 +64,25 @@ pub fn build(
 ) -> Result<Vec<Box<dyn Stage>>, RobotError> {
     wanted.iter().map(|s| (s.build)(config)).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::VisionSpec;
+
+    #[test]
+    fn every_vision_table_takes_its_defaults_and_names_a_stray_key() {
+        for entry in STAGES {
+            let Some(table) = entry.vision_table else {
+                continue;
+            };
+            let mut spec = VisionSpec::default();
+            assert_eq!((entry.check_vision)(&spec), Vec::new(), "{}", entry.name);
+            let stray: toml::Value = toml::from_str("no_such_key = 1").unwrap();
+            spec.tables.0.insert(table.to_string(), stray);
+            let problems = (entry.check_vision)(&spec);
+            assert_eq!(problems.len(), 1, "{}: {problems:?}", entry.name);
+            assert_eq!(problems[0].field, format!("vision.{table}.no_such_key"));
+        }
+    }
+}

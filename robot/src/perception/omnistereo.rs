@@ -11,7 +11,9 @@
 //! the translation. The motion is recorded, not fused: a 15 mm step measured to a few
 //! millimetres is no better than the wheels over 50 ms.
 
-use super::stage::{Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, image};
+use super::stage::{
+    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, image, vision_settings,
+};
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::{MapLandmark, StereoRig};
@@ -33,13 +35,19 @@ pub const ENTRY: StageEntry = StageEntry {
               motion (Spacek and Burbridge, Sect. 2)",
     pose_source: Some("omnistereo"),
     table: None,
+    vision_table: Some("omnistereo"),
+    check_vision: |v| {
+        v.tables
+            .check::<OmnistereoConfig>("vision", "omnistereo", |t, p| {
+                if let Err(e) = t.validate() {
+                    p.fail("", e.to_string());
+                }
+            })
+    },
     asked: |c| c.control.pose_source == "omnistereo",
     camera: CameraNeed::None,
     check: |c| {
         let mut p = Vec::new();
-        if let Err(e) = c.vision.omnistereo.validate() {
-            p.push(ConfigProblem::new("vision.omnistereo", e.to_string()));
-        }
         if c.map.landmarks.is_empty() {
             let why = "omnistereo trilateration needs landmarks: add [[world.pillars]] of \
                        distinct colours";
@@ -51,7 +59,7 @@ pub const ENTRY: StageEntry = StageEntry {
         let rig = c.stereo.ok_or_else(|| {
             RobotError::Config("pose_source \"omnistereo\" needs the robot's two cones".into())
         })?;
-        let config = c.vision.omnistereo.clone();
+        let config = vision_settings(c, "omnistereo")?;
         Ok(Box::new(OmnistereoStage::new(
             config,
             rig,

@@ -19,6 +19,7 @@
 
 use super::stage::{
     Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, image, vision_camera,
+    vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::{ActuatorCommand, ActuatorState, Observation};
@@ -41,18 +42,24 @@ pub const ENTRY: StageEntry = StageEntry {
               (Ishikawa, Kikuchi and Kato)",
     pose_source: Some("resection"),
     table: Some("resection"),
+    vision_table: Some("resection"),
+    check_vision: |v| {
+        v.tables
+            .check::<ResectionConfig>("vision", "resection", |t, p| {
+                if let Err(e) = t.validate() {
+                    p.fail("", e.to_string());
+                }
+            })
+    },
     asked: |c| c.control.pose_source == "resection",
     camera: CameraNeed::MirrorOrPinhole,
     check,
     build: |c| Ok(Box::new(build(c)?)),
 };
 
-/// `[vision.resection]`, `[control.resection]` and the map's marks.
+/// `[control.resection]` and the map's marks.
 fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
     let mut out = Vec::new();
-    if let Err(e) = c.vision.resection.validate() {
-        out.push(ConfigProblem::new("vision.resection", e.to_string()));
-    }
     match c.control.table::<SearchConfig>("resection") {
         Err(e) => out.push(e),
         Ok(r) => {
@@ -93,7 +100,7 @@ fn build(config: &RobotConfig) -> Result<ResectionStage, RobotError> {
         .control
         .table("resection")
         .map_err(|e| RobotError::Config(e.to_string()))?;
-    let vision = config.vision.resection.clone();
+    let vision = vision_settings(config, "resection")?;
     ResectionStage::new(camera, view, vision, search, &config.map.marks)
 }
 

@@ -4,7 +4,7 @@
 
 use crate::RobotError;
 use crate::boundary::{ActuatorCommand, Observation};
-use crate::config::RobotConfig;
+use crate::config::{RobotConfig, VisionSpec};
 use crate::estimates::{GroundReading, LandmarkSighting, Measurement, MotionReading, NotFound};
 use crate::tables::ConfigProblem;
 use image::RgbaImage;
@@ -107,14 +107,31 @@ pub struct StageEntry {
     pub pose_source: Option<&'static str>,
     /// Its own table under `[control]`, if it has one (checked by `check`).
     pub table: Option<&'static str>,
+    /// Its settings table under `[vision]`, if it has one (stages may share one).
+    pub vision_table: Option<&'static str>,
+    /// Parses and checks that table's values wherever it is written, naming each field at
+    /// fault.
+    pub check_vision: fn(&VisionSpec) -> Vec<ConfigProblem>,
     /// Whether the robot's configuration asks for it (besides a controller that reads it).
     pub asked: fn(&RobotConfig) -> bool,
     /// What it needs of vision's camera.
     pub camera: CameraNeed,
-    /// Checks what it needs of the robot (its settings, the map), naming each field at fault.
+    /// Checks what it needs of the robot (its camera, the map, its settings on that camera),
+    /// naming each field at fault; its vision table's own values are `check_vision`'s.
     pub check: fn(&RobotConfig) -> Vec<ConfigProblem>,
     /// Builds it for a robot.
     pub build: fn(&RobotConfig) -> Result<Box<dyn Stage>, RobotError>,
+}
+
+/// The settings table `name` of a robot's `[vision]`, as a build error when it does not parse.
+pub fn vision_settings<T: serde::de::DeserializeOwned + Default>(
+    config: &RobotConfig,
+    name: &str,
+) -> Result<T, RobotError> {
+    config
+        .vision
+        .table(name)
+        .map_err(|e| RobotError::Config(e.to_string()))
 }
 
 /// The calibration of camera `sensor`, or the error saying there is none.
