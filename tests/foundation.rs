@@ -133,6 +133,14 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             ":11:1: field `control.wander.clearance_mm`: invalid type: string \"wide\"",
         ),
         (
+            "wall_follow_side",
+            format!(
+                "{BASE}\n[control]\nkind = \"wall_follow\"\n[control.wall_follow]\nside = \"up\"\n"
+            ),
+            ":13:1: field `control.wall_follow.side`: unknown variant `up`, expected `left` or \
+             `right`",
+        ),
+        (
             "script_unknown_key",
             format!("{BASE}\n[control.script]\nspeed = 3.0\n"),
             ":11:1: field `control.script.speed`: unknown field `speed`",
@@ -187,7 +195,8 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             "unknown_control_table",
             format!("{BASE}\n[control.avodance]\nmargin_mm = 1.0\n"),
             ":10:10: field `control.avodance`: unknown field `avodance`, expected one of kind, \
-             pose_source, localization_gain, avoidance, wander, forward, script, resection",
+             pose_source, localization_gain, avoidance, wander, forward, script, wall_follow, \
+             resection",
         ),
     ];
     for (name, text, expected) in cases {

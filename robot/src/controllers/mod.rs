@@ -12,6 +12,7 @@ pub mod optical_flow;
 pub mod script;
 pub mod segmentation;
 pub mod velocity_aware;
+pub mod wall_follow;
 pub mod wander;
 
 use crate::RobotError;
@@ -29,6 +30,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
     segmentation::ENTRY,
     optical_flow::ENTRY,
     script::ENTRY,
+    wall_follow::ENTRY,
 ];
 
 /// The controller called `name`.
