@@ -1,10 +1,10 @@
 //! A forward camera's Horn-Schunck flow-balance avoidance (Ahmed, Saatchi and Caparrelli,
 //! Sect. 2.1.2).
 
-use super::segmentation::{ForwardDriveConfig, needs_forward_camera};
+use super::segmentation::ForwardDriveConfig;
 use crate::boundary::BodyCommand;
 use crate::controller::{Controller, ControllerEntry, Situation, parses, settings};
-use crate::perception::forward::ForwardVisionConfig;
+use crate::perception::forward::{ForwardVisionConfig, needs_forward_camera};
 use crate::perception::stage::vision_settings;
 
 /// The registry's entry.

@@ -2,9 +2,8 @@
 //! Sect. 2.1.1), with the settings it shares with the flow avoidance (`[control.forward]`).
 
 use crate::boundary::BodyCommand;
-use crate::config::RobotConfig;
 use crate::controller::{Controller, ControllerEntry, Situation, parses, settings};
-use crate::tables::ConfigProblem;
+use crate::perception::forward::needs_forward_camera;
 use serde::{Deserialize, Serialize};
 
 /// The registry's entry.
@@ -24,18 +23,6 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         }))
     },
 };
-
-/// A forward camera's avoidance needs vision's camera to be a forward pinhole.
-pub fn needs_forward_camera(c: &RobotConfig) -> Vec<ConfigProblem> {
-    if c.forward_camera.is_some() {
-        return Vec::new();
-    }
-    vec![ConfigProblem::new(
-        "vision.sensor",
-        "the forward camera's avoidance and visual odometry need vision's camera to be a \
-         pinhole ([robot.sensors.pinhole])",
-    )]
-}
 
 /// How the forward camera's avoidance drives (`[control.forward]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

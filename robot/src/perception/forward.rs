@@ -40,6 +40,19 @@ pub struct ForwardVisionConfig {
 /// The table the three stages share.
 const TABLE: &str = "forward";
 
+/// The forward camera's stages, and the controllers that read them, need vision's camera to be
+/// a forward pinhole.
+pub fn needs_forward_camera(c: &RobotConfig) -> Vec<ConfigProblem> {
+    if c.forward_camera.is_some() {
+        return Vec::new();
+    }
+    vec![ConfigProblem::new(
+        "vision.sensor",
+        "the forward camera's avoidance and visual odometry need vision's camera to be a \
+         pinhole ([robot.sensors.pinhole])",
+    )]
+}
+
 /// `[vision.forward]`'s settings.
 fn settings(c: &RobotConfig) -> Result<ForwardVisionConfig, RobotError> {
     vision_settings(c, TABLE)
@@ -103,16 +116,7 @@ pub const VISUAL_ODOMETRY: StageEntry = StageEntry {
     check_vision,
     asked: |c| settings(c).is_ok_and(|f| f.visual_odometry),
     camera: CameraNeed::Forward,
-    check: |c| {
-        if c.forward_camera.is_some() {
-            return Vec::new();
-        }
-        vec![ConfigProblem::new(
-            "vision.sensor",
-            "the forward camera's avoidance and visual odometry need vision's camera to be a \
-             pinhole ([robot.sensors.pinhole])",
-        )]
-    },
+    check: needs_forward_camera,
     build: |c| {
         Ok(Box::new(VisualOdometryStage::new(
             camera(c)?,
