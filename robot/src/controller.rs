@@ -94,10 +94,7 @@ pub fn settings<T: serde::de::DeserializeOwned + Default>(
     config: &RobotConfig,
     name: &str,
 ) -> Result<T, RobotError> {
-    config
-        .control
-        .table(name)
-        .map_err(|e| RobotError::Config(e.to_string()))
+    Ok(config.control.table(name)?)
 }
 
 /// Runs `f` on the surroundings vision reported (with `near` as the surely free boundary, when

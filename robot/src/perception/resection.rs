@@ -96,10 +96,7 @@ fn build(config: &RobotConfig) -> Result<ResectionStage, RobotError> {
             )));
         }
     };
-    let search = config
-        .control
-        .table("resection")
-        .map_err(|e| RobotError::Config(e.to_string()))?;
+    let search = config.control.table("resection")?;
     let vision = vision_settings(config, "resection")?;
     ResectionStage::new(camera, view, vision, search, &config.map.marks)
 }

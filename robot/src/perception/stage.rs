@@ -128,10 +128,7 @@ pub fn vision_settings<T: serde::de::DeserializeOwned + Default>(
     config: &RobotConfig,
     name: &str,
 ) -> Result<T, RobotError> {
-    config
-        .vision
-        .table(name)
-        .map_err(|e| RobotError::Config(e.to_string()))
+    Ok(config.vision.table(name)?)
 }
 
 /// The calibration of camera `sensor`, or the error saying there is none.
