@@ -195,7 +195,7 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             "unknown_control_table",
             format!("{BASE}\n[control.avodance]\nmargin_mm = 1.0\n"),
             ":10:10: field `control.avodance`: unknown field `avodance`, expected one of kind, \
-             pose_source, localization_gain, avoidance, wander, forward, script, wall_follow, \
+             pose_source, localization_gain, avoidance, planner, wander, forward, script, wall_follow, \
              resection",
         ),
     ];

@@ -196,4 +196,10 @@ pub trait RobotSoftware: Send {
     fn estimate(&self) -> Option<nalgebra::Isometry2<f64>> {
         None
     }
+
+    /// The map it built, if it builds one (drawn under the paths in `topview.png`); default:
+    /// none.
+    fn map(&self) -> Option<crate::MapSnapshot> {
+        None
+    }
 }

@@ -206,8 +206,13 @@ pub struct MapMark {
 pub struct WorldMap {
     /// Landmarks, with the colours vision names them by.
     pub landmarks: Vec<MapLandmark>,
-    /// Straight obstacles.
+    /// Straight obstacles that stay put: walls and boards standing in the world.
     pub segments: Vec<MapSegment>,
+    /// The sides of the boxes (cubes) where the map says they stand: things that may be moved,
+    /// so a planner does not trust them.
+    pub boxes: Vec<MapSegment>,
+    /// The walls that bound the floor: the field's walls and goals, corridor walls.
+    pub bounds: Vec<MapSegment>,
     /// Striped marks.
     pub marks: Vec<MapMark>,
 }

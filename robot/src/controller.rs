@@ -6,6 +6,7 @@ use crate::RobotError;
 use crate::boundary::BodyCommand;
 use crate::config::{ControlSpec, RobotConfig};
 use crate::estimates::GroundReading;
+use crate::navigation::{MapSnapshot, NavigationReport};
 use crate::near_field::NearSpace;
 use crate::tables::ConfigProblem;
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -20,6 +21,8 @@ pub struct Situation<'a> {
     pub freespace: Option<&'a FreeSpace>,
     /// The target relative to the robot (body frame, by the estimate), with a mission.
     pub target_body_mm: Option<Vector2<f64>>,
+    /// The target itself (world frame), with a mission and a pose estimate.
+    pub target_mm: Option<Point2<f64>>,
     /// The measured body velocity.
     pub velocity_body_mm_s: Vector2<f64>,
     /// The pose estimate (world frame), when the robot has one.
@@ -44,6 +47,24 @@ pub trait Controller: Send {
     fn step(&self) -> Option<usize> {
         None
     }
+    /// What its planner did this cycle, if it plans.
+    fn navigation(&self) -> Option<&NavigationReport> {
+        None
+    }
+    /// The map its planner built, if it plans.
+    fn map(&self) -> Option<MapSnapshot> {
+        None
+    }
+}
+
+/// A settings table of a controller (`[control.NAME]`) and its check, which parses it and
+/// names each field at fault.
+#[derive(Clone, Copy)]
+pub struct ControlTable {
+    /// Its name under `[control]`.
+    pub name: &'static str,
+    /// Parses and checks it.
+    pub check: fn(&ControlSpec) -> Vec<ConfigProblem>,
 }
 
 /// A controller as the registry lists it: a new controller is its own file with one of these
@@ -53,14 +74,12 @@ pub struct ControllerEntry {
     pub name: &'static str,
     /// What it does, in one line, with the paper and section it follows.
     pub summary: &'static str,
-    /// Its own table under `[control]`, if it has settings (controllers alike may share one).
-    pub table: Option<&'static str>,
+    /// Its own tables under `[control]`, if it has settings (controllers alike may share one).
+    pub tables: &'static [ControlTable],
     /// Whether it drives to the scenario's `[goal]`, which must then be given.
     pub needs_goal: bool,
     /// The perception stages it reads, by name ([`crate::perception::STAGES`]).
     pub stages: &'static [&'static str],
-    /// Parses and checks its table, naming each field at fault.
-    pub check_table: fn(&ControlSpec) -> Vec<ConfigProblem>,
     /// Checks what it needs of the robot (a camera, a map) when it is the robot's controller.
     pub check_use: fn(&RobotConfig) -> Vec<ConfigProblem>,
     /// Builds it for a robot.

@@ -146,6 +146,8 @@ pub struct Estimates {
     pub visual_odometry: Option<OdometryStep>,
     /// The move a scripted drive is at (the number of moves once done).
     pub step: Option<usize>,
+    /// What the planner did, when the controller plans.
+    pub navigation: Option<crate::NavigationReport>,
 }
 
 impl Estimates {

@@ -23,6 +23,7 @@ pub mod controllers;
 pub mod estimates;
 pub mod estimator;
 pub mod mission;
+pub mod navigation;
 pub mod near_field;
 pub mod perception;
 pub mod robot;
@@ -44,6 +45,7 @@ pub use estimates::{
 };
 pub use estimator::PoseEstimator;
 pub use mission::Mission;
+pub use navigation::{CellState, GridGeometry, MapSnapshot, NavigationReport, PlannerConfig};
 pub use perception::forward::ForwardVisionConfig;
 pub use perception::{STAGES, StageEntry};
 pub use robot::{Robot, stages_of};

@@ -5,7 +5,7 @@ use crate::boundary::{Observation, OdometryReading, Outputs, RobotSoftware};
 use crate::config::{ODOMETRY, RobotConfig};
 use crate::controller::{Controller, Situation};
 use crate::controllers;
-use crate::estimates::{Estimates, Fix};
+use crate::estimates::{Estimates, Fix, NotFound};
 use crate::estimator::PoseEstimator;
 use crate::mission::Mission;
 use crate::perception::{self, Belief, Percepts, Stage, StageEntry};
@@ -116,6 +116,11 @@ impl RobotSoftware for Robot {
         self.estimator.estimate()
     }
 
+    /// The map its planner built, if its controller plans.
+    fn map(&self) -> Option<crate::MapSnapshot> {
+        self.controller.map()
+    }
+
     /// One control cycle: perceive, fuse, judge the mission on the estimate, decide.
     fn cycle(&mut self, obs: &Observation<'_>) -> Result<Outputs, RobotError> {
         let belief = Belief {
@@ -141,14 +146,19 @@ impl RobotSoftware for Robot {
         if let Some(m) = &mut self.mission {
             m.update(pose.as_ref());
         }
-        let target_body_mm = match (&self.mission, &pose) {
-            (Some(m), Some(p)) => Some(p.inverse_transform_point(&m.target()).coords),
+        let target_mm = match (&self.mission, &pose) {
+            (Some(m), Some(_)) => Some(m.target()),
+            _ => None,
+        };
+        let target_body_mm = match (target_mm, &pose) {
+            (Some(t), Some(p)) => Some(p.inverse_transform_point(&t).coords),
             _ => None,
         };
         let velocity_body_mm_s = self.estimator.velocity_body_mm_s();
         let command = self.controller.decide(&Situation {
             freespace: percepts.freespace.as_ref(),
             target_body_mm,
+            target_mm,
             velocity_body_mm_s,
             pose,
             odometry_pose: self.estimator.odometry_pose(),
@@ -158,6 +168,20 @@ impl RobotSoftware for Robot {
             t_s: obs.t_s,
         });
         self.estimator.end_cycle();
+        let navigation = self.controller.navigation().cloned();
+        let mut not_found = percepts.not_found;
+        if let (Some(n), Some(t)) = (&navigation, target_mm)
+            && n.unreachable
+        {
+            not_found.push(NotFound {
+                source: "planner",
+                reason: format!(
+                    "unreachable: no route through free or unknown cells reaches ({:.0}, {:.0}); \
+                     the robot stopped",
+                    t.x, t.y
+                ),
+            });
+        }
         Ok(Outputs {
             command,
             actuators: percepts.actuators,
@@ -167,7 +191,7 @@ impl RobotSoftware for Robot {
                 velocity_body_mm_s,
                 freespace: percepts.freespace,
                 fixes,
-                not_found: percepts.not_found,
+                not_found,
                 target: self.mission.as_ref().map(Mission::index),
                 landmarks: percepts.landmarks,
                 motion: percepts.motion,
@@ -175,6 +199,7 @@ impl RobotSoftware for Robot {
                 flow: percepts.flow,
                 visual_odometry: percepts.visual_odometry,
                 step: self.controller.step(),
+                navigation,
             },
         })
     }

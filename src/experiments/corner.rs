@@ -281,6 +281,7 @@ fn draw_comparison(file: &Path, runs: &[ReplayRun]) -> anyhow::Result<()> {
                 }],
                 markers,
                 spots: Vec::new(),
+                grid: None,
             }
         })
         .collect();

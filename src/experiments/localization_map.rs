@@ -673,6 +673,7 @@ fn map_figure(
                 paths: Vec::new(),
                 markers: Vec::new(),
                 spots,
+                grid: None,
             }
         })
         .collect();

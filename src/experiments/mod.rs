@@ -4,6 +4,7 @@
 //! [`Runner`]) and loading scenario files with every experiment's checks. An experiment drives
 //! the loop of [`crate::run`]; the loop never calls up into an experiment.
 
+pub mod clutter;
 pub mod corner;
 pub mod experiment;
 pub mod forward;

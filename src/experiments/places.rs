@@ -314,6 +314,7 @@ fn draw_places(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Res
         }],
         markers,
         spots: Vec::new(),
+        grid: None,
     };
     draw_panels(file, &[panel], 1100)?;
     Ok(())

@@ -4,7 +4,7 @@
 
 use super::experiment::{ExperimentEntry, ExperimentSetup};
 use super::replay::Replay;
-use super::{corner, forward, heading, localization_map, omnistereo, places, resection};
+use super::{clutter, corner, forward, heading, localization_map, omnistereo, places, resection};
 use crate::scenario::{Checker, Scenario};
 use omniloop_robot::ConfigProblem;
 
@@ -17,6 +17,7 @@ pub const EXPERIMENTS: &[ExperimentEntry] = &[
     omnistereo::ENTRY,
     resection::ENTRY,
     forward::ENTRY,
+    clutter::ENTRY,
 ];
 
 /// Every replay, in the order `omniloop replay --list` shows them.

@@ -292,6 +292,7 @@ fn figure(
                 size_px: 5,
             },
         ],
+        grid: None,
     };
     panels_png("resection.png", &[panel], 1000)
 }

@@ -1,7 +1,7 @@
 //! Writing a run's results: `summary.json`, `trajectory.csv`, `estimates.jsonl` and
 //! `topview.png`.
 
-use super::topview::{Marker, PathLayer, draw_topview};
+use super::topview::{Marker, Panel, PathLayer, draw_panels};
 use crate::run::RunOutput;
 use crate::run::record::{write_estimates_jsonl, write_trajectory_csv};
 use crate::scenario::Scenario;
@@ -71,6 +71,22 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
             discs: None,
         });
     }
+    let plan: Vec<Point2<f64>> = out
+        .estimates
+        .iter()
+        .rev()
+        .find_map(|e| e.navigation.as_ref())
+        .map(|n| n.path_mm.clone())
+        .unwrap_or_default();
+    if plan.len() > 1 {
+        layers.push(PathLayer {
+            label: "last plan".into(),
+            rgb: [20, 140, 60],
+            points: &plan,
+            dots: false,
+            discs: None,
+        });
+    }
     layers.push(PathLayer {
         label: "true path".into(),
         rgb: [220, 30, 30],
@@ -100,13 +116,21 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
             label: "goal".into(),
         });
     }
-    draw_topview(
-        file,
-        &scenario.name,
-        &scenario.world,
-        &layers,
-        &markers,
-        1000,
-    )?;
+    let title = match out.map {
+        Some(_) => format!(
+            "{}  (robot's map: green free, red blocked, clear unknown)",
+            scenario.name
+        ),
+        None => scenario.name.clone(),
+    };
+    let panel = Panel {
+        title,
+        layout: &scenario.world,
+        paths: layers,
+        markers,
+        spots: Vec::new(),
+        grid: out.map.as_ref(),
+    };
+    draw_panels(file, &[panel], 1000)?;
     Ok(())
 }

@@ -2,6 +2,7 @@
 //! with plotters into a PNG.
 
 use nalgebra::Point2;
+use omniloop_robot::{CellState, MapSnapshot};
 use omniloop_sim::{Layout, Rgb, SolidShape};
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -191,6 +192,9 @@ pub struct Panel<'a> {
     pub markers: Vec<Marker>,
     /// Spots, drawn over the rest.
     pub spots: Vec<Spots>,
+    /// A map the robot built, drawn over the floor: free cells green, blocked ones red, unknown
+    /// ones left clear.
+    pub grid: Option<&'a MapSnapshot>,
 }
 
 type Area<'b> = DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>;
@@ -256,6 +260,9 @@ fn draw_panel(
             line,
         ))
         .map_err(|e| err(&e))?;
+    }
+    if let Some(grid) = panel.grid {
+        draw_grid(&plot, grid)?;
     }
     for s in layout.solids() {
         let fill = rgb(s.rgb).filled();
@@ -357,6 +364,41 @@ fn draw_panel(
     Ok(())
 }
 
+/// The robot's map, a rectangle a run of like cells along each row.
+fn draw_grid(
+    plot: &DrawingArea<
+        BitMapBackend<'_>,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    grid: &MapSnapshot,
+) -> Result<(), String> {
+    let g = &grid.geometry;
+    let (ox, oy, c) = (g.origin_mm.x, g.origin_mm.y, g.cell_mm);
+    for y in 0..g.height {
+        let row = &grid.cells[y * g.width..(y + 1) * g.width];
+        let mut x = 0;
+        while x < g.width {
+            let state = row[x];
+            let run = row[x..].iter().take_while(|&&s| s == state).count();
+            let style = match state {
+                CellState::Free => Some(RGBColor(40, 200, 60).mix(0.3).filled()),
+                CellState::Blocked => Some(RGBColor(200, 30, 30).mix(0.65).filled()),
+                CellState::Unknown => None,
+            };
+            if let Some(style) = style {
+                let (x0, y0) = (ox + x as f64 * c, oy + y as f64 * c);
+                plot.draw(&Rectangle::new(
+                    [(x0, y0), (x0 + run as f64 * c, y0 + c)],
+                    style,
+                ))
+                .map_err(|e| e.to_string())?;
+            }
+            x += run;
+        }
+    }
+    Ok(())
+}
+
 fn circle_points(c: Point2<f64>, r: f64, n: usize) -> Vec<(f64, f64)> {
     (0..=n)
         .map(|k| {
@@ -447,6 +489,7 @@ pub fn draw_topview(
             paths: paths.to_vec(),
             markers: markers.to_vec(),
             spots: Vec::new(),
+            grid: None,
         }],
         width,
     )

@@ -1,7 +1,7 @@
 //! What a run leaves behind: the trajectory (one row a control cycle) and the summary.
 
-use nalgebra::Isometry2;
-use omniloop_robot::{Estimates, Fix, FixOutcome, Measurement};
+use nalgebra::{Isometry2, Point2};
+use omniloop_robot::{Estimates, Fix, FixOutcome, Measurement, NavigationReport};
 use omniloop_vision::{LocalizationMode, LocalizationQuality};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
@@ -115,6 +115,12 @@ pub struct Summary {
     /// With localization in the loop: how many localizations corrected the pose.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub localization_fixes: Option<usize>,
+    /// With a planner: whether it found the goal unreachable (and stopped the robot).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub unreachable: Option<bool>,
+    /// With a planner: how many times its progress watchdog fired.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub watchdog_fired: Option<usize>,
     /// With checkpoints: the heading error at the end of each visit (the estimate within the
     /// goal's `checkpoint_radius_mm` of a checkpoint), degrees.
     #[serde(skip_serializing_if = "Option::is_none", default)]
@@ -260,6 +266,45 @@ struct EstimateLine<'a> {
     landmarks: Vec<LandmarkRecord>,
     #[serde(skip_serializing_if = "Option::is_none")]
     motion: Option<MotionRecord>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    plan: Option<PlanRecord>,
+}
+
+/// What the planner did in one cycle: its plan, the point the controller headed for, the way
+/// still to go, and the map's counts.
+#[derive(Debug, Serialize)]
+struct PlanRecord {
+    path_mm: Vec<[f64; 2]>,
+    lookahead_mm: Option<[f64; 2]>,
+    remaining_mm: Option<f64>,
+    replans: usize,
+    watchdog: usize,
+    unreachable: bool,
+    cells_free: usize,
+    cells_unknown: usize,
+    cells_blocked: usize,
+}
+
+impl PlanRecord {
+    fn of(n: &NavigationReport) -> Self {
+        let xy = |p: &Point2<f64>| [round_mm(p.x), round_mm(p.y)];
+        Self {
+            path_mm: n.path_mm.iter().map(xy).collect(),
+            lookahead_mm: n.lookahead_mm.as_ref().map(xy),
+            remaining_mm: n.remaining_mm.map(round_mm),
+            replans: n.replans,
+            watchdog: n.watchdog,
+            unreachable: n.unreachable,
+            cells_free: n.cells[0],
+            cells_unknown: n.cells[1],
+            cells_blocked: n.cells[2],
+        }
+    }
+}
+
+/// To a tenth of a millimetre, for the record.
+fn round_mm(v: f64) -> f64 {
+    (v * 10.0).round() / 10.0
 }
 
 /// A landmark ranged in one cycle.
@@ -319,6 +364,7 @@ pub fn write_estimates_jsonl(
                 features: m.features,
                 inliers: m.inliers,
             }),
+            plan: e.navigation.as_ref().map(PlanRecord::of),
         };
         serde_json::to_writer(&mut w, &line)?;
         writeln!(w)?;

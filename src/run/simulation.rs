@@ -51,6 +51,8 @@ pub struct RunOutput {
     pub other_paths: Vec<Vec<Point2<f64>>>,
     /// Files of the experiment's own (tables, figures), written beside the run's.
     pub files: Vec<OutputFile>,
+    /// The map the robot's software built, when it builds one.
+    pub map: Option<omniloop_robot::MapSnapshot>,
 }
 
 /// A file an experiment produced: its name in the output folder and its contents.
@@ -388,6 +390,11 @@ impl Simulation {
             ));
         }
         let stats = self.world.stats(0);
+        let navigation = self
+            .estimates
+            .iter()
+            .rev()
+            .find_map(|e| e.navigation.as_ref());
         let summary = Summary {
             scenario: self.scenario.name.clone(),
             seed: self.scenario.seed,
@@ -412,6 +419,8 @@ impl Simulation {
             targets_reached: self.truth.targets_reached(),
             localization_fixes: localization_fixes(&self.estimates),
             checkpoint_heading_error_deg: self.truth.checkpoint_heading_errors_deg(),
+            unreachable: navigation.map(|n| n.unreachable),
+            watchdog_fired: navigation.map(|n| n.watchdog),
             experiment: serde_json::Map::new(),
         };
         RunOutput {
@@ -420,6 +429,7 @@ impl Simulation {
             estimates: self.estimates,
             other_paths: self.other_paths,
             files: Vec::new(),
+            map: self.robot.map(),
         }
     }
 }

@@ -288,20 +288,21 @@ fn controller(c: &mut Checker, s: &Scenario) -> Option<&'static ControllerEntry>
 /// checks it (a table controllers share is checked once; the chosen controller's always).
 fn check_tables(c: &mut Checker, s: &Scenario, chosen: &ControllerEntry) {
     let spec = &s.control;
+    let controller_tables = || CONTROLLERS.iter().flat_map(|e| e.tables.iter());
     let mut checked: Vec<&str> = Vec::new();
     for name in spec.tables.names() {
-        if let Some(owner) = CONTROLLERS.iter().find(|e| e.table == Some(name)) {
-            c.problems((owner.check_table)(spec));
+        if let Some(table) = controller_tables().find(|t| t.name == name) {
+            c.problems((table.check)(spec));
             checked.push(name);
         } else if !STAGES.iter().any(|e| e.table == Some(name)) {
-            let tables = CONTROLLERS.iter().filter_map(|e| e.table);
+            let tables = controller_tables().map(|t| t.name);
             let tables = tables.chain(STAGES.iter().filter_map(|e| e.table));
             let keys = ["kind", "pose_source", "localization_gain"];
             unknown_table(c, "control", name, &keys, tables);
         }
     }
-    if chosen.table.is_none_or(|t| !checked.contains(&t)) {
-        c.problems((chosen.check_table)(spec));
+    for table in chosen.tables.iter().filter(|t| !checked.contains(&t.name)) {
+        c.problems((table.check)(spec));
     }
 }
 

@@ -396,7 +396,8 @@ impl Scenario {
     }
 
     /// The map the robot is given: the world's pillars (landmarks, by colour) and its walls,
-    /// boards and boxes (straight obstacles). Corridor walls and the field are not on it.
+    /// boards (straight obstacles), the cubes (boxes, which may be moved) and the walls that
+    /// bound the floor (the field's and the corridors').
     pub fn robot_map(&self) -> WorldMap {
         let w = &self.world;
         let p = |a: [f64; 2]| Point2::new(a[0], a[1]);
@@ -405,7 +406,7 @@ impl Scenario {
             to_mm: p(b),
             half_thickness_mm: 0.5 * t,
         };
-        let mut segments: Vec<MapSegment> = w
+        let segments: Vec<MapSegment> = w
             .walls
             .iter()
             .map(|x| seg(x.from_mm, x.to_mm, x.thickness_mm))
@@ -415,6 +416,22 @@ impl Scenario {
                     .map(|b| seg(b.from_mm, b.to_mm, b.thickness_mm)),
             )
             .collect();
+        let mut bounds: Vec<MapSegment> = w
+            .field
+            .iter()
+            .flat_map(|f| f.walls())
+            .map(|x| seg(x.from_mm, x.to_mm, x.thickness_mm))
+            .collect();
+        // Corridor walls by their inner faces, the outline of the corridors' floor.
+        for contour in omniloop_sim::corridor::outline(&w.corridors) {
+            let n = contour.len();
+            bounds.extend((0..n).map(|k| MapSegment {
+                from_mm: contour[k],
+                to_mm: contour[(k + 1) % n],
+                half_thickness_mm: 0.0,
+            }));
+        }
+        let mut boxes = Vec::new();
         for cube in &w.cubes {
             let (h, a) = (0.5 * cube.size_mm, cube.angle_deg.to_radians());
             let corner = |sx: f64, sy: f64| {
@@ -427,7 +444,7 @@ impl Scenario {
                 corner(1.0, 1.0),
                 corner(-1.0, 1.0),
             ];
-            segments.extend((0..4).map(|k| seg(c[k], c[(k + 1) % 4], 0.0)));
+            boxes.extend((0..4).map(|k| seg(c[k], c[(k + 1) % 4], 0.0)));
         }
         WorldMap {
             landmarks: w
@@ -440,6 +457,8 @@ impl Scenario {
                 })
                 .collect(),
             segments,
+            boxes,
+            bounds,
             marks: w
                 .boards
                 .iter()

@@ -118,6 +118,15 @@ pub struct FreeSpace {
     /// Points on the boundary of that surely free region, robot frame (three a direction,
     /// like `obstacle_points`).
     pub clear_points: Vec<Point2<f64>>,
+    /// Per direction ending on an obstacle, the farthest its near face can be: it fills at
+    /// least `1 - r_th` of the first blocked cell, so it begins no farther than where it would
+    /// fill just the cell's outer part (computed as `clear_mm`, on the image's pixel areas).
+    /// The face lies between `free_mm` and this; the template's range where the direction is
+    /// free throughout.
+    pub front_mm: Vec<f64>,
+    /// Where the sensor axis stands in the robot frame, mm: the origin of every direction's
+    /// distances.
+    pub axis_mm: Point2<f64>,
 }
 
 const NONE: u16 = u16::MAX;
@@ -427,6 +436,8 @@ impl FreeSpaceDetector {
             range_mm: self.template.edges_mm[i_n],
             clear_mm: vec![0.0; j_n],
             clear_points: Vec::new(),
+            front_mm: vec![self.template.edges_mm[i_n]; j_n],
+            axis_mm: Point2::from(self.template.mount_mm),
         };
         let [mx, my] = self.template.mount_mm;
         for j in 0..j_n {
@@ -443,6 +454,9 @@ impl FreeSpaceDetector {
                 self.surely_free_mm[a - 1]
             };
             out.clear_mm[j] = clear;
+            if a < i_n {
+                out.front_mm[j] = self.surely_free_mm[a];
+            }
             for phi in [c - 0.5 * dir_step, c, c + 0.5 * dir_step] {
                 let u = (phi.cos(), phi.sin());
                 if a < i_n {

@@ -4,7 +4,8 @@
 use crate::boundary::BodyCommand;
 use crate::config::ControlSpec;
 use crate::controller::{
-    Controller, ControllerEntry, Situation, check_table, no_problems, settings, with_surroundings,
+    ControlTable, Controller, ControllerEntry, Situation, check_table, no_problems, settings,
+    with_surroundings,
 };
 use crate::tables::{ConfigProblem, Problems};
 use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, GoalDirection};
@@ -14,10 +15,12 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "goal_direction",
     summary: "the free direction closest to the goal's, from the image (ref. [4] of the corner \
               paper)",
-    table: Some("avoidance"),
+    tables: &[ControlTable {
+        name: "avoidance",
+        check: check_avoidance,
+    }],
     needs_goal: true,
     stages: &["freespace"],
-    check_table: check_avoidance,
     check_use: no_problems,
     build: |c| {
         let b = &c.body;

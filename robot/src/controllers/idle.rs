@@ -7,10 +7,9 @@ use crate::controller::{Controller, ControllerEntry, Situation, no_problems};
 pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "idle",
     summary: "stand still (the default)",
-    table: None,
+    tables: &[],
     needs_goal: false,
     stages: &[],
-    check_table: no_problems,
     check_use: no_problems,
     build: |_| Ok(Box::new(Idle)),
 };

@@ -9,10 +9,9 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "observe",
     summary: "stand still while the cameras search; drive to the observation points perception \
               asks for (E5, Fig. 4)",
-    table: None,
+    tables: &[],
     needs_goal: false,
     stages: &[],
-    check_table: no_problems,
     check_use: no_problems,
     build: |c| {
         Ok(Box::new(Observe {

@@ -3,7 +3,7 @@
 
 use super::segmentation::ForwardDriveConfig;
 use crate::boundary::BodyCommand;
-use crate::controller::{Controller, ControllerEntry, Situation, parses, settings};
+use crate::controller::{ControlTable, Controller, ControllerEntry, Situation, parses, settings};
 use crate::perception::forward::{ForwardVisionConfig, needs_forward_camera};
 use crate::perception::stage::vision_settings;
 
@@ -12,10 +12,12 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "optical_flow",
     summary: "a forward camera's Horn-Schunck flow balance: straight until the flow is strong, \
               then turn away from the side with more (Ahmed et al., Sect. 2.1.2)",
-    table: Some("forward"),
+    tables: &[ControlTable {
+        name: "forward",
+        check: |spec| parses::<ForwardDriveConfig>(spec, "forward"),
+    }],
     needs_goal: false,
     stages: &["flow"],
-    check_table: |spec| parses::<ForwardDriveConfig>(spec, "forward"),
     check_use: needs_forward_camera,
     build: |c| {
         Ok(Box::new(FlowAvoidance {

@@ -2,7 +2,9 @@
 //! (`[control.script]`; E6's square of Fig. 8 and the tests of Fig. 10).
 
 use crate::boundary::BodyCommand;
-use crate::controller::{Controller, ControllerEntry, Situation, no_problems, parses, settings};
+use crate::controller::{
+    ControlTable, Controller, ControllerEntry, Situation, no_problems, parses, settings,
+};
 use omniloop_control::wrap_pi;
 use serde::{Deserialize, Serialize};
 
@@ -11,10 +13,12 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "script",
     summary: "drive a list of moves (straight runs, turns on the spot) on dead reckoning \
               ([control.script])",
-    table: Some("script"),
+    tables: &[ControlTable {
+        name: "script",
+        check: |spec| parses::<ScriptConfig>(spec, "script"),
+    }],
     needs_goal: false,
     stages: &[],
-    check_table: |spec| parses::<ScriptConfig>(spec, "script"),
     check_use: no_problems,
     build: |c| {
         Ok(Box::new(Script {

@@ -2,7 +2,7 @@
 //! Sect. 2.1.1), with the settings it shares with the flow avoidance (`[control.forward]`).
 
 use crate::boundary::BodyCommand;
-use crate::controller::{Controller, ControllerEntry, Situation, parses, settings};
+use crate::controller::{ControlTable, Controller, ControllerEntry, Situation, parses, settings};
 use crate::perception::forward::needs_forward_camera;
 use serde::{Deserialize, Serialize};
 
@@ -11,10 +11,12 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "segmentation",
     summary: "a forward camera's ground segmentation: straight while the ground ahead reaches \
               far enough, else turn to the clearer side (Ahmed et al., Sect. 2.1.1)",
-    table: Some("forward"),
+    tables: &[ControlTable {
+        name: "forward",
+        check: |spec| parses::<ForwardDriveConfig>(spec, "forward"),
+    }],
     needs_goal: false,
     stages: &["ground"],
-    check_table: |spec| parses::<ForwardDriveConfig>(spec, "forward"),
     check_use: needs_forward_camera,
     build: |c| {
         Ok(Box::new(Segmentation {

@@ -1,10 +1,15 @@
 //! Velocity-aware avoidance (Sect. 3.2 of the corner paper), from the image; with chosen
-//! speeds, a near-field memory supplies where obstacles are inside the camera's blind zone.
+//! speeds, a near-field memory supplies where obstacles are inside the camera's blind zone;
+//! with a planner (`[control.planner]`, on by default), the goal it heads for is a lookahead
+//! point on a plan over the map the robot builds, and the controller stays the safety layer.
 
 use super::goal_direction::check_avoidance;
 use crate::boundary::BodyCommand;
 use crate::controller::{
-    Controller, ControllerEntry, Situation, no_problems, settings, with_surroundings,
+    ControlTable, Controller, ControllerEntry, Situation, no_problems, settings, with_surroundings,
+};
+use crate::navigation::{
+    self, MapSnapshot, NavigationReport, Navigator, PlannerConfig, PlannerKind,
 };
 use crate::near_field::NearField;
 use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, SpeedChoice, VelocityAware};
@@ -12,16 +17,30 @@ use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, SpeedChoice, Velocity
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "velocity_aware",
-    summary: "velocity-aware avoidance, eq. (8) predicted paths (Sect. 3.2 of the corner paper)",
-    table: Some("avoidance"),
+    summary: "velocity-aware avoidance, eq. (8) predicted paths (Sect. 3.2 of the corner paper), \
+              under a planner on the map the robot builds",
+    tables: &[
+        ControlTable {
+            name: "avoidance",
+            check: check_avoidance,
+        },
+        ControlTable {
+            name: navigation::TABLE,
+            check: navigation::check_planner,
+        },
+    ],
     needs_goal: true,
     stages: &["freespace"],
-    check_table: check_avoidance,
     check_use: no_problems,
     build: |c| {
         let b = &c.body;
         let drive = AccelLimitedDrive::new(b.accel_limit_mm_s2, b.angular_accel_limit_rad_s2)?;
         let avoid: AvoidanceConfig = settings(c, "avoidance")?;
+        let planner: PlannerConfig = settings(c, navigation::TABLE)?;
+        let navigator = match planner.kind {
+            PlannerKind::Grid => Some(Navigator::new(c, planner)?),
+            PlannerKind::None => None,
+        };
         Ok(Box::new(VelocityAwareStack {
             near: (avoid.speed == SpeedChoice::Chosen).then(|| NearField::new(b.radius_mm)),
             controller: VelocityAware::new(
@@ -31,14 +50,17 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
                 b.radius_mm,
                 c.control_period_s,
             )?,
+            navigator,
         }))
     },
 };
 
-/// The velocity-aware controller with its near-field memory (chosen speeds only).
+/// The velocity-aware controller with its near-field memory (chosen speeds only) and its
+/// navigator (with a planner).
 pub struct VelocityAwareStack {
     controller: VelocityAware,
     near: Option<NearField>,
+    navigator: Option<Navigator>,
 }
 
 impl Controller for VelocityAwareStack {
@@ -47,8 +69,26 @@ impl Controller for VelocityAwareStack {
             (Some(near), Some(fs)) => Some(near.update(fs, &s.odometry_pose, s.t_s)),
             _ => None,
         };
+        let target_body_mm = match (&mut self.navigator, &s.pose, s.target_mm) {
+            (Some(nav), Some(pose), Some(target)) => {
+                nav.steer(s.freespace, pose, s.velocity_body_mm_s, target, s.t_s)
+            }
+            _ => s.target_body_mm,
+        };
+        let s = Situation {
+            target_body_mm,
+            ..*s
+        };
         let v = s.velocity_body_mm_s;
         let c = &self.controller;
-        with_surroundings(s, clear, |sur, target| c.decide(sur, target, v).v_mm_s)
+        with_surroundings(&s, clear, |sur, target| c.decide(sur, target, v).v_mm_s)
+    }
+
+    fn navigation(&self) -> Option<&NavigationReport> {
+        self.navigator.as_ref().map(Navigator::report)
+    }
+
+    fn map(&self) -> Option<MapSnapshot> {
+        self.navigator.as_ref().map(Navigator::map)
     }
 }

@@ -20,7 +20,7 @@
 use crate::boundary::BodyCommand;
 use crate::config::ControlSpec;
 use crate::controller::{
-    Controller, ControllerEntry, Situation, check_table, no_problems, settings,
+    ControlTable, Controller, ControllerEntry, Situation, check_table, no_problems, settings,
 };
 use crate::tables::{ConfigProblem, Problems};
 use nalgebra::Vector2;
@@ -34,10 +34,12 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "wall_follow",
     summary: "keeps a wall on one side at a set gap, on the free space from the image (the \
               boundary following of the Bug algorithms, Lumelsky and Stepanov 1987)",
-    table: Some("wall_follow"),
+    tables: &[ControlTable {
+        name: "wall_follow",
+        check: check_wall_follow,
+    }],
     needs_goal: false,
     stages: &["freespace"],
-    check_table: check_wall_follow,
     check_use: no_problems,
     build: |c| {
         Ok(Box::new(WallFollow {
@@ -225,6 +227,7 @@ mod tests {
         w.decide(&Situation {
             freespace: fs,
             target_body_mm: None,
+            target_mm: None,
             velocity_body_mm_s: nalgebra::Vector2::zeros(),
             pose: None,
             odometry_pose: nalgebra::Isometry2::identity(),

@@ -13,7 +13,9 @@
 use crate::RobotError;
 use crate::boundary::BodyCommand;
 use crate::config::{ControlSpec, RobotConfig, WorldMap};
-use crate::controller::{Controller, ControllerEntry, Situation, check_table, settings};
+use crate::controller::{
+    ControlTable, Controller, ControllerEntry, Situation, check_table, settings,
+};
 use crate::tables::{ConfigProblem, Problems};
 use nalgebra::{Isometry2, Point2, Vector2};
 use rand::rngs::StdRng;
@@ -25,12 +27,14 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     name: "wander",
     summary: "random wandering on the map: forward until an obstacle is near, then a random turn \
               (E4, Spacek and Burbridge, Sect. 2.1)",
-    table: Some("wander"),
+    tables: &[ControlTable {
+        name: "wander",
+        check: check_wander,
+    }],
     needs_goal: false,
     stages: &[],
-    check_table: check_wander,
     check_use: |c| {
-        if c.map.segments.is_empty() {
+        if c.map.segments.is_empty() && c.map.boxes.is_empty() {
             return vec![ConfigProblem::new(
                 "control.kind",
                 "\"wander\" drives on a map of the world's walls and pillars: the world has no walls",
@@ -114,7 +118,10 @@ impl Wander {
                 )));
             }
         }
-        if config.map.landmarks.is_empty() && config.map.segments.is_empty() {
+        if config.map.landmarks.is_empty()
+            && config.map.segments.is_empty()
+            && config.map.boxes.is_empty()
+        {
             return Err(RobotError::Config(
                 "control.kind = \"wander\" needs a map: the world has no walls or pillars".into(),
             ));
@@ -140,7 +147,7 @@ impl Wander {
             .landmarks
             .iter()
             .map(|l| (p - l.centre_mm).norm() - l.radius_mm);
-        let segments = self.map.segments.iter().map(|s| {
+        let segments = self.map.segments.iter().chain(&self.map.boxes).map(|s| {
             let ab = s.to_mm - s.from_mm;
             let t = ((p - s.from_mm).dot(&ab) / ab.norm_squared().max(1e-9)).clamp(0.0, 1.0);
             (p - (s.from_mm + ab * t)).norm() - s.half_thickness_mm
@@ -228,7 +235,7 @@ mod tests {
             map: WorldMap {
                 landmarks: Vec::new(),
                 segments: vec![seg([1000.0, -1000.0], [1000.0, 1000.0])],
-                marks: Vec::new(),
+                ..WorldMap::default()
             },
             stereo: None,
             seed: 3,
@@ -239,6 +246,7 @@ mod tests {
         Situation {
             freespace: None,
             target_body_mm: None,
+            target_mm: None,
             velocity_body_mm_s: Vector2::zeros(),
             pose: Some(pose),
             odometry_pose: Isometry2::identity(),

@@ -1,0 +1,496 @@
+//! The occupancy grid the robot builds in its estimated (world) frame from what the free-space
+//! stage sees each cycle, seeded with the map it is given.
+//!
+//! Each cell holds the log-odds of being occupied (the standard update of occupancy-grid
+//! mapping, Thrun, Burgard and Fox, *Probabilistic Robotics*, eq. (9.7)), with the inverse
+//! sensor model of the polar template (ours):
+//!
+//! - a cell of direction j's sector nearer than its surely free distance `clear_mm[j]` is free
+//!   (`L_FREE`), and so is the robot's own disc;
+//! - where the direction ends on an obstacle (`free_mm[j]` short of the template's range) the
+//!   obstacle's near face lies between the first blocked cell's near edge `free_mm[j]` and the
+//!   farthest it can be, `front_mm[j]` (it fills at least `1 - r_th` of the cell): the band
+//!   `[front_mm[j] - depth, front_mm[j]]` is occupied (`L_OCC`) along the sector's centre line
+//!   only (cells within `STRIP_CELLS` of it), and whatever lies beyond is not seen. The far
+//!   bound: a mark there lies on or behind a face turned to the robot (inside the obstacle, or
+//!   just behind a thin one, which the robot's inflated radius still covers), while a face
+//!   seen obliquely lies beyond the near bound at the sector's centre and a mark there would
+//!   stand in the floor. The centre line, not the whole arc: an obstacle
+//!   filling half the cell spans its middle, but the arc at a metre is 200 mm wide and, marked
+//!   whole, closes every gap beside a cube; a thin mark is inflated by the robot's radius for
+//!   planning anyway, and a wider obstacle is hit by several sectors and views. Only cells
+//!   nearer than `TRUST_MM` are marked so: farther, the cells are too long to place a face.
+//!   An obstacle whose cell holds a wall of the map (anywhere across the sector, between
+//!   `free_mm[j]` and `front_mm[j] + depth`) is that wall (the map explains it) and is not
+//!   marked again: a wall seen obliquely through a long cell would otherwise be marked up to a
+//!   hundred millimetres inside the floor and close the gaps beside it.
+//!
+//! The evidence decays toward "unknown" with the time constant `forget_s`
+//! (`L <- L exp(-dt / forget_s)`), so that a thing that moved away is forgotten; what the robot
+//! keeps seeing keeps its evidence. The walls of the map it is given are a fixed layer,
+//! blocked for good.
+
+use super::PlannerConfig;
+use crate::config::{MapSegment, WorldMap};
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_vision::FreeSpace;
+use std::f64::consts::TAU;
+
+/// Log-odds added by a sighting of free floor.
+const L_FREE: f32 = -0.4;
+/// Log-odds added by a sighting of an obstacle's near face.
+const L_OCC: f32 = 0.85;
+/// Bounds of the log-odds, so that a cell seen long one way can be re-seen the other way.
+const L_MIN: f32 = -3.0;
+/// See [`L_MIN`].
+const L_MAX: f32 = 3.5;
+/// Above this a cell is blocked (one sighting of an obstacle is enough).
+const BLOCKED_ABOVE: f32 = 0.6;
+/// Below this a cell is free (one sighting of floor is enough).
+const FREE_BELOW: f32 = -0.3;
+/// Occupied marks lie within this many cells of a sector's centre line.
+const STRIP_CELLS: f64 = 0.75;
+/// Obstacles farther than this are not marked (the template's far cells are too long), mm.
+const TRUST_MM: f64 = 800.0;
+/// Most cells a grid may have (a 30 m x 30 m world at 25 mm cells).
+pub const MAX_CELLS: usize = 1_440_000;
+
+/// What the planner makes of a cell.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellState {
+    /// Seen free, recently enough.
+    Free,
+    /// Never seen, or forgotten.
+    Unknown,
+    /// Seen occupied, or a wall of the map.
+    Blocked,
+}
+
+/// Where the grid lies: its lower-left corner, cell size and extent.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridGeometry {
+    /// World position of the lower-left corner of cell (0, 0), mm.
+    pub origin_mm: Point2<f64>,
+    /// Side of a cell, mm.
+    pub cell_mm: f64,
+    /// Cells along x.
+    pub width: usize,
+    /// Cells along y.
+    pub height: usize,
+}
+
+impl GridGeometry {
+    /// A grid of `cell_mm` cells covering the box `lo..hi` (world mm).
+    pub fn covering(lo: Point2<f64>, hi: Point2<f64>, cell_mm: f64) -> Self {
+        let cells = |a: f64, b: f64| ((b - a) / cell_mm).ceil().max(1.0) as usize;
+        Self {
+            origin_mm: lo,
+            cell_mm,
+            width: cells(lo.x, hi.x),
+            height: cells(lo.y, hi.y),
+        }
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// Whether the grid has no cell.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The cell holding world point `p`, if inside the grid.
+    pub fn cell_of(&self, p: Point2<f64>) -> Option<usize> {
+        let (x, y) = self.coords_of(p)?;
+        Some(y * self.width + x)
+    }
+
+    /// Column and row of world point `p`, if inside the grid.
+    pub fn coords_of(&self, p: Point2<f64>) -> Option<(usize, usize)> {
+        let fx = ((p.x - self.origin_mm.x) / self.cell_mm).floor();
+        let fy = ((p.y - self.origin_mm.y) / self.cell_mm).floor();
+        let inside = fx >= 0.0 && fy >= 0.0 && fx < self.width as f64 && fy < self.height as f64;
+        inside.then_some((fx as usize, fy as usize))
+    }
+
+    /// World centre of cell `i`.
+    pub fn centre(&self, i: usize) -> Point2<f64> {
+        let (x, y) = (i % self.width, i / self.width);
+        self.origin_mm + Vector2::new(x as f64 + 0.5, y as f64 + 0.5) * self.cell_mm
+    }
+}
+
+/// The robot's occupancy grid.
+#[derive(Debug, Clone)]
+pub struct OccupancyGrid {
+    geometry: GridGeometry,
+    log_odds: Vec<f32>,
+    fixed: Vec<bool>,
+    forget_s: f64,
+    last_t_s: Option<f64>,
+}
+
+impl OccupancyGrid {
+    /// A grid of `geometry`, unknown everywhere but on the map's walls, goals and pillars (the
+    /// boxes of the map may have been moved, and are not trusted).
+    pub fn new(geometry: GridGeometry, map: &WorldMap, config: &PlannerConfig) -> Self {
+        let n = geometry.len();
+        let mut grid = Self {
+            geometry,
+            log_odds: vec![0.0; n],
+            fixed: vec![false; n],
+            forget_s: config.forget_s,
+            last_t_s: None,
+        };
+        if config.seed_map {
+            for s in map.bounds.iter().chain(&map.segments) {
+                grid.fix_segment(s);
+            }
+            for l in &map.landmarks {
+                grid.fix_disc(l.centre_mm, l.radius_mm);
+            }
+        }
+        grid
+    }
+
+    /// Where the grid lies.
+    pub fn geometry(&self) -> &GridGeometry {
+        &self.geometry
+    }
+
+    /// The state of cell `i`.
+    pub fn state(&self, i: usize) -> CellState {
+        if self.fixed[i] {
+            return CellState::Blocked;
+        }
+        let l = self.log_odds[i];
+        if l > BLOCKED_ABOVE {
+            CellState::Blocked
+        } else if l < FREE_BELOW {
+            CellState::Free
+        } else {
+            CellState::Unknown
+        }
+    }
+
+    /// Counts of free, unknown and blocked cells.
+    pub fn counts(&self) -> [usize; 3] {
+        let mut c = [0; 3];
+        for i in 0..self.geometry.len() {
+            c[match self.state(i) {
+                CellState::Free => 0,
+                CellState::Unknown => 1,
+                CellState::Blocked => 2,
+            }] += 1;
+        }
+        c
+    }
+
+    /// Marks every cell whose centre lies within half a cell of segment `s`'s body.
+    fn fix_segment(&mut self, s: &MapSegment) {
+        let g = self.geometry;
+        let reach = s.half_thickness_mm + 0.5 * g.cell_mm;
+        let lo = s.from_mm.inf(&s.to_mm) - Vector2::repeat(reach);
+        let hi = s.from_mm.sup(&s.to_mm) + Vector2::repeat(reach);
+        self.each_cell_in(lo, hi, |grid, i, c| {
+            let ab = s.to_mm - s.from_mm;
+            let t = ((c - s.from_mm).dot(&ab) / ab.norm_squared().max(1e-9)).clamp(0.0, 1.0);
+            if (c - (s.from_mm + ab * t)).norm() <= reach {
+                grid.fixed[i] = true;
+            }
+        });
+    }
+
+    /// Marks every cell whose centre lies within half a cell of a disc.
+    fn fix_disc(&mut self, centre: Point2<f64>, radius_mm: f64) {
+        let reach = radius_mm + 0.5 * self.geometry.cell_mm;
+        let r = Vector2::repeat(reach);
+        self.each_cell_in(centre - r, centre + r, |grid, i, c| {
+            if (c - centre).norm() <= reach {
+                grid.fixed[i] = true;
+            }
+        });
+    }
+
+    /// Calls `f(grid, index, centre)` for every cell of the box `lo..hi` inside the grid.
+    fn each_cell_in(
+        &mut self,
+        lo: Point2<f64>,
+        hi: Point2<f64>,
+        mut f: impl FnMut(&mut Self, usize, Point2<f64>),
+    ) {
+        let g = self.geometry;
+        let span = |a: f64, o: f64, n: usize| {
+            let k = ((a - o) / g.cell_mm).floor();
+            k.clamp(0.0, n as f64 - 1.0) as usize
+        };
+        let (x0, x1) = (
+            span(lo.x, g.origin_mm.x, g.width),
+            span(hi.x, g.origin_mm.x, g.width),
+        );
+        let (y0, y1) = (
+            span(lo.y, g.origin_mm.y, g.height),
+            span(hi.y, g.origin_mm.y, g.height),
+        );
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let i = y * g.width + x;
+                f(self, i, g.centre(i));
+            }
+        }
+    }
+
+    /// Lets the evidence fade toward "unknown" up to time `t_s`.
+    fn age(&mut self, t_s: f64) {
+        if let Some(t0) = self.last_t_s {
+            let dt = t_s - t0;
+            if dt > 0.0 {
+                let k = (-dt / self.forget_s).exp() as f32;
+                for l in &mut self.log_odds {
+                    *l *= k;
+                }
+            }
+        }
+        self.last_t_s = Some(t_s);
+    }
+
+    /// Takes one cycle's free space, seen from `pose` (the robot's estimate, world frame) by a
+    /// robot of `body_radius_mm`, at time `t_s`.
+    pub fn observe(
+        &mut self,
+        fs: &FreeSpace,
+        pose: &Isometry2<f64>,
+        body_radius_mm: f64,
+        t_s: f64,
+    ) {
+        self.age(t_s);
+        let n = fs.direction_rad.len();
+        if n == 0 || fs.a.len() != n || fs.free_mm.len() != n || fs.clear_mm.len() != n {
+            return;
+        }
+        let front_of = |j: usize| {
+            fs.front_mm
+                .get(j)
+                .map_or(fs.free_mm[j], |f| f.max(fs.free_mm[j]))
+        };
+        let depth = self.geometry.cell_mm.max(30.0);
+        let strip = STRIP_CELLS * self.geometry.cell_mm;
+        let reach = (0..n).map(front_of).fold(body_radius_mm, f64::max);
+        let axis = pose * fs.axis_mm;
+        let here = Point2::from(pose.translation.vector);
+        let heading = pose.rotation.angle();
+        let step = TAU / n as f64;
+        let first = fs.direction_rad[0];
+        let explained: Vec<bool> = (0..n)
+            .map(|j| self.holds_wall(fs, j, pose, axis, front_of(j) + depth))
+            .collect();
+        let r = Vector2::repeat(reach);
+        self.each_cell_in(axis - r, axis + r, |grid, i, c| {
+            if grid.fixed[i] {
+                return;
+            }
+            let v = c - axis;
+            let d = v.norm();
+            if d > reach {
+                return;
+            }
+            let delta = if (c - here).norm() <= body_radius_mm {
+                L_FREE
+            } else {
+                let bearing = v.y.atan2(v.x) - heading - first;
+                let k = (bearing / step).round();
+                let j = (k as i64).rem_euclid(n as i64) as usize;
+                let open = fs.a[j] > 0;
+                let obstacle = (fs.free_mm[j] < fs.range_mm || !open)
+                    && fs.free_mm[j] <= TRUST_MM
+                    && !explained[j];
+                let lateral = d * (bearing - k * step).sin().abs();
+                if open && d <= fs.clear_mm[j] {
+                    L_FREE
+                } else if obstacle
+                    && lateral <= strip
+                    && d <= front_of(j)
+                    && d >= (front_of(j) - depth).min(fs.free_mm[j])
+                {
+                    L_OCC
+                } else {
+                    return;
+                }
+            };
+            let l = &mut grid.log_odds[i];
+            *l = (*l + delta).clamp(L_MIN, L_MAX);
+        });
+    }
+
+    /// Whether a wall of the map stands in direction `j`'s sector between its first blocked
+    /// cell's near edge and `far_mm` (rays across the sector, every half cell).
+    fn holds_wall(
+        &self,
+        fs: &FreeSpace,
+        j: usize,
+        pose: &Isometry2<f64>,
+        axis: Point2<f64>,
+        far_mm: f64,
+    ) -> bool {
+        let n = fs.direction_rad.len();
+        let half = 0.5 * TAU / n as f64;
+        let near = fs.free_mm[j];
+        let steps = ((far_mm - near) / (0.5 * self.geometry.cell_mm))
+            .ceil()
+            .max(1.0) as usize;
+        [-1.0, -0.5, 0.0, 0.5, 1.0].iter().any(|f| {
+            let a = fs.direction_rad[j] + f * half;
+            let u = pose.rotation * Vector2::new(a.cos(), a.sin());
+            (0..=steps).any(|k| {
+                let d = near + (far_mm - near) * k as f64 / steps as f64;
+                self.geometry
+                    .cell_of(axis + u * d)
+                    .is_some_and(|i| self.fixed[i])
+            })
+        })
+    }
+
+    /// The cells as free, unknown or blocked, for figures and records.
+    pub fn snapshot(&self) -> MapSnapshot {
+        MapSnapshot {
+            geometry: self.geometry,
+            cells: (0..self.geometry.len()).map(|i| self.state(i)).collect(),
+        }
+    }
+}
+
+/// The robot's map at one moment: each cell's state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapSnapshot {
+    /// Where the grid lies.
+    pub geometry: GridGeometry,
+    /// Row-major from the lower-left cell.
+    pub cells: Vec<CellState>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Free space of `n` directions around a robot at the origin: free to `clear(angle)`.
+    fn seen(n: usize, free: impl Fn(f64) -> f64) -> FreeSpace {
+        let dirs: Vec<f64> = (0..n).map(|j| j as f64 * TAU / n as f64).collect();
+        let free_mm: Vec<f64> = dirs.iter().map(|&a| free(a)).collect();
+        FreeSpace {
+            a: free_mm
+                .iter()
+                .map(|&f| if f > 200.0 { 3 } else { 0 })
+                .collect(),
+            clear_mm: free_mm.iter().map(|f| f - 40.0).collect(),
+            front_mm: free_mm.iter().map(|f| f + 20.0).collect(),
+            free_mm,
+            direction_rad: dirs,
+            range_mm: 1000.0,
+            ..FreeSpace::default()
+        }
+    }
+
+    fn grid() -> OccupancyGrid {
+        let g = GridGeometry::covering(
+            Point2::new(-2000.0, -2000.0),
+            Point2::new(2000.0, 2000.0),
+            20.0,
+        );
+        OccupancyGrid::new(g, &WorldMap::default(), &PlannerConfig::default())
+    }
+
+    #[test]
+    fn a_wall_ahead_is_blocked_the_floor_before_it_free_and_behind_it_unknown() {
+        let mut g = grid();
+        // A wall 600 mm ahead (x = 600) across the robot's front.
+        let fs = seen(64, |a| {
+            let c = a.cos();
+            if c > 0.6 { 600.0 / c } else { 1000.0 }
+        });
+        g.observe(&fs, &Isometry2::identity(), 90.0, 0.0);
+        let at = |x: f64, y: f64| {
+            let i = g.geometry().cell_of(Point2::new(x, y)).unwrap();
+            g.state(i)
+        };
+        assert_eq!(at(300.0, 0.0), CellState::Free);
+        assert_eq!(at(610.0, 0.0), CellState::Blocked);
+        assert_eq!(
+            at(800.0, 0.0),
+            CellState::Unknown,
+            "behind the wall is not seen"
+        );
+        assert_eq!(at(0.0, 500.0), CellState::Free);
+        assert_eq!(
+            at(0.0, 1500.0),
+            CellState::Unknown,
+            "beyond the template's range"
+        );
+    }
+
+    #[test]
+    fn seen_again_free_an_obstacle_that_moved_is_cleared_and_unseen_evidence_fades() {
+        let mut g = grid();
+        let wall = seen(64, |a| {
+            if a.cos() > 0.9 {
+                500.0 / a.cos()
+            } else {
+                1000.0
+            }
+        });
+        let open = seen(64, |_| 1000.0);
+        let pose = Isometry2::identity();
+        g.observe(&wall, &pose, 90.0, 0.0);
+        let i = g.geometry().cell_of(Point2::new(510.0, 0.0)).unwrap();
+        assert_eq!(g.state(i), CellState::Blocked);
+        for k in 1..=5 {
+            g.observe(&open, &pose, 90.0, 0.04 * k as f64);
+        }
+        assert_eq!(g.state(i), CellState::Free, "seen free again");
+        // Seen once blocked, then not seen for long: forgotten.
+        let mut g = grid();
+        g.observe(&wall, &pose, 90.0, 0.0);
+        let away = Isometry2::new(Vector2::new(-1900.0, -1900.0), 0.0);
+        g.observe(&seen(64, |_| 100.0), &away, 90.0, 60.0);
+        assert_eq!(
+            g.state(i),
+            CellState::Unknown,
+            "forgotten after a minute unseen"
+        );
+    }
+
+    #[test]
+    fn the_maps_walls_and_pillars_are_blocked_and_its_boxes_are_not() {
+        let seg = |a: [f64; 2], b: [f64; 2], t: f64| MapSegment {
+            from_mm: Point2::new(a[0], a[1]),
+            to_mm: Point2::new(b[0], b[1]),
+            half_thickness_mm: t,
+        };
+        let map = WorldMap {
+            bounds: vec![seg([-1000.0, 1000.0], [1000.0, 1000.0], 25.0)],
+            landmarks: vec![crate::config::MapLandmark {
+                centre_mm: Point2::new(500.0, 0.0),
+                radius_mm: 60.0,
+                rgb: [200, 0, 0],
+            }],
+            boxes: vec![seg([-500.0, -500.0], [-400.0, -500.0], 0.0)],
+            ..WorldMap::default()
+        };
+        let geo = GridGeometry::covering(
+            Point2::new(-1200.0, -1200.0),
+            Point2::new(1200.0, 1200.0),
+            20.0,
+        );
+        let g = OccupancyGrid::new(geo, &map, &PlannerConfig::default());
+        let at = |x: f64, y: f64| g.state(g.geometry().cell_of(Point2::new(x, y)).unwrap());
+        assert_eq!(at(0.0, 1010.0), CellState::Blocked);
+        assert_eq!(at(540.0, 0.0), CellState::Blocked);
+        assert_eq!(
+            at(-450.0, -500.0),
+            CellState::Unknown,
+            "boxes may have moved"
+        );
+        assert_eq!(at(0.0, 0.0), CellState::Unknown);
+    }
+}

@@ -1,0 +1,597 @@
+//! The navigator: keeps the grid, replans, hands the controller a lookahead point on the plan,
+//! and watches the progress.
+//!
+//! - Replanning: when there is no plan, the target changed, every `replan_period_s`, and when
+//!   the robot has strayed from the plan by more than `STRAY_MM`.
+//! - Following: the point `lookahead_mm` along the plan beyond the robot's nearest point on
+//!   it (or the farthest vertex before it that the robot sees over passable cells). The
+//!   controller's goal is that point's direction with the length of the remaining path, so
+//!   the approach speed `min(v_max, sqrt(2 alpha d))` is that of the whole way still to go,
+//!   lowered where the way turns (ours): a turn by `theta` is taken at no more than
+//!   `v_c = v_max max(cos theta, MIN_TURN_SPEED)`, so the goal's distance is at most
+//!   `d_turn + v_c^2 / (2 alpha)` for the plan's next sharp vertex `d_turn` ahead, and at most
+//!   `v_c^2 / (2 alpha)` when the robot's own course is `theta` off the lookahead's direction.
+//!   An acceleration-limited robot at speed turns on a circle of radius `v^2 / alpha` (533 mm
+//!   at 400 mm/s and 300 mm/s^2): without this it would swing wide of every bend and round
+//!   every replanned way back.
+//! - The watchdog (ours): no progress for `watchdog_s` (the robot stayed within
+//!   `progress_mm` of where it was), or for twice that long along the route (the remaining
+//!   path did not shorten by `progress_mm`; a new plan more than `REBASE_MM` longer, the world
+//!   turned out worse than hoped, starts the count again), raises the cost of the cells within
+//!   `PENALTY_RADIUS_MM` of the lookahead point by `PENALTY`, which fades like the grid's
+//!   evidence, and replans: a place where the robot keeps failing becomes dearer than
+//!   another way round.
+//! - Unreachable: while no route through free or unknown cells reaches the goal, the
+//!   controller heads straight for it (it still keeps every command inside the surely free
+//!   space), so that the robot looks nearer, where the map is finer; when no route has been
+//!   found for `UNREACHABLE_S` in a row, the goal is reported unreachable and the robot stops
+//!   and stays stopped (until it is given another target).
+
+use super::PlannerConfig;
+use super::grid::{GridGeometry, MAX_CELLS, MapSnapshot, OccupancyGrid};
+use super::planner::{CostMap, CostSettings, length};
+use crate::RobotError;
+use crate::config::RobotConfig;
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_vision::FreeSpace;
+
+/// Strayed this far from the plan, the robot replans, mm.
+const STRAY_MM: f64 = 120.0;
+/// A new plan this much longer than the last restarts the watchdog's count along the route.
+const REBASE_MM: f64 = 500.0;
+/// The watchdog's penalty: the added cost factor.
+const PENALTY: f32 = 4.0;
+/// The watchdog's penalty: the radius of the region made dearer, mm.
+const PENALTY_RADIUS_MM: f64 = 200.0;
+/// No route for this long in a row: the goal is unreachable, s.
+const UNREACHABLE_S: f64 = 2.0;
+/// The least fraction of the top speed a turn is taken at.
+const MIN_TURN_SPEED: f64 = 0.2;
+/// A vertex turning the plan by more than this is a bend to slow for, rad.
+const BEND_RAD: f64 = 0.35;
+/// Below this speed the robot has no course to turn from, mm/s.
+const COURSE_MIN_SPEED_MM_S: f64 = 50.0;
+/// Padding round the map (or, without one, round start and targets) the grid covers, mm.
+const PAD_WITH_MAP_MM: f64 = 400.0;
+/// See [`PAD_WITH_MAP_MM`].
+const PAD_WITHOUT_MAP_MM: f64 = 2000.0;
+
+/// What the navigator did this cycle, for the estimates record.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NavigationReport {
+    /// The plan, pulled taut: from the robot at the last replan to the target, world mm.
+    pub path_mm: Vec<Point2<f64>>,
+    /// The point the controller heads for, world mm.
+    pub lookahead_mm: Option<Point2<f64>>,
+    /// Length of the way still to go along the plan, mm.
+    pub remaining_mm: Option<f64>,
+    /// Plans made so far.
+    pub replans: usize,
+    /// Times the watchdog fired so far.
+    pub watchdog: usize,
+    /// Whether the goal was found unreachable (the robot stopped).
+    pub unreachable: bool,
+    /// Cells free, unknown and blocked.
+    pub cells: [usize; 3],
+}
+
+/// Progress of the robot, for the watchdog.
+#[derive(Debug, Clone)]
+struct Watchdog {
+    anchor: Point2<f64>,
+    anchor_t_s: f64,
+    best_mm: f64,
+    best_t_s: f64,
+}
+
+impl Watchdog {
+    fn new(here: Point2<f64>, t_s: f64) -> Self {
+        Self {
+            anchor: here,
+            anchor_t_s: t_s,
+            best_mm: f64::INFINITY,
+            best_t_s: t_s,
+        }
+    }
+
+    /// Whether the robot has made no progress for too long.
+    fn stuck(&mut self, here: Point2<f64>, remaining_mm: f64, t_s: f64, c: &PlannerConfig) -> bool {
+        if (here - self.anchor).norm() > c.progress_mm {
+            self.anchor = here;
+            self.anchor_t_s = t_s;
+        }
+        if remaining_mm < self.best_mm - c.progress_mm {
+            self.best_mm = remaining_mm;
+            self.best_t_s = t_s;
+        }
+        let stuck =
+            t_s - self.anchor_t_s > c.watchdog_s || t_s - self.best_t_s > 2.0 * c.watchdog_s;
+        if stuck {
+            *self = Self::new(here, t_s);
+            self.best_mm = remaining_mm;
+        }
+        stuck
+    }
+}
+
+/// The plan being followed.
+#[derive(Debug, Clone)]
+struct Plan {
+    path: Vec<Point2<f64>>,
+    made_t_s: f64,
+}
+
+/// The robot's navigation: its grid, its plan and the watchdog.
+#[derive(Debug, Clone)]
+pub struct Navigator {
+    config: PlannerConfig,
+    costs: CostSettings,
+    radius_mm: f64,
+    max_speed_mm_s: f64,
+    accel_mm_s2: f64,
+    accept_mm: f64,
+    grid: OccupancyGrid,
+    penalty: Vec<f32>,
+    penalty_t_s: f64,
+    cost_map: Option<CostMap>,
+    plan: Option<Plan>,
+    target: Option<Point2<f64>>,
+    watchdog: Option<Watchdog>,
+    failing_since_s: Option<f64>,
+    report: NavigationReport,
+}
+
+impl Navigator {
+    /// A navigator for the robot `config` describes, with the planner settings `planner`.
+    pub fn new(config: &RobotConfig, planner: PlannerConfig) -> Result<Self, RobotError> {
+        let geometry = grid_geometry(config, planner.cell_mm)?;
+        let accept_mm = config
+            .goal
+            .as_ref()
+            .map_or(100.0, |g| g.tolerance_mm - g.estimate_margin_mm)
+            .max(planner.cell_mm);
+        Ok(Self {
+            costs: CostSettings {
+                inflated_mm: config.body.radius_mm + planner.inflation_mm,
+                comfort_mm: planner.comfort_mm,
+                unknown_cost: planner.unknown_cost,
+            },
+            radius_mm: config.body.radius_mm,
+            max_speed_mm_s: config.body.max_speed_mm_s,
+            accel_mm_s2: config.body.accel_limit_mm_s2,
+            accept_mm,
+            grid: OccupancyGrid::new(geometry, &config.map, &planner),
+            penalty: vec![0.0; geometry.len()],
+            penalty_t_s: 0.0,
+            cost_map: None,
+            plan: None,
+            target: None,
+            watchdog: None,
+            failing_since_s: None,
+            report: NavigationReport::default(),
+            config: planner,
+        })
+    }
+
+    /// What it did this cycle.
+    pub fn report(&self) -> &NavigationReport {
+        &self.report
+    }
+
+    /// The grid's cells now.
+    pub fn map(&self) -> MapSnapshot {
+        self.grid.snapshot()
+    }
+
+    /// One cycle: takes the free space seen (if any) from the estimated `pose`, and returns
+    /// where the controller should head for `target` (world mm), the robot moving at
+    /// `velocity_body_mm_s`: a body-frame vector whose direction is the lookahead point's and
+    /// whose length is the way still to go (shortened before bends); `None` to stop (no
+    /// route, or the goal unreachable).
+    pub fn steer(
+        &mut self,
+        fs: Option<&FreeSpace>,
+        pose: &Isometry2<f64>,
+        velocity_body_mm_s: Vector2<f64>,
+        target: Point2<f64>,
+        t_s: f64,
+    ) -> Option<Vector2<f64>> {
+        if let Some(fs) = fs {
+            self.grid.observe(fs, pose, self.radius_mm, t_s);
+        }
+        let here = Point2::from(pose.translation.vector);
+        if self.target != Some(target) {
+            self.target = Some(target);
+            self.plan = None;
+            self.failing_since_s = None;
+            self.watchdog = Some(Watchdog::new(here, t_s));
+            self.report.unreachable = false;
+        }
+        self.report.cells = self.grid.counts();
+        if self.report.unreachable {
+            return self.stop();
+        }
+        if (target - here).norm() <= self.accept_mm {
+            self.report.lookahead_mm = Some(target);
+            self.report.remaining_mm = Some((target - here).norm());
+            return Some(pose.inverse_transform_vector(&(target - here)));
+        }
+        let remaining = self.report.remaining_mm.unwrap_or(f64::INFINITY);
+        let fired = self
+            .watchdog
+            .as_mut()
+            .is_some_and(|w| w.stuck(here, remaining, t_s, &self.config));
+        if fired {
+            self.report.watchdog += 1;
+            let ahead = self.report.lookahead_mm.unwrap_or(here);
+            self.penalise(ahead, t_s);
+            self.plan = None;
+        }
+        if self.needs_plan(here, t_s) && !self.replan(here, target, t_s) {
+            if self.report.unreachable {
+                return self.stop();
+            }
+            self.report.lookahead_mm = Some(target);
+            self.report.remaining_mm = None;
+            return Some(pose.inverse_transform_vector(&(target - here)));
+        }
+        let course = pose.rotation * velocity_body_mm_s;
+        self.follow(pose, here, course)
+    }
+
+    fn stop(&mut self) -> Option<Vector2<f64>> {
+        self.report.lookahead_mm = None;
+        self.report.remaining_mm = None;
+        None
+    }
+
+    /// Whether to plan again now.
+    fn needs_plan(&self, here: Point2<f64>, t_s: f64) -> bool {
+        let Some(plan) = &self.plan else {
+            return true;
+        };
+        t_s - plan.made_t_s >= self.config.replan_period_s - 1e-9
+            || distance_to_path(&plan.path, here).0 > STRAY_MM
+    }
+
+    /// Plans from `here` to `target`; false when no route exists (and, after
+    /// `UNREACHABLE_S` of that, marks the goal unreachable).
+    fn replan(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
+        self.fade_penalty(t_s);
+        let costs = CostMap::new(&self.grid, &self.costs, &self.penalty, here);
+        let found = costs.plan(here, target, self.accept_mm);
+        self.report.replans += 1;
+        let Some((cells, _)) = found else {
+            let since = *self.failing_since_s.get_or_insert(t_s);
+            if t_s - since >= UNREACHABLE_S - 1e-9 {
+                self.report.unreachable = true;
+            }
+            self.plan = None;
+            self.cost_map = Some(costs);
+            return false;
+        };
+        self.failing_since_s = None;
+        let path = costs.taut(here, &cells, target);
+        let new_len = length(&path);
+        if let (Some(w), Some(old)) = (&mut self.watchdog, self.report.remaining_mm)
+            && new_len > old + REBASE_MM
+        {
+            w.best_mm = new_len;
+            w.best_t_s = t_s;
+        }
+        self.report.path_mm = path.clone();
+        self.plan = Some(Plan {
+            path,
+            made_t_s: t_s,
+        });
+        self.cost_map = Some(costs);
+        true
+    }
+
+    /// The controller's goal vector for the robot at `here`, moving at `course` (world frame),
+    /// on the current plan.
+    fn follow(
+        &mut self,
+        pose: &Isometry2<f64>,
+        here: Point2<f64>,
+        course: Vector2<f64>,
+    ) -> Option<Vector2<f64>> {
+        let (plan, costs) = (self.plan.as_ref()?, self.cost_map.as_ref()?);
+        let path = &plan.path;
+        let (_, s_near) = distance_to_path(path, here);
+        let total = length(path);
+        let mut s = (s_near + self.config.lookahead_mm).min(total);
+        let mut point = point_at(path, s);
+        // Back off to the farthest point before it that the robot sees over passable cells.
+        let step = 0.5 * costs.geometry().cell_mm;
+        while s > s_near + step && !costs.line_clear(here, point) {
+            s -= step;
+            point = point_at(path, s);
+        }
+        let remaining = (point - here).norm() + (total - s);
+        self.report.lookahead_mm = Some(point);
+        self.report.remaining_mm = Some(remaining);
+        let v = point - here;
+        if v.norm() < 1e-6 {
+            return Some(Vector2::zeros());
+        }
+        let mut reach = remaining;
+        if let Some((d_turn, theta)) = next_bend(path, s_near) {
+            reach = reach.min(d_turn + self.braking_mm(theta));
+        }
+        if course.norm() > COURSE_MIN_SPEED_MM_S {
+            reach = reach.min(self.braking_mm(course.angle(&v)));
+        }
+        Some(pose.inverse_transform_vector(&(v.normalize() * reach)))
+    }
+
+    /// The distance in which the robot brakes from the top speed to the speed it takes a turn
+    /// by `theta` at (infinite for a gentle turn).
+    fn braking_mm(&self, theta: f64) -> f64 {
+        if theta <= BEND_RAD {
+            return f64::INFINITY;
+        }
+        let v = self.max_speed_mm_s * theta.cos().max(MIN_TURN_SPEED);
+        v * v / (2.0 * self.accel_mm_s2)
+    }
+
+    /// Makes the cells round `at` dearer.
+    fn penalise(&mut self, at: Point2<f64>, t_s: f64) {
+        self.fade_penalty(t_s);
+        let g = *self.grid.geometry();
+        let r = (PENALTY_RADIUS_MM / g.cell_mm).ceil() as i64;
+        let Some((cx, cy)) = g.coords_of(at) else {
+            return;
+        };
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let (x, y) = (cx as i64 + dx, cy as i64 + dy);
+                if x < 0 || y < 0 || x >= g.width as i64 || y >= g.height as i64 {
+                    continue;
+                }
+                let i = y as usize * g.width + x as usize;
+                if (g.centre(i) - at).norm() <= PENALTY_RADIUS_MM {
+                    self.penalty[i] += PENALTY;
+                }
+            }
+        }
+    }
+
+    /// Lets the watchdog's penalties fade like the grid's evidence.
+    fn fade_penalty(&mut self, t_s: f64) {
+        let dt = t_s - self.penalty_t_s;
+        if dt > 0.0 {
+            let k = (-dt / self.config.forget_s).exp() as f32;
+            for p in &mut self.penalty {
+                *p *= k;
+            }
+        }
+        self.penalty_t_s = t_s;
+    }
+}
+
+/// The grid for a robot: the map it is given (or, without one, its start and targets) and
+/// some room round it.
+fn grid_geometry(config: &RobotConfig, cell_mm: f64) -> Result<GridGeometry, RobotError> {
+    let m = &config.map;
+    let mut points: Vec<Point2<f64>> = vec![Point2::from(config.start.translation.vector)];
+    points.extend(config.goal.iter().flat_map(|g| g.targets()));
+    let mapped: Vec<Point2<f64>> = m
+        .bounds
+        .iter()
+        .chain(&m.segments)
+        .flat_map(|s| [s.from_mm, s.to_mm])
+        .chain(m.landmarks.iter().map(|l| l.centre_mm))
+        .collect();
+    let pad = if m.bounds.is_empty() {
+        PAD_WITHOUT_MAP_MM
+    } else {
+        PAD_WITH_MAP_MM
+    };
+    points.extend(mapped);
+    let lo = points.iter().fold(points[0], |a, p| a.inf(p)) - Vector2::repeat(pad);
+    let hi = points.iter().fold(points[0], |a, p| a.sup(p)) + Vector2::repeat(pad);
+    let g = GridGeometry::covering(lo, hi, cell_mm);
+    if g.len() > MAX_CELLS {
+        return Err(RobotError::Config(format!(
+            "control.planner.cell_mm: a grid of {cell_mm} mm cells over {:.0} x {:.0} mm has {} \
+             cells, more than {MAX_CELLS}: raise cell_mm",
+            hi.x - lo.x,
+            hi.y - lo.y,
+            g.len()
+        )));
+    }
+    Ok(g)
+}
+
+/// Distance from `p` to a polyline, and the arc length of the nearest point on it.
+fn distance_to_path(path: &[Point2<f64>], p: Point2<f64>) -> (f64, f64) {
+    let mut best = (f64::INFINITY, 0.0);
+    let mut s0 = 0.0;
+    for w in path.windows(2) {
+        let ab = w[1] - w[0];
+        let len = ab.norm();
+        let t = if len > 0.0 {
+            ((p - w[0]).dot(&ab) / (len * len)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let d = (p - (w[0] + ab * t)).norm();
+        if d < best.0 {
+            best = (d, s0 + t * len);
+        }
+        s0 += len;
+    }
+    if path.len() == 1 {
+        best = ((p - path[0]).norm(), 0.0);
+    }
+    best
+}
+
+/// The next vertex beyond arc length `s` where the polyline turns by more than `BEND_RAD`: its
+/// distance along the line from `s` and the turn's angle.
+fn next_bend(path: &[Point2<f64>], s: f64) -> Option<(f64, f64)> {
+    let mut at = 0.0;
+    for w in path.windows(3) {
+        at += (w[1] - w[0]).norm();
+        if at <= s {
+            continue;
+        }
+        let theta = (w[1] - w[0]).angle(&(w[2] - w[1]));
+        if theta > BEND_RAD {
+            return Some((at - s, theta));
+        }
+    }
+    None
+}
+
+/// The point at arc length `s` along a polyline.
+fn point_at(path: &[Point2<f64>], s: f64) -> Point2<f64> {
+    let mut left = s.max(0.0);
+    for w in path.windows(2) {
+        let len = (w[1] - w[0]).norm();
+        if left <= len && len > 0.0 {
+            return w[0] + (w[1] - w[0]) * (left / len);
+        }
+        left -= len;
+    }
+    *path.last().unwrap_or(&Point2::origin())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{BodySpec, ControlSpec, GoalSpec, MapSegment, VisionSpec, WorldMap};
+    use std::f64::consts::TAU;
+
+    fn robot(map: WorldMap, goal: [f64; 2]) -> RobotConfig {
+        RobotConfig {
+            start: Isometry2::new(Vector2::new(-1000.0, 0.0), 0.0),
+            body: BodySpec {
+                radius_mm: 90.0,
+                max_speed_mm_s: 400.0,
+                accel_limit_mm_s2: 300.0,
+                angular_accel_limit_rad_s2: 10.0,
+            },
+            control_period_s: 0.04,
+            cameras: Vec::new(),
+            calibrations: Vec::new(),
+            columns: Vec::new(),
+            forward_camera: None,
+            vision: VisionSpec::default(),
+            control: ControlSpec::default(),
+            goal: Some(GoalSpec::to(goal, 100.0)),
+            map,
+            stereo: None,
+            seed: 1,
+        }
+    }
+
+    fn box_map(half: f64) -> WorldMap {
+        let c = [[-half, -half], [half, -half], [half, half], [-half, half]];
+        WorldMap {
+            bounds: (0..4)
+                .map(|k| MapSegment {
+                    from_mm: Point2::new(c[k][0], c[k][1]),
+                    to_mm: Point2::new(c[(k + 1) % 4][0], c[(k + 1) % 4][1]),
+                    half_thickness_mm: 25.0,
+                })
+                .collect(),
+            ..WorldMap::default()
+        }
+    }
+
+    /// Free space of a robot that sees nothing but open floor.
+    fn open_floor() -> FreeSpace {
+        let n = 32;
+        FreeSpace {
+            direction_rad: (0..n).map(|j| j as f64 * TAU / n as f64).collect(),
+            a: vec![6; n],
+            free_mm: vec![1000.0; n],
+            clear_mm: vec![960.0; n],
+            range_mm: 1000.0,
+            ..FreeSpace::default()
+        }
+    }
+
+    #[test]
+    fn heads_along_the_plan_with_the_remaining_way_as_the_goals_distance() {
+        let cfg = robot(box_map(1500.0), [1000.0, 0.0]);
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let v = nav
+            .steer(
+                Some(&open_floor()),
+                &cfg.start,
+                Vector2::zeros(),
+                Point2::new(1000.0, 0.0),
+                0.0,
+            )
+            .unwrap();
+        assert!(v.y.abs() < 1e-6 && v.x > 1900.0 && v.x < 2100.0, "{v:?}");
+        assert_eq!(nav.report().replans, 1);
+        assert!(!nav.report().unreachable);
+    }
+
+    #[test]
+    fn a_goal_walled_off_is_reported_unreachable_after_two_seconds_and_the_robot_stops() {
+        // The goal inside a closed square the map knows.
+        let mut map = box_map(1500.0);
+        let inner = box_map(300.0);
+        map.bounds.extend(inner.bounds.iter().map(|s| MapSegment {
+            from_mm: s.from_mm + Vector2::new(700.0, 0.0),
+            to_mm: s.to_mm + Vector2::new(700.0, 0.0),
+            ..*s
+        }));
+        let cfg = robot(map, [700.0, 0.0]);
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let goal = Point2::new(700.0, 0.0);
+        let mut t = 0.0;
+        while t < 1.9 {
+            let v = nav.steer(None, &cfg.start, Vector2::zeros(), goal, t);
+            assert!(
+                v.is_some_and(|v| v.x > 0.0),
+                "heads for the goal while it looks"
+            );
+            assert!(!nav.report().unreachable, "not yet at {t} s");
+            t += 0.04;
+        }
+        for _ in 0..5 {
+            nav.steer(None, &cfg.start, Vector2::zeros(), goal, t);
+            t += 0.04;
+        }
+        assert!(nav.report().unreachable);
+        assert!(
+            nav.steer(
+                Some(&open_floor()),
+                &cfg.start,
+                Vector2::zeros(),
+                goal,
+                t + 5.0
+            )
+            .is_none(),
+            "stays stopped"
+        );
+    }
+
+    #[test]
+    fn the_watchdog_fires_when_the_robot_stays_put_and_makes_the_place_dearer() {
+        let cfg = robot(box_map(1500.0), [1000.0, 0.0]);
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let goal = Point2::new(1000.0, 0.0);
+        let mut t = 0.0;
+        while t < 4.2 {
+            nav.steer(Some(&open_floor()), &cfg.start, Vector2::zeros(), goal, t);
+            t += 0.04;
+        }
+        assert_eq!(nav.report().watchdog, 1);
+        assert!(nav.penalty.iter().any(|&p| p > 3.0));
+    }
+
+    #[test]
+    fn a_grid_too_large_for_its_cells_is_a_config_error_naming_the_field() {
+        let mut cfg = robot(WorldMap::default(), [200_000.0, 0.0]);
+        cfg.goal = Some(GoalSpec::to([200_000.0, 0.0], 100.0));
+        let err = Navigator::new(&cfg, PlannerConfig::default()).unwrap_err();
+        assert!(err.to_string().contains("control.planner.cell_mm"), "{err}");
+    }
+}

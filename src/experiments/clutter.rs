@@ -1,0 +1,358 @@
+//! Navigation among clutter: a seed gives the Small-Size field with `cubes` cubes at random, and
+//! a start and a goal at random free places at least `min_distance_mm` apart, the goal
+//! reachable through gaps at least `passage_mm` wide (a layout whose goal is not is drawn again:
+//! the benchmark measures navigation, not luck). The sweep keys `experiment.clutter.seed` and
+//! `experiment.clutter.cubes` make a benchmark of it; the metrics add the straight-line
+//! distance from start to goal (`straight_mm`) and, when the goal was reached, the path ratio
+//! (`path_ratio`: the path's length over the shortest way into the goal's tolerance circle,
+//! `straight_mm - goal_tolerance_mm`) to `summary.json`.
+
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use crate::run::{RunError, RunOutput};
+use crate::scenario::{Checker, PoseSpec, Scenario};
+use nalgebra::{Point2, Rotation2, Vector2};
+use omniloop_robot::GoalSpec;
+use omniloop_sim::{Cube, FieldSpec};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+
+/// The clutter (`[experiment.clutter]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ClutterSpec {
+    /// The layout's seed (the run's own `seed` draws the noise).
+    pub seed: u64,
+    /// How many cubes.
+    pub cubes: usize,
+    /// Side of a cube, mm.
+    pub cube_size_mm: f64,
+    /// Least distance between start and goal, mm.
+    pub min_distance_mm: f64,
+    /// Least gap between the robot's edge at start or goal and any cube or wall, mm.
+    pub clearance_mm: f64,
+    /// The goal must be reachable through gaps at least this wide, mm.
+    pub passage_mm: f64,
+    /// The goal's tolerance, mm.
+    pub goal_tolerance_mm: f64,
+}
+
+impl Default for ClutterSpec {
+    fn default() -> Self {
+        Self {
+            seed: 1,
+            cubes: 10,
+            cube_size_mm: 130.0,
+            min_distance_mm: 1500.0,
+            clearance_mm: 60.0,
+            passage_mm: 260.0,
+            goal_tolerance_mm: 100.0,
+        }
+    }
+}
+
+/// Most layouts drawn before giving up.
+const TRIES: usize = 200;
+/// Most cubes the field takes.
+const MAX_CUBES: usize = 40;
+/// Cell of the reachability check, mm.
+const CELL_MM: f64 = 20.0;
+
+/// A drawn layout.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClutterLayout {
+    /// The cubes.
+    pub cubes: Vec<Cube>,
+    /// Where the robot starts.
+    pub start: PoseSpec,
+    /// The goal.
+    pub goal: [f64; 2],
+}
+
+impl ClutterSpec {
+    /// The layout of this seed on `field` for a robot of `radius_mm`.
+    pub fn layout(&self, field: &FieldSpec, radius_mm: f64) -> Result<ClutterLayout, String> {
+        let mut rng = StdRng::seed_from_u64(self.seed ^ 0x0043_4c55_5454_4552);
+        for _ in 0..TRIES {
+            let cubes = self.draw_cubes(&mut rng, field);
+            let free = |p: Point2<f64>| {
+                gap_mm(p, &cubes, self.cube_size_mm, field) - radius_mm >= self.clearance_mm
+            };
+            let Some(start) = random_place(&mut rng, field, radius_mm, &free) else {
+                continue;
+            };
+            let far = |p: Point2<f64>| free(p) && (p - start).norm() >= self.min_distance_mm;
+            let Some(goal) = random_place(&mut rng, field, radius_mm, &far) else {
+                continue;
+            };
+            if !self.reachable(field, &cubes, start, goal) {
+                continue;
+            }
+            return Ok(ClutterLayout {
+                cubes,
+                start: PoseSpec {
+                    x_mm: start.x,
+                    y_mm: start.y,
+                    heading_deg: rng.random_range(-180.0..180.0),
+                },
+                goal: [goal.x, goal.y],
+            });
+        }
+        Err(format!(
+            "no layout of {} cubes in {TRIES} draws leaves a start and a goal {} mm apart joined \
+             by gaps of {} mm: fewer cubes or a shorter min_distance_mm",
+            self.cubes, self.min_distance_mm, self.passage_mm
+        ))
+    }
+
+    /// Cubes at random on the playing floor, none overlapping another.
+    fn draw_cubes(&self, rng: &mut StdRng, field: &FieldSpec) -> Vec<Cube> {
+        let h = 0.5 * self.cube_size_mm * std::f64::consts::SQRT_2;
+        let mut cubes: Vec<Cube> = Vec::with_capacity(self.cubes);
+        while cubes.len() < self.cubes {
+            let c = [
+                rng.random_range(-field.half_length_mm + h..field.half_length_mm - h),
+                rng.random_range(-field.half_width_mm + h..field.half_width_mm - h),
+            ];
+            let apart = cubes
+                .iter()
+                .all(|o| (Point2::from(o.center_mm) - Point2::from(c)).norm() >= 2.0 * h);
+            if apart {
+                cubes.push(Cube {
+                    center_mm: c,
+                    size_mm: self.cube_size_mm,
+                    angle_deg: rng.random_range(0.0..90.0),
+                    rgb: omniloop_sim::Rgb([40, 40, 40]),
+                });
+            }
+        }
+        cubes
+    }
+
+    /// Whether a disc of `passage_mm / 2` can roll from `start` to `goal` (4-connected cells).
+    fn reachable(
+        &self,
+        field: &FieldSpec,
+        cubes: &[Cube],
+        start: Point2<f64>,
+        goal: Point2<f64>,
+    ) -> bool {
+        let (a, b) = (field.half_length_mm, field.half_width_mm);
+        let (w, h) = ((2.0 * a / CELL_MM) as usize, (2.0 * b / CELL_MM) as usize);
+        let centre = |x: usize, y: usize| {
+            Point2::new(
+                -a + (x as f64 + 0.5) * CELL_MM,
+                -b + (y as f64 + 0.5) * CELL_MM,
+            )
+        };
+        let cell = |p: Point2<f64>| {
+            let x = ((p.x + a) / CELL_MM).clamp(0.0, w as f64 - 1.0) as usize;
+            let y = ((p.y + b) / CELL_MM).clamp(0.0, h as f64 - 1.0) as usize;
+            (x, y)
+        };
+        let open = |x: usize, y: usize| {
+            gap_mm(centre(x, y), cubes, self.cube_size_mm, field) >= 0.5 * self.passage_mm
+        };
+        let mut seen = vec![false; w * h];
+        let (s, g) = (cell(start), cell(goal));
+        let mut queue = VecDeque::from([s]);
+        seen[s.1 * w + s.0] = true;
+        while let Some((x, y)) = queue.pop_front() {
+            if (x, y) == g {
+                return true;
+            }
+            let near = [
+                (x + 1, y),
+                (x.wrapping_sub(1), y),
+                (x, y + 1),
+                (x, y.wrapping_sub(1)),
+            ];
+            for (nx, ny) in near {
+                if nx < w && ny < h && !seen[ny * w + nx] && open(nx, ny) {
+                    seen[ny * w + nx] = true;
+                    queue.push_back((nx, ny));
+                }
+            }
+        }
+        false
+    }
+
+    fn validate(&self, s: &Scenario, c: &mut Checker) {
+        let p = "experiment.clutter";
+        if self.cubes > MAX_CUBES {
+            c.fail(
+                format!("{p}.cubes"),
+                format!(
+                    "at most {MAX_CUBES} cubes fit the field (got {})",
+                    self.cubes
+                ),
+            );
+        }
+        for (key, v) in [
+            ("cube_size_mm", self.cube_size_mm),
+            ("min_distance_mm", self.min_distance_mm),
+            ("passage_mm", self.passage_mm),
+            ("goal_tolerance_mm", self.goal_tolerance_mm),
+        ] {
+            c.positive(format!("{p}.{key}"), v);
+        }
+        let sane = self.clearance_mm.is_finite() && self.clearance_mm >= 0.0;
+        if !sane {
+            c.fail(format!("{p}.clearance_mm"), "must be a finite number >= 0");
+        }
+        let positive = [self.cube_size_mm, self.min_distance_mm, self.passage_mm];
+        if sane && self.cubes <= MAX_CUBES && positive.iter().all(|v| v.is_finite() && *v > 0.0) {
+            let field = s.world.field.clone().unwrap_or_default();
+            if let Err(why) = self.layout(&field, s.robot.radius_mm) {
+                c.fail(p, why);
+            }
+        }
+    }
+}
+
+/// Distance from `p` to the nearest cube surface or field wall (the floor's boundary; the
+/// goal pockets count as wall), mm.
+fn gap_mm(p: Point2<f64>, cubes: &[Cube], size_mm: f64, field: &FieldSpec) -> f64 {
+    let walls = (field.half_length_mm - p.x.abs()).min(field.half_width_mm - p.y.abs());
+    cubes.iter().fold(walls, |best, c| {
+        let q = Rotation2::new(-c.angle_deg.to_radians()) * (p - Point2::from(c.center_mm));
+        let out = Vector2::new(
+            (q.x.abs() - 0.5 * size_mm).max(0.0),
+            (q.y.abs() - 0.5 * size_mm).max(0.0),
+        );
+        best.min(out.norm())
+    })
+}
+
+/// A random place on the playing floor where `ok` holds, if one turns up.
+fn random_place(
+    rng: &mut StdRng,
+    field: &FieldSpec,
+    radius_mm: f64,
+    ok: &dyn Fn(Point2<f64>) -> bool,
+) -> Option<Point2<f64>> {
+    let (a, b) = (
+        field.half_length_mm - radius_mm,
+        field.half_width_mm - radius_mm,
+    );
+    (0..500)
+        .map(|_| Point2::new(rng.random_range(-a..a), rng.random_range(-b..b)))
+        .find(|&p| ok(p))
+}
+
+/// The registry's entry: `[experiment.clutter]`.
+pub const ENTRY: ExperimentEntry = ExperimentEntry {
+    name: "clutter",
+    summary: "navigation among clutter: the field with cubes at random, start and goal apart",
+    setup: |t| setup::<ClutterSpec>(t, "clutter"),
+};
+
+impl ExperimentSetup for ClutterSpec {
+    fn prepare(&self, s: &mut Scenario) {
+        let field = s.world.field.get_or_insert_with(FieldSpec::default).clone();
+        let Ok(layout) = self.layout(&field, s.robot.radius_mm) else {
+            return;
+        };
+        s.world.cubes.extend(layout.cubes);
+        s.robot.start.get_or_insert(layout.start);
+        if s.goal.is_none() {
+            s.goal = Some(GoalSpec {
+                estimate_margin_mm: 30.0,
+                ..GoalSpec::to(layout.goal, self.goal_tolerance_mm)
+            });
+        }
+    }
+
+    fn check(&self, s: &Scenario, c: &mut Checker) {
+        self.validate(s, c);
+    }
+
+    fn procedure(&self, s: &Scenario) -> Result<Box<dyn Experiment>, RunError> {
+        Ok(Box::new(Clutter {
+            goal: s.goal.as_ref().map(|g| (g.point(), g.tolerance_mm)),
+        }))
+    }
+}
+
+/// The driving procedure, with the path ratio among the metrics.
+struct Clutter {
+    /// The goal and its tolerance.
+    goal: Option<(Point2<f64>, f64)>,
+}
+
+impl Experiment for Clutter {
+    fn metrics(&self, out: &RunOutput) -> Metrics {
+        let mut m = Metrics::new();
+        let (Some(first), Some((goal, tolerance))) = (out.trajectory.first(), self.goal) else {
+            return m;
+        };
+        let straight = (goal - Point2::new(first.x_mm, first.y_mm)).norm();
+        m.insert("straight_mm".into(), straight.into());
+        let shortest = straight - tolerance;
+        if out.summary.reached_goal && shortest > 0.0 {
+            m.insert(
+                "path_ratio".into(),
+                (out.summary.path_length_mm / shortest).into(),
+            );
+        }
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_seed_gives_one_layout_with_start_and_goal_apart_and_clear() {
+        let spec = ClutterSpec {
+            cubes: 16,
+            ..ClutterSpec::default()
+        };
+        let field = FieldSpec::default();
+        let a = spec.layout(&field, 90.0).unwrap();
+        assert_eq!(
+            a,
+            spec.layout(&field, 90.0).unwrap(),
+            "same seed, same layout"
+        );
+        let b = ClutterSpec {
+            seed: 2,
+            ..spec.clone()
+        }
+        .layout(&field, 90.0)
+        .unwrap();
+        assert_ne!(a.cubes, b.cubes);
+        assert_eq!(a.cubes.len(), 16);
+        let (s, g) = (
+            Point2::new(a.start.x_mm, a.start.y_mm),
+            Point2::from(a.goal),
+        );
+        assert!((g - s).norm() >= 1500.0);
+        for p in [s, g] {
+            assert!(
+                gap_mm(p, &a.cubes, 130.0, &field) >= 90.0 + 60.0,
+                "{p:?} too near"
+            );
+        }
+        assert!(spec.reachable(&field, &a.cubes, s, g));
+    }
+
+    #[test]
+    fn a_wall_of_cubes_across_the_field_makes_the_goal_unreachable() {
+        let field = FieldSpec::default();
+        let spec = ClutterSpec::default();
+        let wall: Vec<Cube> = (0..13)
+            .map(|k| Cube {
+                center_mm: [0.0, -780.0 + 130.0 * k as f64],
+                size_mm: 130.0,
+                angle_deg: 0.0,
+                rgb: omniloop_sim::Rgb([40, 40, 40]),
+            })
+            .collect();
+        let (s, g) = (Point2::new(-800.0, 0.0), Point2::new(800.0, 0.0));
+        assert!(!spec.reachable(&field, &wall, s, g));
+        assert!(spec.reachable(&field, &wall[..5], s, g));
+    }
+}

@@ -1,0 +1,126 @@
+//! Navigation among obstacles: the planner on the map the robot builds, above the
+//! velocity-aware controller, on the traps of `scenarios/` and the clutter generator.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
+
+mod common;
+
+use common::{cpu, omniloop, scenario, tmp};
+use omniloop::run_scenario;
+
+#[test]
+fn an_enclosed_goal_is_reported_unreachable_within_ten_seconds_and_the_robot_stands_still() {
+    let out = run_scenario(&scenario("trap_enclosed.toml"), &cpu(), |_| {}, |_, _| {}).unwrap();
+    let s = &out.summary;
+    assert_eq!(s.unreachable, Some(true), "{s:?}");
+    assert!(!s.reached_goal);
+    assert_eq!(s.wall_contacts, 0, "{s:?}");
+    let (k, first) = out
+        .estimates
+        .iter()
+        .enumerate()
+        .find(|(_, e)| e.not_found.iter().any(|n| n.source == "planner"))
+        .expect("a cycle reports the goal unreachable");
+    assert!(first.t_s <= 10.0, "reported at {} s", first.t_s);
+    let reason = &first
+        .not_found
+        .iter()
+        .find(|n| n.source == "planner")
+        .unwrap()
+        .reason;
+    assert!(reason.starts_with("unreachable:"), "{reason}");
+    // Braking from 400 mm/s at 300 mm/s^2 takes 1.33 s; after that it stands still.
+    let stopped_from = first.t_s + 1.5;
+    for row in out
+        .trajectory
+        .iter()
+        .skip(k)
+        .filter(|r| r.t_s >= stopped_from)
+    {
+        let v = row.vx_mm_s.hypot(row.vy_mm_s);
+        assert!(v < 1.0, "moving at {v} mm/s at {} s", row.t_s);
+    }
+    // Every later cycle says so too.
+    assert!(
+        out.estimates[k..]
+            .iter()
+            .all(|e| e.navigation.as_ref().is_some_and(|n| n.unreachable))
+    );
+}
+
+#[test]
+fn a_goal_in_a_field_corner_behind_a_cube_is_reached_without_contact() {
+    let out = run_scenario(
+        &scenario("trap_corner_goal.toml"),
+        &cpu(),
+        |_| {},
+        |_, _| {},
+    )
+    .unwrap();
+    let s = &out.summary;
+    assert!(s.reached_goal, "{s:?}");
+    assert_eq!(s.wall_contacts, 0, "{s:?}");
+    assert_eq!(s.unreachable, Some(false));
+    // The robot built a map: the field's walls from its map and cells it saw free and blocked.
+    let map = out.map.as_ref().expect("the planner's map");
+    let count = |st| map.cells.iter().filter(|&&c| c == st).count();
+    use omniloop_robot::CellState::{Blocked, Free};
+    assert!(
+        count(Free) > 1000 && count(Blocked) > 500,
+        "free {} blocked {}",
+        count(Free),
+        count(Blocked)
+    );
+    // Each cycle records the plan: a path ending at the goal.
+    let plan = out.estimates[10]
+        .navigation
+        .as_ref()
+        .expect("a plan record");
+    let end = plan.path_mm.last().unwrap();
+    assert!(
+        (end.x - 1250.0).abs() < 1.0 && (end.y - 650.0).abs() < 1.0,
+        "{end:?}"
+    );
+}
+
+#[test]
+fn the_clutter_layout_follows_its_seed_and_the_run_writes_the_plan_and_the_map() {
+    let dir = tmp("clutter_run");
+    omniloop([
+        "run",
+        "scenarios/clutter.toml",
+        "--renderer",
+        "cpu",
+        "--quiet",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["unreachable"], false);
+    assert!(
+        summary["straight_mm"].as_f64().unwrap() >= 1500.0,
+        "{summary}"
+    );
+    assert!(dir.join("topview.png").is_file());
+    let first = std::fs::read_to_string(dir.join("estimates.jsonl")).unwrap();
+    let line: serde_json::Value = serde_json::from_str(first.lines().next().unwrap()).unwrap();
+    assert!(
+        line["plan"]["path_mm"]
+            .as_array()
+            .is_some_and(|p| p.len() >= 2),
+        "{line}"
+    );
+    // Another layout seed, another layout (the sweep key `experiment.clutter.seed`).
+    let a = scenario("clutter.toml");
+    let text = std::fs::read_to_string(common::scenario_path("clutter.toml"))
+        .unwrap()
+        .replace(
+            "[experiment.clutter]\nseed = 1",
+            "[experiment.clutter]\nseed = 2",
+        );
+    let b =
+        omniloop::experiments::parse_scenario(&text, "clutter.toml".as_ref(), "clutter").unwrap();
+    assert_ne!(a.world.cubes, b.world.cubes);
+    assert_ne!(a.goal, b.goal);
+    assert_eq!(a.world.cubes.len(), 10);
+}
