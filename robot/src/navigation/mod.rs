@@ -13,7 +13,6 @@ pub use grid::{CellState, GridGeometry, MapSnapshot, OccupancyGrid};
 pub use navigator::{NavigationReport, Navigator};
 
 use crate::config::ControlSpec;
-use crate::controller::check_table;
 use crate::tables::{ConfigProblem, Problems};
 use serde::{Deserialize, Serialize};
 
@@ -80,20 +79,21 @@ pub const TABLE: &str = "planner";
 
 /// Parses and checks `[control.planner]`, naming each field at fault.
 pub fn check_planner(spec: &ControlSpec) -> Vec<ConfigProblem> {
-    check_table(spec, TABLE, |c: &PlannerConfig, p: &mut Problems| {
-        if !(c.cell_mm.is_finite() && (5.0..=200.0).contains(&c.cell_mm)) {
-            p.fail(
-                "cell_mm",
-                format!("must lie in [5, 200] mm (got {})", c.cell_mm),
-            );
-        }
-        p.non_negative("inflation_mm", c.inflation_mm);
-        p.non_negative("comfort_mm", c.comfort_mm);
-        p.non_negative("unknown_cost", c.unknown_cost);
-        p.positive("replan_period_s", c.replan_period_s);
-        p.positive("lookahead_mm", c.lookahead_mm);
-        p.positive("watchdog_s", c.watchdog_s);
-        p.positive("progress_mm", c.progress_mm);
-        p.positive("forget_s", c.forget_s);
-    })
+    spec.tables
+        .check("control", TABLE, |c: &PlannerConfig, p: &mut Problems| {
+            if !(c.cell_mm.is_finite() && (5.0..=200.0).contains(&c.cell_mm)) {
+                p.fail(
+                    "cell_mm",
+                    format!("must lie in [5, 200] mm (got {})", c.cell_mm),
+                );
+            }
+            p.non_negative("inflation_mm", c.inflation_mm);
+            p.non_negative("comfort_mm", c.comfort_mm);
+            p.non_negative("unknown_cost", c.unknown_cost);
+            p.positive("replan_period_s", c.replan_period_s);
+            p.positive("lookahead_mm", c.lookahead_mm);
+            p.positive("watchdog_s", c.watchdog_s);
+            p.positive("progress_mm", c.progress_mm);
+            p.positive("forget_s", c.forget_s);
+        })
 }
