@@ -30,7 +30,7 @@
 //! keeps seeing keeps its evidence. The walls of the map it is given are a fixed layer,
 //! blocked for good.
 
-use super::PlannerConfig;
+use super::config::PlannerConfig;
 use crate::config::{MapSegment, WorldMap};
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_vision::FreeSpace;

@@ -27,7 +27,7 @@
 //!   found for `UNREACHABLE_S` in a row, the goal is reported unreachable and the robot stops
 //!   and stays stopped (until it is given another target).
 
-use super::PlannerConfig;
+use super::config::PlannerConfig;
 use super::grid::{GridGeometry, MAX_CELLS, MapSnapshot, OccupancyGrid};
 use super::planner::{CostMap, CostSettings, length};
 use crate::RobotError;

@@ -222,7 +222,7 @@ pub fn length(points: &[Point2<f64>]) -> f64 {
 mod tests {
     use super::*;
     use crate::config::{MapSegment, WorldMap};
-    use crate::navigation::PlannerConfig;
+    use crate::navigation::config::PlannerConfig;
 
     fn settings() -> CostSettings {
         CostSettings {
