@@ -9,6 +9,12 @@
 //! odometry since), or, when it remembers none, a blind point at the body's edge (something is
 //! there at a distance nobody knows: the robot may pass it at a slant or move away from it,
 //! never head into it).
+//!
+//! A point is forgotten once it is older than `KEEP_S` *and* the robot has travelled more than
+//! `KEEP_TRAVEL_MM` since it was last seen: odometry drifts with the way driven, not with the
+//! time, and a robot creeping past a cube's corner (at the slowest turning speed, 80 mm/s
+//! for a 400 mm/s robot) must not forget the corner half-way along and slide into it at a
+//! slant (a blind point allows that).
 
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_vision::FreeSpace;
@@ -16,8 +22,11 @@ use std::f64::consts::TAU;
 
 /// Obstacle points farther than this are not remembered (fresh vision covers them), mm.
 const NEAR_MM: f64 = 450.0;
-/// How long a point is remembered, s.
+/// How long a point is remembered at least, s.
 const KEEP_S: f64 = 2.0;
+/// How far the robot may drive, at least, before a point is forgotten, mm (a 4% odometry
+/// scale error moves it by 10 mm over that).
+const KEEP_TRAVEL_MM: f64 = 250.0;
 /// Points closer than this to a remembered one refresh it instead of adding another, mm.
 const MERGE_MM: f64 = 12.0;
 
@@ -33,9 +42,12 @@ pub struct NearSpace {
 /// Remembered obstacle points near the robot.
 #[derive(Debug, Clone)]
 pub struct NearField {
-    /// Points in the odometry frame, with the time they were last seen.
-    points: Vec<(Point2<f64>, f64)>,
+    /// Points in the odometry frame, with the time and the odometer when they were last seen.
+    points: Vec<(Point2<f64>, f64, f64)>,
     radius_mm: f64,
+    /// The way driven so far, mm, and where the robot was last cycle (odometry frame).
+    odometer_mm: f64,
+    last: Option<Point2<f64>>,
 }
 
 impl NearField {
@@ -44,6 +56,8 @@ impl NearField {
         Self {
             points: Vec::new(),
             radius_mm,
+            odometer_mm: 0.0,
+            last: None,
         }
     }
 
@@ -52,8 +66,13 @@ impl NearField {
     /// remembered (or blind points at the body's edge) where it is blocked.
     pub fn update(&mut self, fs: &FreeSpace, odo: &Isometry2<f64>, t_s: f64) -> NearSpace {
         let here = Point2::from(odo.translation.vector);
-        self.points
-            .retain(|&(p, t)| t_s - t <= KEEP_S && (p - here).norm() <= 2.0 * NEAR_MM);
+        self.odometer_mm += self.last.map_or(0.0, |l| (here - l).norm());
+        self.last = Some(here);
+        let odometer = self.odometer_mm;
+        self.points.retain(|&(p, t, o)| {
+            (t_s - t <= KEEP_S || odometer - o <= KEEP_TRAVEL_MM)
+                && (p - here).norm() <= 2.0 * NEAR_MM
+        });
         let n = fs.direction_rad.len();
         let half = 0.5 * TAU / n as f64;
         let mut out = NearSpace {
@@ -75,7 +94,7 @@ impl NearField {
             // The first ring is blocked: the obstacle may be nearer than vision can tell.
             let c = fs.direction_rad[j];
             let before = out.clear.len();
-            for (p, _) in &self.points {
+            for (p, _, _) in &self.points {
                 let q = odo.inverse_transform_point(p).coords;
                 let off = (q.y.atan2(q.x) - c + TAU / 2.0).rem_euclid(TAU) - TAU / 2.0;
                 if off.abs() <= half {
@@ -93,13 +112,14 @@ impl NearField {
     }
 
     fn remember(&mut self, p: Point2<f64>, t_s: f64) {
+        let seen = (p, t_s, self.odometer_mm);
         match self
             .points
             .iter_mut()
-            .find(|(q, _)| (q - p).norm() < MERGE_MM)
+            .find(|(q, _, _)| (q - p).norm() < MERGE_MM)
         {
-            Some(entry) => *entry = (p, t_s),
-            None => self.points.push((p, t_s)),
+            Some(entry) => *entry = seen,
+            None => self.points.push(seen),
         }
     }
 }
@@ -172,8 +192,15 @@ mod tests {
         let out = fresh.update(&seen(150.0), &odo, 0.5);
         assert!((ahead(&out.blind) - 90.0).abs() < 1e-9);
         assert_eq!(ahead(&out.clear), f64::INFINITY);
-        // Forgotten after a while.
+        // Kept while the robot creeps on (old, but driven less than KEEP_TRAVEL_MM since)...
         let out = m.update(&seen(150.0), &odo, 3.0);
+        assert!((ahead(&out.clear) - 150.0).abs() < 1e-9);
+        assert!(out.blind.is_empty());
+        // ...and forgotten once it is old and the robot has driven on: back and forth along
+        // the wall, its memory of the wall ahead is gone.
+        let along = Isometry2::new(Vector2::new(150.0, 200.0), 0.0);
+        m.update(&seen(150.0), &along, 3.5);
+        let out = m.update(&seen(150.0), &odo, 4.0);
         assert!((ahead(&out.blind) - 90.0).abs() < 1e-9);
     }
 }
