@@ -48,6 +48,27 @@ fn an_enclosed_goal_is_reported_unreachable_within_ten_seconds_and_the_robot_sta
 }
 
 #[test]
+fn the_goal_behind_a_cul_de_sac_facing_the_start_is_reached_without_contact() {
+    let out = run_scenario(
+        &scenario("trap_cul_de_sac.toml"),
+        &cpu(),
+        |_| {},
+        |_, _| {},
+    )
+    .unwrap();
+    let s = &out.summary;
+    assert!(s.reached_goal, "{s:?}");
+    assert_eq!(s.wall_contacts, 0, "{s:?}");
+    assert_eq!(s.unreachable, Some(false), "{s:?}");
+    // The way is round an arm of the U: the robot passed beyond the arms' outer faces (y = 455
+    // and -455 mm), through a gap of about 300 mm between an arm and the field's wall.
+    assert!(
+        out.trajectory.iter().any(|r| r.y_mm.abs() > 455.0 + 90.0),
+        "never went round an arm"
+    );
+}
+
+#[test]
 fn a_goal_in_a_field_corner_behind_a_cube_is_reached_without_contact() {
     let out = run_scenario(
         &scenario("trap_corner_goal.toml"),

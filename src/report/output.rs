@@ -118,7 +118,7 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
     }
     let title = match out.map {
         Some(_) => format!(
-            "{}  (robot's map: green free, red blocked, clear unknown)",
+            "{}  (robot's map: green free, orange suspect, red blocked, clear unknown)",
             scenario.name
         ),
         None => scenario.name.clone(),

@@ -382,6 +382,7 @@ fn draw_grid(
             let run = row[x..].iter().take_while(|&&s| s == state).count();
             let style = match state {
                 CellState::Free => Some(RGBColor(40, 200, 60).mix(0.3).filled()),
+                CellState::Suspect => Some(RGBColor(240, 150, 30).mix(0.65).filled()),
                 CellState::Blocked => Some(RGBColor(200, 30, 30).mix(0.65).filled()),
                 CellState::Unknown => None,
             };

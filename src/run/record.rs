@@ -282,6 +282,7 @@ struct PlanRecord {
     unreachable: bool,
     cells_free: usize,
     cells_unknown: usize,
+    cells_suspect: usize,
     cells_blocked: usize,
 }
 
@@ -297,7 +298,8 @@ impl PlanRecord {
             unreachable: n.unreachable,
             cells_free: n.cells[0],
             cells_unknown: n.cells[1],
-            cells_blocked: n.cells[2],
+            cells_suspect: n.cells[2],
+            cells_blocked: n.cells[3],
         }
     }
 }

@@ -20,6 +20,12 @@
 //!   whole, closes every gap beside a cube; a thin mark is inflated by the robot's radius for
 //!   planning anyway, and a wider obstacle is hit by several sectors and views. Only cells
 //!   nearer than `TRUST_MM` are marked so: farther, the cells are too long to place a face.
+//!   A cell marked only from farther than `CONFIRM_MM` is *suspect*, not blocked: at that range
+//!   a sector is over 70 mm wide (32 directions), and its centre-line mark may stand that far
+//!   into the floor beside an obstacle's edge, enough to close a 300 mm gap beside a cube.
+//!   The planner may cross a suspect cell at a cost, so the robot goes to look from nearer,
+//!   where a sighting either confirms the cell (blocked) or clears it (free); only confirmed
+//!   cells make a goal unreachable.
 //!   An obstacle whose cell holds a wall of the map (anywhere across the sector, between
 //!   `free_mm[j]` and `front_mm[j] + depth`) is that wall (the map explains it) and is not
 //!   marked again: a wall seen obliquely through a long cell would otherwise be marked up to a
@@ -52,6 +58,8 @@ const FREE_BELOW: f32 = -0.3;
 const STRIP_CELLS: f64 = 0.75;
 /// Obstacles farther than this are not marked (the template's far cells are too long), mm.
 const TRUST_MM: f64 = 800.0;
+/// A mark from nearer than this confirms a cell blocked; from farther it is only suspect, mm.
+pub const CONFIRM_MM: f64 = 450.0;
 /// Most cells a grid may have (a 30 m x 30 m world at 25 mm cells).
 pub const MAX_CELLS: usize = 1_440_000;
 
@@ -62,7 +70,9 @@ pub enum CellState {
     Free,
     /// Never seen, or forgotten.
     Unknown,
-    /// Seen occupied, or a wall of the map.
+    /// Seen occupied, but only from farther than [`CONFIRM_MM`]: passable at a cost.
+    Suspect,
+    /// Seen occupied from near enough to place the face, or a wall of the map.
     Blocked,
 }
 
@@ -127,6 +137,8 @@ impl GridGeometry {
 pub struct OccupancyGrid {
     geometry: GridGeometry,
     log_odds: Vec<f32>,
+    /// Whether the cell's occupied evidence includes a sighting from within `CONFIRM_MM`.
+    confirmed: Vec<bool>,
     fixed: Vec<bool>,
     forget_s: f64,
     last_t_s: Option<f64>,
@@ -140,6 +152,7 @@ impl OccupancyGrid {
         let mut grid = Self {
             geometry,
             log_odds: vec![0.0; n],
+            confirmed: vec![false; n],
             fixed: vec![false; n],
             forget_s: config.forget_s,
             last_t_s: None,
@@ -167,7 +180,11 @@ impl OccupancyGrid {
         }
         let l = self.log_odds[i];
         if l > BLOCKED_ABOVE {
-            CellState::Blocked
+            if self.confirmed[i] {
+                CellState::Blocked
+            } else {
+                CellState::Suspect
+            }
         } else if l < FREE_BELOW {
             CellState::Free
         } else {
@@ -175,14 +192,15 @@ impl OccupancyGrid {
         }
     }
 
-    /// Counts of free, unknown and blocked cells.
-    pub fn counts(&self) -> [usize; 3] {
-        let mut c = [0; 3];
+    /// Counts of free, unknown, suspect and blocked cells.
+    pub fn counts(&self) -> [usize; 4] {
+        let mut c = [0; 4];
         for i in 0..self.geometry.len() {
             c[match self.state(i) {
                 CellState::Free => 0,
                 CellState::Unknown => 1,
-                CellState::Blocked => 2,
+                CellState::Suspect => 2,
+                CellState::Blocked => 3,
             }] += 1;
         }
         c
@@ -248,8 +266,9 @@ impl OccupancyGrid {
             let dt = t_s - t0;
             if dt > 0.0 {
                 let k = (-dt / self.forget_s).exp() as f32;
-                for l in &mut self.log_odds {
+                for (l, near) in self.log_odds.iter_mut().zip(&mut self.confirmed) {
                     *l *= k;
+                    *near &= *l > BLOCKED_ABOVE;
                 }
             }
         }
@@ -296,6 +315,7 @@ impl OccupancyGrid {
             if d > reach {
                 return;
             }
+            let mut near = false;
             let delta = if (c - here).norm() <= body_radius_mm {
                 L_FREE
             } else {
@@ -314,6 +334,7 @@ impl OccupancyGrid {
                     && d <= front_of(j)
                     && d >= (front_of(j) - depth).min(fs.free_mm[j])
                 {
+                    near = d <= CONFIRM_MM;
                     L_OCC
                 } else {
                     return;
@@ -321,6 +342,8 @@ impl OccupancyGrid {
             };
             let l = &mut grid.log_odds[i];
             *l = (*l + delta).clamp(L_MIN, L_MAX);
+            let confirmed = &mut grid.confirmed[i];
+            *confirmed = (*confirmed || near) && *l > BLOCKED_ABOVE;
         });
     }
 
@@ -350,6 +373,16 @@ impl OccupancyGrid {
                     .is_some_and(|i| self.fixed[i])
             })
         })
+    }
+
+    /// Marks the cell holding `p` occupied, as a sighting from near (`confirmed`) or from afar
+    /// would: for the planner's tests.
+    #[cfg(test)]
+    pub(super) fn mark_occupied(&mut self, p: Point2<f64>, confirmed: bool) {
+        if let Some(i) = self.geometry.cell_of(p) {
+            self.log_odds[i] = L_MAX;
+            self.confirmed[i] = confirmed;
+        }
     }
 
     /// The cells as free, unknown or blocked, for figures and records.
@@ -404,10 +437,11 @@ mod tests {
     #[test]
     fn a_wall_ahead_is_blocked_the_floor_before_it_free_and_behind_it_unknown() {
         let mut g = grid();
-        // A wall 600 mm ahead (x = 600) across the robot's front.
+        // A wall 400 mm ahead (x = 400) across the robot's front, near enough to be placed
+        // (CONFIRM_MM).
         let fs = seen(64, |a| {
             let c = a.cos();
-            if c > 0.6 { 600.0 / c } else { 1000.0 }
+            if c > 0.6 { 400.0 / c } else { 1000.0 }
         });
         g.observe(&fs, &Isometry2::identity(), 90.0, 0.0);
         let at = |x: f64, y: f64| {
@@ -415,9 +449,9 @@ mod tests {
             g.state(i)
         };
         assert_eq!(at(300.0, 0.0), CellState::Free);
-        assert_eq!(at(610.0, 0.0), CellState::Blocked);
+        assert_eq!(at(410.0, 0.0), CellState::Blocked);
         assert_eq!(
-            at(800.0, 0.0),
+            at(600.0, 0.0),
             CellState::Unknown,
             "behind the wall is not seen"
         );
@@ -430,11 +464,42 @@ mod tests {
     }
 
     #[test]
+    fn an_obstacle_seen_only_from_afar_is_suspect_and_seen_from_near_blocked() {
+        // A wall across the robot's front, seen from 700 mm, then from 300 mm.
+        let wall = |x: f64| {
+            seen(32, move |a: f64| {
+                let c = a.cos();
+                if c > 0.6 { x / c } else { 1000.0 }
+            })
+        };
+        let mut g = grid();
+        let pose = Isometry2::identity();
+        g.observe(&wall(700.0), &pose, 90.0, 0.0);
+        let i = g.geometry().cell_of(Point2::new(710.0, 0.0)).unwrap();
+        assert_eq!(g.state(i), CellState::Suspect, "seen from 700 mm");
+        let counts = g.counts();
+        assert!(counts[2] > 0 && counts[3] == 0, "{counts:?}");
+        // The robot drives up to 300 mm of it and sees it there: confirmed.
+        let near = Isometry2::new(Vector2::new(400.0, 0.0), 0.0);
+        g.observe(&wall(300.0), &near, 90.0, 0.04);
+        assert_eq!(g.state(i), CellState::Blocked, "seen from 300 mm");
+        // Seen free again from near, it clears; marked again from afar, only suspect.
+        for k in 1..=8 {
+            g.observe(&seen(32, |_| 1000.0), &near, 90.0, 0.04 + 0.04 * k as f64);
+        }
+        assert_eq!(g.state(i), CellState::Free);
+        for k in 0..4 {
+            g.observe(&wall(700.0), &pose, 90.0, 0.5 + 0.04 * k as f64);
+        }
+        assert_eq!(g.state(i), CellState::Suspect);
+    }
+
+    #[test]
     fn seen_again_free_an_obstacle_that_moved_is_cleared_and_unseen_evidence_fades() {
         let mut g = grid();
         let wall = seen(64, |a| {
             if a.cos() > 0.9 {
-                500.0 / a.cos()
+                400.0 / a.cos()
             } else {
                 1000.0
             }
@@ -442,7 +507,7 @@ mod tests {
         let open = seen(64, |_| 1000.0);
         let pose = Isometry2::identity();
         g.observe(&wall, &pose, 90.0, 0.0);
-        let i = g.geometry().cell_of(Point2::new(510.0, 0.0)).unwrap();
+        let i = g.geometry().cell_of(Point2::new(410.0, 0.0)).unwrap();
         assert_eq!(g.state(i), CellState::Blocked);
         for k in 1..=5 {
             g.observe(&open, &pose, 90.0, 0.04 * k as f64);

@@ -21,15 +21,24 @@
 //!   `PENALTY_RADIUS_MM` of the lookahead point by `PENALTY`, which fades like the grid's
 //!   evidence, and replans: a place where the robot keeps failing becomes dearer than
 //!   another way round.
-//! - Unreachable: while no route through free or unknown cells reaches the goal, the
+//! - Unreachable: while no route through free, unknown or suspect cells reaches the goal, the
 //!   controller heads straight for it (it still keeps every command inside the surely free
 //!   space), so that the robot looks nearer, where the map is finer; when no route has been
 //!   found for `UNREACHABLE_S` in a row, the goal is reported unreachable and the robot stops
-//!   and stays stopped (until it is given another target).
+//!   and stays stopped (until it is given another target). The robot drives through suspect
+//!   cells (seen occupied only from afar) to look at them from nearer, but they count as
+//!   evidence too: each replan also prices the map as it would be if every far mark were
+//!   right (suspect cells blocked and spread by half a sector); a count of seconds goes up
+//!   while on that map the goal lies in a closed pocket (under `POCKET_MM2`, the robot outside
+//!   it and within `POCKET_SIGHT_MM` of the goal) and down, as fast, while it does not, and the goal is reported unreachable when the
+//!   count reaches `UNREACHABLE_SUSPECT_S`: a ring of cubes round the goal seen from outside
+//!   closes such a pocket, though its far side was never seen from near, while a barrier
+//!   across the field closed only by far marks does not (one gap closed in error there would
+//!   end a run that a look from nearer would have saved).
 
 use super::config::PlannerConfig;
 use super::grid::{GridGeometry, MAX_CELLS, MapSnapshot, OccupancyGrid};
-use super::planner::{CostMap, CostSettings, length};
+use super::planner::{CostMap, CostSettings, Suspects, length};
 use crate::RobotError;
 use crate::config::RobotConfig;
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -45,6 +54,16 @@ const PENALTY: f32 = 4.0;
 const PENALTY_RADIUS_MM: f64 = 200.0;
 /// No route for this long in a row: the goal is unreachable, s.
 const UNREACHABLE_S: f64 = 2.0;
+/// The map with every far mark taken as right has held the goal in a closed pocket for this
+/// long (net of the time it did not): the goal is unreachable, s.
+const UNREACHABLE_SUSPECT_S: f64 = 4.0;
+/// The largest pocket round the goal that marks from afar may close, mm^2 (half a metre
+/// square: a goal ringed by obstacles; far marks are not trusted to cut the field in two,
+/// where one gap closed in error would end the run).
+const POCKET_MM2: f64 = 0.25e6;
+/// The pocket counts only while the robot is this near the goal: near enough that the marks
+/// closing it were seen from under a sector's width of error, mm.
+const POCKET_SIGHT_MM: f64 = 700.0;
 /// The least fraction of the top speed a turn is taken at.
 const MIN_TURN_SPEED: f64 = 0.2;
 /// A vertex turning the plan by more than this is a bend to slow for, rad.
@@ -71,8 +90,8 @@ pub struct NavigationReport {
     pub watchdog: usize,
     /// Whether the goal was found unreachable (the robot stopped).
     pub unreachable: bool,
-    /// Cells free, unknown and blocked.
-    pub cells: [usize; 3],
+    /// Cells free, unknown, suspect and blocked.
+    pub cells: [usize; 4],
 }
 
 /// Progress of the robot, for the watchdog.
@@ -138,6 +157,10 @@ pub struct Navigator {
     target: Option<Point2<f64>>,
     watchdog: Option<Watchdog>,
     failing_since_s: Option<f64>,
+    /// Seconds without a route on the map with every far mark taken as right, net of those
+    /// with one, and when that was last counted.
+    closed_s: f64,
+    closed_t_s: Option<f64>,
     report: NavigationReport,
 }
 
@@ -168,6 +191,8 @@ impl Navigator {
             target: None,
             watchdog: None,
             failing_since_s: None,
+            closed_s: 0.0,
+            closed_t_s: None,
             report: NavigationReport::default(),
             config: planner,
         })
@@ -204,6 +229,8 @@ impl Navigator {
             self.target = Some(target);
             self.plan = None;
             self.failing_since_s = None;
+            self.closed_s = 0.0;
+            self.closed_t_s = None;
             self.watchdog = Some(Watchdog::new(here, t_s));
             self.report.unreachable = false;
         }
@@ -258,7 +285,13 @@ impl Navigator {
     /// `UNREACHABLE_S` of that, marks the goal unreachable).
     fn replan(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
         self.fade_penalty(t_s);
-        let costs = CostMap::new(&self.grid, &self.costs, &self.penalty, here);
+        let costs = CostMap::new(
+            &self.grid,
+            &self.costs,
+            &self.penalty,
+            here,
+            Suspects::Costly,
+        );
         let found = costs.plan(here, target, self.accept_mm);
         self.report.replans += 1;
         let Some((cells, _)) = found else {
@@ -271,6 +304,12 @@ impl Navigator {
             return false;
         };
         self.failing_since_s = None;
+        if self.closed_on_far_marks(here, target, t_s) {
+            self.report.unreachable = true;
+            self.plan = None;
+            self.cost_map = Some(costs);
+            return false;
+        }
         let path = costs.taut(here, &cells, target);
         let new_len = length(&path);
         if let (Some(w), Some(old)) = (&mut self.watchdog, self.report.remaining_mm)
@@ -286,6 +325,22 @@ impl Navigator {
         });
         self.cost_map = Some(costs);
         true
+    }
+
+    /// Counts the time the map with every far mark taken as right has no route from `here` to
+    /// `target`; whether that reached `UNREACHABLE_SUSPECT_S`.
+    fn closed_on_far_marks(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
+        let dt = self.closed_t_s.map_or(0.0, |t0| t_s - t0);
+        self.closed_t_s = Some(t_s);
+        let suspects = self.report.cells[2] > 0;
+        let pocket = (POCKET_MM2 / (self.grid.geometry().cell_mm.powi(2))) as usize;
+        let closed =
+            suspects
+                && (target - here).norm() <= POCKET_SIGHT_MM
+                && CostMap::new(&self.grid, &self.costs, &[], here, Suspects::Blocked)
+                    .goal_in_pocket(here, target, self.accept_mm, pocket);
+        self.closed_s = (self.closed_s + if closed { dt } else { -dt }).max(0.0);
+        closed && self.closed_s >= UNREACHABLE_SUSPECT_S - 1e-9
     }
 
     /// The controller's goal vector for the robot at `here`, moving at `course` (world frame),

@@ -4,10 +4,12 @@
 //! The cost of a step between neighbouring cells (8-connected) is its length times the mean of
 //! the two cells' factors; a cell's factor is
 //!
-//! `f = 1 + u [cell unknown] + w (1 - (d - r_i) / c)^2 [d < r_i + c] + p`
+//! `f = 1 + u [cell unknown] + w (1 - (d - r_i) / c)^2 [d < r_i + c] + s [d_s < r_i] + p`
 //!
 //! with `d` the distance from the cell's centre to the nearest blocked cell's centre (the
-//! exact Euclidean distance transform of Felzenszwalb and Huttenlocher, by `imageproc`), `r_i`
+//! exact Euclidean distance transform of Felzenszwalb and Huttenlocher, by `imageproc`), `d_s`
+//! the same to the nearest suspect cell (seen occupied only from afar, see
+//! [`super::grid`]) and `s` its factor `SUSPECT_FACTOR`, `r_i`
 //! the robot's radius plus `inflation_mm` (nearer is impassable), `c` the comfort band
 //! `comfort_mm` in which paths pay `w` to keep off obstacles (the middle of a gap is cheapest),
 //! `u` the `unknown_cost` and `p` the watchdog's penalty on the cell. The heuristic is the
@@ -18,15 +20,33 @@
 
 use super::grid::{CellState, GridGeometry, OccupancyGrid};
 use imageproc::distance_transform::euclidean_squared_distance_transform;
+use imageproc::image::{GrayImage, ImageBuffer, Luma};
 use nalgebra::Point2;
 use pathfinding::prelude::astar;
 
 /// The factor of a cell the robot must cross to leave a too-near obstacle.
 const ESCAPE_FACTOR: f32 = 6.0;
+/// The factor `s` of a cell within `r_i` of a suspect one: crossing a suspect obstacle's
+/// inflated band (about 200 mm) costs as much as two metres of free floor, so the robot goes
+/// to look only where the way round is longer.
+const SUSPECT_FACTOR: f32 = 10.0;
+/// Half the width of a 32-direction sector at 600 mm: how far from its mark an obstacle seen
+/// from afar may stand, mm.
+const SUSPECT_SPREAD_MM: f32 = 60.0;
 /// Weight `w` of the comfort band.
 const COMFORT_WEIGHT: f32 = 3.0;
 /// Step costs are integers: this many units a millimetre.
 const UNITS_PER_MM: f64 = 8.0;
+
+/// What the planner makes of a suspect cell (seen occupied only from afar).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Suspects {
+    /// Passable at the factor `SUSPECT_FACTOR` within `r_i` of it: the way the robot drives.
+    Costly,
+    /// Blocked like a confirmed cell, and spread by `SUSPECT_SPREAD_MM`: the map as it would
+    /// be if every far mark stood for an obstacle anywhere within half a sector of it.
+    Blocked,
+}
 
 /// How the planner weighs the map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,24 +67,27 @@ pub struct CostMap {
 }
 
 impl CostMap {
-    /// Prices `grid` for a robot at `robot` (world mm), adding `penalty` (one value a cell).
+    /// Prices `grid` for a robot at `robot` (world mm), adding `penalty` (one value a cell),
+    /// with its suspect cells taken as `suspects` says.
     pub fn new(
         grid: &OccupancyGrid,
         settings: &CostSettings,
         penalty: &[f32],
         robot: Point2<f64>,
+        suspects: Suspects,
     ) -> Self {
         let g = *grid.geometry();
-        let mut blocked = imageproc::image::GrayImage::new(g.width as u32, g.height as u32);
-        for (i, px) in blocked.pixels_mut().enumerate() {
-            if grid.state(i) == CellState::Blocked {
-                px.0[0] = 255;
-            }
-        }
-        let d2 = euclidean_squared_distance_transform(&blocked);
-        let any_blocked = blocked.pixels().any(|p| p.0[0] > 0);
         let cell2 = (g.cell_mm * g.cell_mm) as f32;
         let ri = settings.inflated_mm as f32;
+        let (d2, any_blocked) = distances_to(grid, CellState::Blocked);
+        let (s2, any_suspect) = distances_to(grid, CellState::Suspect);
+        let suspect_mm = |i: usize| {
+            if any_suspect {
+                (s2.as_raw()[i] as f32 * cell2).sqrt()
+            } else {
+                f32::INFINITY
+            }
+        };
         let comfort = settings.comfort_mm.max(1e-6) as f32;
         let escape2 =
             ((settings.inflated_mm + g.cell_mm) * (settings.inflated_mm + g.cell_mm)) as f32;
@@ -72,14 +95,20 @@ impl CostMap {
             .pixels()
             .enumerate()
             .map(|(i, px)| {
-                let d = if any_blocked {
+                let mut d = if any_blocked {
                     (px.0[0] as f32 * cell2).sqrt()
                 } else {
                     f32::INFINITY
                 };
+                if suspects == Suspects::Blocked {
+                    d = d.min((suspect_mm(i) - SUSPECT_SPREAD_MM).max(0.0));
+                }
                 let mut f = 1.0 + penalty.get(i).copied().unwrap_or(0.0);
                 if grid.state(i) == CellState::Unknown {
                     f += settings.unknown_cost as f32;
+                }
+                if suspects == Suspects::Costly && suspect_mm(i) < ri {
+                    f += SUSPECT_FACTOR;
                 }
                 if d < ri {
                     let near_robot = (g.centre(i) - robot).norm_squared() as f32 <= escape2;
@@ -121,6 +150,52 @@ impl CostMap {
             self.factor_at(a + (b - a) * (k as f64 / n as f64))
                 .is_some()
         })
+    }
+
+    /// Whether the goal `to` lies in a closed pocket of fewer than `limit` passable cells (the
+    /// cells within `accept_mm` of it and every cell connected to them, 8-connected) that does
+    /// not hold `from`: false when the pocket is larger, holds `from`, or no cell near the goal
+    /// is passable (nothing to say then).
+    pub fn goal_in_pocket(
+        &self,
+        from: Point2<f64>,
+        to: Point2<f64>,
+        accept_mm: f64,
+        limit: usize,
+    ) -> bool {
+        let g = self.geometry;
+        let accept = accept_mm.max(0.5 * g.cell_mm);
+        let r = nalgebra::Vector2::repeat(accept);
+        let (Some(lo), Some(hi)) = (g.coords_of(to - r), g.coords_of(to + r)) else {
+            return false;
+        };
+        let mut seen = std::collections::HashSet::new();
+        let mut queue: std::collections::VecDeque<usize> = (lo.1..=hi.1)
+            .flat_map(|y| (lo.0..=hi.0).map(move |x| y * g.width + x))
+            .filter(|&i| self.factor[i].is_some() && (g.centre(i) - to).norm() <= accept)
+            .collect();
+        if queue.is_empty() {
+            return false;
+        }
+        seen.extend(queue.iter().copied());
+        let robot = g.cell_of(from);
+        while let Some(i) = queue.pop_front() {
+            if Some(i) == robot || seen.len() >= limit {
+                return false;
+            }
+            let (x, y) = ((i % g.width) as i64, (i / g.width) as i64);
+            for (dx, dy) in NEIGHBOURS {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= g.width as i64 || ny >= g.height as i64 {
+                    continue;
+                }
+                let j = (ny * g.width as i64 + nx) as usize;
+                if self.factor[j].is_some() && seen.insert(j) {
+                    queue.push_back(j);
+                }
+            }
+        }
+        true
     }
 
     /// The cheapest path from `from` to within `accept_mm` of `to`: cell centres from the
@@ -201,6 +276,24 @@ impl CostMap {
     }
 }
 
+/// The squared distance, in cells, from every cell to the nearest cell in `state` (row-major,
+/// from the lower-left cell), and whether there is any.
+fn distances_to(
+    grid: &OccupancyGrid,
+    state: CellState,
+) -> (ImageBuffer<Luma<f64>, Vec<f64>>, bool) {
+    let g = grid.geometry();
+    let mut marked = GrayImage::new(g.width as u32, g.height as u32);
+    let mut any = false;
+    for (i, px) in marked.pixels_mut().enumerate() {
+        if grid.state(i) == state {
+            px.0[0] = 255;
+            any = true;
+        }
+    }
+    (euclidean_squared_distance_transform(&marked), any)
+}
+
 /// The 8 neighbours of a cell.
 const NEIGHBOURS: [(i64, i64); 8] = [
     (1, 0),
@@ -223,6 +316,7 @@ mod tests {
     use super::*;
     use crate::config::{MapSegment, WorldMap};
     use crate::navigation::config::PlannerConfig;
+    use nalgebra::Vector2;
 
     fn settings() -> CostSettings {
         CostSettings {
@@ -256,7 +350,13 @@ mod tests {
     fn goes_round_a_wall_and_keeps_its_inflated_distance() {
         // A wall across x = 0 from y = -1500 to y = 600: the way is round its end.
         let grid = walled(&[([0.0, -1500.0], [0.0, 600.0])]);
-        let costs = CostMap::new(&grid, &settings(), &[], Point2::new(-800.0, 0.0));
+        let costs = CostMap::new(
+            &grid,
+            &settings(),
+            &[],
+            Point2::new(-800.0, 0.0),
+            Suspects::Costly,
+        );
         let from = Point2::new(-800.0, 0.0);
         let to = Point2::new(800.0, 0.0);
         let (cells, cost) = costs
@@ -286,10 +386,70 @@ mod tests {
         for (gap, open) in [(180.0, false), (260.0, true)] {
             let h = gap / 2.0 + 10.0;
             let grid = walled(&[([0.0, -1500.0], [0.0, -h]), ([0.0, h], [0.0, 1500.0])]);
-            let costs = CostMap::new(&grid, &settings(), &[], Point2::new(-800.0, 0.0));
+            let costs = CostMap::new(
+                &grid,
+                &settings(),
+                &[],
+                Point2::new(-800.0, 0.0),
+                Suspects::Costly,
+            );
             let found = costs.plan(Point2::new(-800.0, 0.0), Point2::new(800.0, 0.0), 50.0);
             assert_eq!(found.is_some(), open, "gap {gap} mm");
         }
+    }
+
+    /// A grid free of walls with cells marked occupied along the segment `a`-`b`.
+    fn marked(a: [f64; 2], b: [f64; 2], confirmed: bool) -> OccupancyGrid {
+        let mut grid = walled(&[]);
+        let (a, b) = (Point2::new(a[0], a[1]), Point2::new(b[0], b[1]));
+        for k in 0..=200 {
+            grid.mark_occupied(a + (b - a) * (k as f64 / 200.0), confirmed);
+        }
+        grid
+    }
+
+    #[test]
+    fn a_wall_seen_only_from_afar_is_crossed_at_a_cost_and_blocks_on_the_strict_map() {
+        // A line of suspect cells across x = 0 from y = -1500 to 1500.
+        let grid = marked([0.0, -1500.0], [0.0, 1500.0], false);
+        let from = Point2::new(-800.0, 0.0);
+        let to = Point2::new(800.0, 0.0);
+        let costly = CostMap::new(&grid, &settings(), &[], from, Suspects::Costly);
+        let (_, cost) = costly
+            .plan(from, to, 50.0)
+            .expect("through the suspect wall");
+        assert!(
+            cost > 1600.0 + 1000.0,
+            "crossing the suspect band costs: {cost}"
+        );
+        let strict = CostMap::new(&grid, &settings(), &[], from, Suspects::Blocked);
+        assert!(strict.plan(from, to, 50.0).is_none());
+        // Seen from near, the same wall blocks the robot's own map.
+        let grid = marked([0.0, -1500.0], [0.0, 1500.0], true);
+        let costs = CostMap::new(&grid, &settings(), &[], from, Suspects::Costly);
+        assert!(costs.plan(from, to, 50.0).is_none());
+    }
+
+    #[test]
+    fn a_goal_ringed_by_marks_is_in_a_pocket_and_one_behind_a_long_barrier_is_not() {
+        let to = Point2::new(600.0, 0.0);
+        let from = Point2::new(-800.0, 0.0);
+        let mut grid = walled(&[]);
+        for k in 0..360 {
+            let a = (k as f64).to_radians();
+            grid.mark_occupied(to + Vector2::new(a.cos(), a.sin()) * 300.0, false);
+        }
+        let strict = CostMap::new(&grid, &settings(), &[], from, Suspects::Blocked);
+        assert!(strict.goal_in_pocket(from, to, 50.0, 2500));
+        assert!(
+            !strict.goal_in_pocket(to + Vector2::new(50.0, 0.0), to, 50.0, 2500),
+            "the robot inside the ring"
+        );
+        // A barrier across the whole grid: no route, but the goal's side is no pocket.
+        let grid = marked([0.0, -1500.0], [0.0, 1500.0], false);
+        let strict = CostMap::new(&grid, &settings(), &[], from, Suspects::Blocked);
+        assert!(strict.plan(from, to, 50.0).is_none());
+        assert!(!strict.goal_in_pocket(from, to, 50.0, 2500));
     }
 
     #[test]
@@ -306,8 +466,9 @@ mod tests {
             },
             &[],
             robot,
+            Suspects::Costly,
         );
-        let dear = CostMap::new(&grid, &settings(), &[], robot);
+        let dear = CostMap::new(&grid, &settings(), &[], robot, Suspects::Costly);
         let to = Point2::new(400.0, 0.0);
         let (_, c0) = cheap.plan(robot, to, 20.0).unwrap();
         let (_, c1) = dear.plan(robot, to, 20.0).unwrap();
