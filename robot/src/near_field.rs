@@ -196,10 +196,10 @@ mod tests {
         let out = m.update(&seen(150.0), &odo, 3.0);
         assert!((ahead(&out.clear) - 150.0).abs() < 1e-9);
         assert!(out.blind.is_empty());
-        // ...and forgotten once it is old and the robot has driven on: back and forth along
-        // the wall, its memory of the wall ahead is gone.
-        let along = Isometry2::new(Vector2::new(150.0, 200.0), 0.0);
-        m.update(&seen(150.0), &along, 3.5);
+        // ...and forgotten once it is old and the robot has driven on: 200 mm away, where it
+        // sees nothing near, and back, its memory of the wall ahead is gone.
+        let away = Isometry2::new(Vector2::new(150.0, 200.0), 0.0);
+        m.update(&seen(5000.0), &away, 3.5);
         let out = m.update(&seen(150.0), &odo, 4.0);
         assert!((ahead(&out.blind) - 90.0).abs() < 1e-9);
     }
