@@ -334,11 +334,19 @@ impl Navigator {
         self.closed_t_s = Some(t_s);
         let suspects = self.report.cells[2] > 0;
         let pocket = (POCKET_MM2 / (self.grid.geometry().cell_mm.powi(2))) as usize;
-        let closed =
-            suspects
-                && (target - here).norm() <= POCKET_SIGHT_MM
-                && CostMap::new(&self.grid, &self.costs, &[], here, Suspects::Blocked)
-                    .goal_in_pocket(here, target, self.accept_mm, pocket);
+        // Whether the robot's body fits, without the planner's inflation (a comfort margin).
+        let body = CostSettings {
+            inflated_mm: self.radius_mm,
+            ..self.costs
+        };
+        let closed = suspects
+            && (target - here).norm() <= POCKET_SIGHT_MM
+            && CostMap::new(&self.grid, &body, &[], here, Suspects::Blocked).goal_in_pocket(
+                here,
+                target,
+                self.accept_mm,
+                pocket,
+            );
         self.closed_s = (self.closed_s + if closed { dt } else { -dt }).max(0.0);
         closed && self.closed_s >= UNREACHABLE_SUSPECT_S - 1e-9
     }
