@@ -49,13 +49,7 @@ fn an_enclosed_goal_is_reported_unreachable_within_ten_seconds_and_the_robot_sta
 
 #[test]
 fn the_goal_behind_a_cul_de_sac_facing_the_start_is_reached_without_contact() {
-    let out = run_scenario(
-        &scenario("trap_cul_de_sac.toml"),
-        &cpu(),
-        |_| {},
-        |_, _| {},
-    )
-    .unwrap();
+    let out = run_scenario(&scenario("trap_cul_de_sac.toml"), &cpu(), |_| {}, |_, _| {}).unwrap();
     let s = &out.summary;
     assert!(s.reached_goal, "{s:?}");
     assert_eq!(s.wall_contacts, 0, "{s:?}");
