@@ -378,7 +378,7 @@ impl OccupancyGrid {
     /// Marks the cell holding `p` occupied, as a sighting from near (`confirmed`) or from afar
     /// would: for the planner's tests.
     #[cfg(test)]
-    pub(super) fn mark_occupied(&mut self, p: Point2<f64>, confirmed: bool) {
+    pub(crate) fn mark_occupied(&mut self, p: Point2<f64>, confirmed: bool) {
         if let Some(i) = self.geometry.cell_of(p) {
             self.log_odds[i] = L_MAX;
             self.confirmed[i] = confirmed;
