@@ -20,7 +20,7 @@
 
 use super::grid::{CellState, GridGeometry, OccupancyGrid};
 use imageproc::distance_transform::euclidean_squared_distance_transform;
-use imageproc::image::{GrayImage, ImageBuffer, Luma};
+use imageproc::image::GrayImage;
 use nalgebra::Point2;
 use pathfinding::prelude::astar;
 
@@ -77,37 +77,24 @@ impl CostMap {
         suspects: Suspects,
     ) -> Self {
         let g = *grid.geometry();
-        let cell2 = (g.cell_mm * g.cell_mm) as f32;
         let ri = settings.inflated_mm as f32;
-        let (d2, any_blocked) = distances_to(grid, CellState::Blocked);
-        let (s2, any_suspect) = distances_to(grid, CellState::Suspect);
-        let suspect_mm = |i: usize| {
-            if any_suspect {
-                (s2.as_raw()[i] as f32 * cell2).sqrt()
-            } else {
-                f32::INFINITY
-            }
-        };
+        let blocked = distances_mm(grid, CellState::Blocked);
+        let suspect = distances_mm(grid, CellState::Suspect);
+        let at = |v: &Option<Vec<f32>>, i: usize| v.as_ref().map_or(f32::INFINITY, |v| v[i]);
         let comfort = settings.comfort_mm.max(1e-6) as f32;
         let escape2 =
             ((settings.inflated_mm + g.cell_mm) * (settings.inflated_mm + g.cell_mm)) as f32;
-        let factor = d2
-            .pixels()
-            .enumerate()
-            .map(|(i, px)| {
-                let mut d = if any_blocked {
-                    (px.0[0] as f32 * cell2).sqrt()
-                } else {
-                    f32::INFINITY
-                };
+        let factor = (0..g.len())
+            .map(|i| {
+                let mut d = at(&blocked, i);
                 if suspects == Suspects::Blocked {
-                    d = d.min((suspect_mm(i) - SUSPECT_SPREAD_MM).max(0.0));
+                    d = d.min((at(&suspect, i) - SUSPECT_SPREAD_MM).max(0.0));
                 }
                 let mut f = 1.0 + penalty.get(i).copied().unwrap_or(0.0);
                 if grid.state(i) == CellState::Unknown {
                     f += settings.unknown_cost as f32;
                 }
-                if suspects == Suspects::Costly && suspect_mm(i) < ri {
+                if suspects == Suspects::Costly && at(&suspect, i) < ri {
                     f += SUSPECT_FACTOR;
                 }
                 if d < ri {
@@ -276,12 +263,9 @@ impl CostMap {
     }
 }
 
-/// The squared distance, in cells, from every cell to the nearest cell in `state` (row-major,
-/// from the lower-left cell), and whether there is any.
-fn distances_to(
-    grid: &OccupancyGrid,
-    state: CellState,
-) -> (ImageBuffer<Luma<f64>, Vec<f64>>, bool) {
+/// The distance from every cell's centre to the nearest centre of a cell in `state` (mm,
+/// row-major from the lower-left cell); `None` when no cell is in `state` (no transform then).
+fn distances_mm(grid: &OccupancyGrid, state: CellState) -> Option<Vec<f32>> {
     let g = grid.geometry();
     let mut marked = GrayImage::new(g.width as u32, g.height as u32);
     let mut any = false;
@@ -291,7 +275,14 @@ fn distances_to(
             any = true;
         }
     }
-    (euclidean_squared_distance_transform(&marked), any)
+    let cell2 = (g.cell_mm * g.cell_mm) as f32;
+    any.then(|| {
+        euclidean_squared_distance_transform(&marked)
+            .as_raw()
+            .iter()
+            .map(|&d2| (d2 as f32 * cell2).sqrt())
+            .collect()
+    })
 }
 
 /// The 8 neighbours of a cell.
@@ -326,6 +317,11 @@ mod tests {
         }
     }
 
+    /// `grid` priced the way the robot drives, for a robot at `robot`.
+    fn costly(grid: &OccupancyGrid, robot: Point2<f64>) -> CostMap {
+        CostMap::new(grid, &settings(), &[], robot, Suspects::Costly)
+    }
+
     fn walled(walls: &[([f64; 2], [f64; 2])]) -> OccupancyGrid {
         let map = WorldMap {
             bounds: walls
@@ -350,13 +346,7 @@ mod tests {
     fn goes_round_a_wall_and_keeps_its_inflated_distance() {
         // A wall across x = 0 from y = -1500 to y = 600: the way is round its end.
         let grid = walled(&[([0.0, -1500.0], [0.0, 600.0])]);
-        let costs = CostMap::new(
-            &grid,
-            &settings(),
-            &[],
-            Point2::new(-800.0, 0.0),
-            Suspects::Costly,
-        );
+        let costs = costly(&grid, Point2::new(-800.0, 0.0));
         let from = Point2::new(-800.0, 0.0);
         let to = Point2::new(800.0, 0.0);
         let (cells, cost) = costs
@@ -386,13 +376,7 @@ mod tests {
         for (gap, open) in [(180.0, false), (260.0, true)] {
             let h = gap / 2.0 + 10.0;
             let grid = walled(&[([0.0, -1500.0], [0.0, -h]), ([0.0, h], [0.0, 1500.0])]);
-            let costs = CostMap::new(
-                &grid,
-                &settings(),
-                &[],
-                Point2::new(-800.0, 0.0),
-                Suspects::Costly,
-            );
+            let costs = costly(&grid, Point2::new(-800.0, 0.0));
             let found = costs.plan(Point2::new(-800.0, 0.0), Point2::new(800.0, 0.0), 50.0);
             assert_eq!(found.is_some(), open, "gap {gap} mm");
         }
@@ -414,8 +398,7 @@ mod tests {
         let grid = marked([0.0, -1500.0], [0.0, 1500.0], false);
         let from = Point2::new(-800.0, 0.0);
         let to = Point2::new(800.0, 0.0);
-        let costly = CostMap::new(&grid, &settings(), &[], from, Suspects::Costly);
-        let (_, cost) = costly
+        let (_, cost) = costly(&grid, from)
             .plan(from, to, 50.0)
             .expect("through the suspect wall");
         assert!(
@@ -426,7 +409,7 @@ mod tests {
         assert!(strict.plan(from, to, 50.0).is_none());
         // Seen from near, the same wall blocks the robot's own map.
         let grid = marked([0.0, -1500.0], [0.0, 1500.0], true);
-        let costs = CostMap::new(&grid, &settings(), &[], from, Suspects::Costly);
+        let costs = costly(&grid, from);
         assert!(costs.plan(from, to, 50.0).is_none());
     }
 
@@ -468,7 +451,7 @@ mod tests {
             robot,
             Suspects::Costly,
         );
-        let dear = CostMap::new(&grid, &settings(), &[], robot, Suspects::Costly);
+        let dear = costly(&grid, robot);
         let to = Point2::new(400.0, 0.0);
         let (_, c0) = cheap.plan(robot, to, 20.0).unwrap();
         let (_, c1) = dear.plan(robot, to, 20.0).unwrap();
