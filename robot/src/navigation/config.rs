@@ -8,11 +8,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PlannerKind {
-    /// A* on the occupancy grid the robot builds.
-    Grid,
-    /// None: the controller heads straight for the target (the papers' set-up; the default
-    /// until the grid planner meets its navigation benchmark, see docs/navigation.md).
+    /// A* on the occupancy grid the robot builds (the default).
     #[default]
+    Grid,
+    /// None: the controller heads straight for the target (the papers' set-up: E1's scenario
+    /// files say so).
     None,
 }
 
@@ -42,12 +42,23 @@ pub struct PlannerConfig {
     pub forget_s: f64,
     /// Seed the grid with the walls, goals and pillars of the map the robot is given.
     pub seed_map: bool,
+    /// No route through free, unknown or suspect cells for this long in a row: the goal is
+    /// reported unreachable, s.
+    pub unreachable_s: f64,
+    /// The map with every far mark taken as right has held the goal in a closed pocket for
+    /// this long (net of the time it did not): the goal is reported unreachable, s.
+    pub pocket_unreachable_s: f64,
+    /// The largest pocket round the goal that marks from afar may close, mm^2 (a goal ringed
+    /// by obstacles; far marks are not trusted to cut the field in two).
+    pub pocket_area_mm2: f64,
+    /// The pocket counts only while the robot is this near the goal, mm.
+    pub pocket_sight_mm: f64,
 }
 
 impl Default for PlannerConfig {
     fn default() -> Self {
         Self {
-            kind: PlannerKind::None,
+            kind: PlannerKind::Grid,
             cell_mm: 20.0,
             inflation_mm: 30.0,
             comfort_mm: 150.0,
@@ -58,6 +69,10 @@ impl Default for PlannerConfig {
             progress_mm: 200.0,
             forget_s: 20.0,
             seed_map: true,
+            unreachable_s: 2.0,
+            pocket_unreachable_s: 4.0,
+            pocket_area_mm2: 0.25e6,
+            pocket_sight_mm: 700.0,
         }
     }
 }
@@ -83,5 +98,9 @@ pub fn check_planner(spec: &ControlSpec) -> Vec<ConfigProblem> {
             p.positive("watchdog_s", c.watchdog_s);
             p.positive("progress_mm", c.progress_mm);
             p.positive("forget_s", c.forget_s);
+            p.positive("unreachable_s", c.unreachable_s);
+            p.positive("pocket_unreachable_s", c.pocket_unreachable_s);
+            p.non_negative("pocket_area_mm2", c.pocket_area_mm2);
+            p.non_negative("pocket_sight_mm", c.pocket_sight_mm);
         })
 }

@@ -24,14 +24,14 @@
 //! - Unreachable: while no route through free, unknown or suspect cells reaches the goal, the
 //!   controller heads straight for it (it still keeps every command inside the surely free
 //!   space), so that the robot looks nearer, where the map is finer; when no route has been
-//!   found for `UNREACHABLE_S` in a row, the goal is reported unreachable and the robot stops
+//!   found for `unreachable_s` in a row, the goal is reported unreachable and the robot stops
 //!   and stays stopped (until it is given another target). The robot drives through suspect
 //!   cells (seen occupied only from afar) to look at them from nearer, but they count as
 //!   evidence too: each replan also prices the map as it would be if every far mark were
 //!   right (suspect cells blocked and spread by half a sector); a count of seconds goes up
-//!   while on that map the goal lies in a closed pocket (under `POCKET_MM2`, the robot outside
-//!   it and within `POCKET_SIGHT_MM` of the goal) and down, as fast, while it does not, and the goal is reported unreachable when the
-//!   count reaches `UNREACHABLE_SUSPECT_S`: a ring of cubes round the goal seen from outside
+//!   while on that map the goal lies in a closed pocket (under `pocket_area_mm2`, the robot outside
+//!   it and within `pocket_sight_mm` of the goal) and down, as fast, while it does not, and the goal is reported unreachable when the
+//!   count reaches `pocket_unreachable_s`: a ring of cubes round the goal seen from outside
 //!   closes such a pocket, though its far side was never seen from near, while a barrier
 //!   across the field closed only by far marks does not (one gap closed in error there would
 //!   end a run that a look from nearer would have saved).
@@ -52,18 +52,6 @@ const REBASE_MM: f64 = 500.0;
 const PENALTY: f32 = 4.0;
 /// The watchdog's penalty: the radius of the region made dearer, mm.
 const PENALTY_RADIUS_MM: f64 = 200.0;
-/// No route for this long in a row: the goal is unreachable, s.
-const UNREACHABLE_S: f64 = 2.0;
-/// The map with every far mark taken as right has held the goal in a closed pocket for this
-/// long (net of the time it did not): the goal is unreachable, s.
-const UNREACHABLE_SUSPECT_S: f64 = 4.0;
-/// The largest pocket round the goal that marks from afar may close, mm^2 (half a metre
-/// square: a goal ringed by obstacles; far marks are not trusted to cut the field in two,
-/// where one gap closed in error would end the run).
-const POCKET_MM2: f64 = 0.25e6;
-/// The pocket counts only while the robot is this near the goal: near enough that the marks
-/// closing it were seen from under a sector's width of error, mm.
-const POCKET_SIGHT_MM: f64 = 700.0;
 /// The least fraction of the top speed a turn is taken at.
 const MIN_TURN_SPEED: f64 = 0.2;
 /// A vertex turning the plan by more than this is a bend to slow for, rad.
@@ -282,7 +270,7 @@ impl Navigator {
     }
 
     /// Plans from `here` to `target`; false when no route exists (and, after
-    /// `UNREACHABLE_S` of that, marks the goal unreachable).
+    /// `unreachable_s` of that, marks the goal unreachable).
     fn replan(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
         self.fade_penalty(t_s);
         let costs = CostMap::new(
@@ -296,7 +284,7 @@ impl Navigator {
         self.report.replans += 1;
         let Some((cells, _)) = found else {
             let since = *self.failing_since_s.get_or_insert(t_s);
-            if t_s - since >= UNREACHABLE_S - 1e-9 {
+            if t_s - since >= self.config.unreachable_s - 1e-9 {
                 self.report.unreachable = true;
             }
             self.plan = None;
@@ -328,19 +316,20 @@ impl Navigator {
     }
 
     /// Counts the time the map with every far mark taken as right has no route from `here` to
-    /// `target`; whether that reached `UNREACHABLE_SUSPECT_S`.
+    /// `target`; whether that reached `pocket_unreachable_s`.
     fn closed_on_far_marks(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
         let dt = self.closed_t_s.map_or(0.0, |t0| t_s - t0);
         self.closed_t_s = Some(t_s);
         let suspects = self.report.cells[2] > 0;
-        let pocket = (POCKET_MM2 / (self.grid.geometry().cell_mm.powi(2))) as usize;
+        let pocket =
+            (self.config.pocket_area_mm2 / (self.grid.geometry().cell_mm.powi(2))) as usize;
         // Whether the robot's body fits, without the planner's inflation (a comfort margin).
         let body = CostSettings {
             inflated_mm: self.radius_mm,
             ..self.costs
         };
         let closed = suspects
-            && (target - here).norm() <= POCKET_SIGHT_MM
+            && (target - here).norm() <= self.config.pocket_sight_mm
             && CostMap::new(&self.grid, &body, &[], here, Suspects::Blocked).goal_in_pocket(
                 here,
                 target,
@@ -348,7 +337,7 @@ impl Navigator {
                 pocket,
             );
         self.closed_s = (self.closed_s + if closed { dt } else { -dt }).max(0.0);
-        closed && self.closed_s >= UNREACHABLE_SUSPECT_S - 1e-9
+        closed && self.closed_s >= self.config.pocket_unreachable_s - 1e-9
     }
 
     /// The controller's goal vector for the robot at `here`, moving at `course` (world frame),
