@@ -85,14 +85,16 @@ fn a_goal_in_a_field_corner_behind_a_cube_is_reached_without_contact() {
         count(Free),
         count(Blocked)
     );
-    // Each cycle records the plan: a path ending at the goal.
+    // Each cycle records the plan: a path ending within the goal's 100 mm tolerance (the goal,
+    // 112 mm from the touchline, lies inside the walls' inflated band, so the plan ends on the
+    // nearest passable cell that counts as there).
     let plan = out.estimates[10]
         .navigation
         .as_ref()
         .expect("a plan record");
     let end = plan.path_mm.last().unwrap();
     assert!(
-        (end.x - 1250.0).abs() < 1.0 && (end.y - 650.0).abs() < 1.0,
+        (end - nalgebra::Point2::new(1250.0, 650.0)).norm() <= 100.0,
         "{end:?}"
     );
 }

@@ -21,7 +21,7 @@ pub use differential::DifferentialDrive;
 pub use drive::{AccelLimitedDrive, VelocityCommand};
 pub use go_to_goal::GoToGoal;
 pub use odometry::DeadReckoning;
-pub use velocity_aware::VelocityAware;
+pub use velocity_aware::{GoalKind, VelocityAware};
 
 /// A 2-D vector in millimetres (positions) or millimetres per second (velocities).
 pub type Vec2 = nalgebra::Vector2<f64>;

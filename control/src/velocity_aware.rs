@@ -12,8 +12,9 @@
 //!   template's outer edge is unknown, not free, and a cell eq. (6) judges free may still be
 //!   partly occupied, so the robot never commits to a speed whose stopping distance exceeds what
 //!   it has seen to be free; an obstacle already within the clearance need only get no nearer,
-//!   and a blind point (something at an unknown distance inside the body's blind zone) may be
-//!   passed at a slant of up to 30 degrees, never headed into.
+//!   and a blind point (something at an unknown distance inside the body's blind zone, placed
+//!   at the body's edge) may be passed at a slant of up to 30 degrees, never headed into: the
+//!   path keeps `r cos 30°` from it, or, nearer than that already, gets no nearer.
 //!   And the next decision comes one control period later, so the path that holds `v_b`
 //!   for that period and then brakes must be clear too: whatever the next cycle sees, braking
 //!   stays safe. In each direction the fastest admissible of `speeds` speeds is found (by
@@ -32,6 +33,28 @@ use crate::avoidance::{
 use crate::{AccelLimitedDrive, ControlError, Vec2, require_positive};
 use std::f64::consts::TAU;
 
+/// How chosen speeds score a heading (`delta` its angle to the goal, `gamma` to the course).
+#[derive(Debug, Clone, Copy)]
+enum Score {
+    /// `v cos(delta)`: the signed speed made good.
+    MadeGood,
+    /// `v (1 + cos(delta)) / 2`.
+    Toward,
+    /// `v ((1 + cos(delta)) / 2 + COURSE_WEIGHT (1 + cos(gamma)) / 2)`, the present course.
+    Course(f64),
+}
+
+/// What the controller knows of the way to the goal handed to it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GoalKind {
+    /// The target, or a point on the way to it, the way not known to be clear (the papers'
+    /// set-up: the goal may lie behind a wall).
+    Ahead,
+    /// The target itself, in sight over cells the robot's map has free (a planner's last
+    /// leg): the robot is to stop on it.
+    InSight,
+}
+
 /// Chooses among commands whose eq. (8) paths stay clear of the obstacles.
 #[derive(Debug, Clone)]
 pub struct VelocityAware {
@@ -48,8 +71,9 @@ const COURSE_WEIGHT: f64 = 0.5;
 /// Below this speed the robot has no course to keep.
 const COURSE_MIN_SPEED_MM_S: f64 = 50.0;
 /// Chosen speeds: a path may pass a blind point (something at an unknown distance, placed at
-/// the body's edge) at this slant from it, radians: it keeps `cos` of the point's distance.
-/// Held to "no nearer" (a right angle), a robot that starts in a corner, its blind zone
+/// the body's edge) at this slant from it, radians: it keeps `cos` of the body's radius from
+/// it, and a blind point already nearer than that (one remembered where it was first placed,
+/// which the robot came nearer to) need only get no nearer. Held to "no nearer" (a right angle), a robot that starts in a corner, its blind zone
 /// holding walls in more than half of the directions, could not move at all; at this slant
 /// it leaves along the free arc's middle, and moving toward a wall stays forbidden (the
 /// nearer the wall, the wider the blocked arc).
@@ -193,15 +217,29 @@ impl VelocityAware {
 
     /// The command for a robot moving at `v_now` (robot frame) with the goal at `goal`.
     pub fn decide(&self, s: &Surroundings<'_>, goal: Vec2, v_now: Vec2) -> Decision {
+        self.decide_toward(s, goal, GoalKind::Ahead, v_now)
+    }
+
+    /// The command for a robot moving at `v_now` (robot frame) sent toward `goal`, the target
+    /// itself or a point on the way to it (a planner's lookahead point, whose distance is the
+    /// way left, shortened before bends), knowing `kind` of the way there.
+    pub fn decide_toward(
+        &self,
+        s: &Surroundings<'_>,
+        goal: Vec2,
+        kind: GoalKind,
+        v_now: Vec2,
+    ) -> Decision {
         let d_goal = goal.norm();
         if d_goal < 1e-6 {
             return STOP;
         }
         let goal_rad = goal.y.atan2(goal.x);
         let speed = approach_speed(self.max_speed_mm_s, &self.drive, d_goal);
+        let arriving = kind == GoalKind::InSight && speed < self.max_speed_mm_s;
         match self.config.speed {
             SpeedChoice::Fixed => self.decide_fixed(s, goal_rad, speed, v_now),
-            SpeedChoice::Chosen => self.decide_chosen(s, goal_rad, speed, v_now),
+            SpeedChoice::Chosen => self.decide_chosen(s, goal_rad, speed, arriving, v_now),
         }
     }
 
@@ -234,6 +272,7 @@ impl VelocityAware {
         s: &Surroundings<'_>,
         goal_rad: f64,
         speed: f64,
+        arriving: bool,
         v_now: Vec2,
     ) -> Decision {
         // An obstacle already nearer than the clearance (the robot was pushed, or vision put it
@@ -242,30 +281,75 @@ impl VelocityAware {
         let clearance = self.radius_mm + self.config.margin_mm;
         let points = [s.clear_points];
         let mut near = self.reachable(&points, v_now, speed, clearance, true);
-        let keep = BLIND_SLANT_RAD.cos();
+        // A blind point at the body's edge may be passed at a slant; one already nearer than
+        // that allows (a remembered one the robot came nearer to) need only get no nearer.
+        let slant = self.radius_mm * BLIND_SLANT_RAD.cos();
         near.extend(s.blind_points.iter().map(|&p| Obstacle {
             p,
-            c2: (clearance * clearance).min(p.norm_squared() * keep * keep),
+            c2: (clearance * clearance).min(p.norm_squared().min(slant * slant)),
         }));
+        // Arriving (within braking distance of a target in sight, where the approach speed
+        // caps the speed) and moving away from it, the score is the signed speed made good,
+        // `v cos(delta)`: a robot that overshot the target brakes and comes back rather than
+        // keep its course away at speed, round and round it, when turning back at once would
+        // swing it too near something. Only at rest may it move away from the target (to go
+        // round what stands in its way), scored as below. (Not where the target may lie
+        // behind a wall: the way there may lead away from it.)
+        let receding = v_now.norm() > COURSE_MIN_SPEED_MM_S
+            && v_now.dot(&Vec2::new(goal_rad.cos(), goal_rad.sin())) < 0.0;
+        if arriving && receding {
+            if let Some(d) = self.best_heading(&near, goal_rad, speed, v_now, Score::MadeGood) {
+                return d;
+            }
+            if v_now.norm() > COURSE_MIN_SPEED_MM_S {
+                return STOP;
+            }
+        }
         // Moving, the robot keeps to its course unless another serves the goal clearly better,
         // so that it follows a wall round to a goal behind it instead of dithering where the
         // goal direction is blocked and both ways along the wall look alike.
-        let course = (v_now.norm() > COURSE_MIN_SPEED_MM_S).then(|| v_now.y.atan2(v_now.x));
+        let score = match v_now.norm() > COURSE_MIN_SPEED_MM_S {
+            true => Score::Course(v_now.y.atan2(v_now.x)),
+            false => Score::Toward,
+        };
+        self.best_heading(&near, goal_rad, speed, v_now, score)
+            .unwrap_or(STOP)
+    }
+
+    /// The admissible heading and speed with the best score, headings nearest the goal first.
+    fn best_heading(
+        &self,
+        near: &[Obstacle],
+        goal_rad: f64,
+        speed: f64,
+        v_now: Vec2,
+        score: Score,
+    ) -> Option<Decision> {
         let mut best: Option<(f64, Decision)> = None;
         for h in self.headings(goal_rad) {
-            let toward_goal = 0.5 * (1.0 + angle_diff(h, goal_rad).cos());
+            let cos = angle_diff(h, goal_rad).cos();
+            let (toward_goal, bonus) = match score {
+                Score::MadeGood => (cos, 0.0),
+                Score::Toward => (0.5 * (1.0 + cos), 0.0),
+                Score::Course(c) => (
+                    0.5 * (1.0 + cos),
+                    COURSE_WEIGHT * 0.5 * (1.0 + angle_diff(h, c).cos()),
+                ),
+            };
             let floor = best.map_or(0.0, |(score, _)| score);
             // Headings come nearest the goal first: none after this can do better.
-            let bound = toward_goal + course.map_or(0.0, |_| COURSE_WEIGHT);
+            let bound = toward_goal
+                + if let Score::Course(_) = score {
+                    COURSE_WEIGHT
+                } else {
+                    0.0
+                };
             if speed * bound <= floor {
                 break;
             }
-            let weight = toward_goal
-                + course.map_or(0.0, |c| {
-                    COURSE_WEIGHT * 0.5 * (1.0 + angle_diff(h, c).cos())
-                });
+            let weight = toward_goal + bonus;
             let u = Vec2::new(h.cos(), h.sin());
-            if let Some(v) = self.fastest(v_now, u, speed, floor / weight, &near) {
+            if let Some(v) = self.fastest(v_now, u, speed, floor / weight, near) {
                 best = Some((
                     v * weight,
                     Decision {
@@ -275,7 +359,7 @@ impl VelocityAware {
                 ));
             }
         }
-        best.map_or(STOP, |(_, d)| d)
+        best.map(|(_, d)| d)
     }
 
     /// The fastest admissible of the speeds `speed k / n` (k = n ... 1) along `u` that is faster
@@ -466,6 +550,35 @@ mod tests {
             let off = (v.dot(p) / (v.norm().max(1e-12) * p.norm())).acos();
             assert!(v.norm() < 1e-9 || off >= FRAC_PI_3 - 1e-9, "{v:?}");
         }
+    }
+
+    #[test]
+    fn a_blind_point_nearer_than_the_slant_allows_is_never_approached() {
+        // A blind point remembered where it was placed, the robot now 15 mm nearer to it than
+        // the body's edge (75 mm < 90 cos 30 = 78 mm), everything else clear, the goal beyond
+        // it at a slant of 40 degrees: placed afresh at the body's edge it would be passed at
+        // that slant, coming nearer every cycle; remembered, it gets no nearer.
+        let c = controller(SpeedChoice::Chosen, false, 400.0);
+        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
+        let free = vec![1000.0; 32];
+        let clear: Vec<Vec2> = dirs
+            .iter()
+            .map(|a| Vec2::new(a.cos(), a.sin()) * 1000.0)
+            .collect();
+        let p = Vec2::new(75.0, 0.0);
+        let s = Surroundings {
+            direction_rad: &dirs,
+            free_mm: &free,
+            range_mm: 1000.0,
+            obstacle_points: &[],
+            clear_points: &clear,
+            blind_points: &[p],
+        };
+        let slant = 40f64.to_radians();
+        let goal = Vec2::new(slant.cos(), slant.sin()) * 1000.0;
+        let v = c.decide(&s, goal, Vec2::zeros()).v_mm_s;
+        assert!(v.norm() > 1.0, "stood still");
+        assert!(v.dot(&p) <= 1e-9, "{v:?} approaches the blind point");
     }
 
     #[test]

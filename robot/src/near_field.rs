@@ -3,18 +3,25 @@
 //! The robot's own body hides the floor within the template's inner edge, so an obstacle nearer
 //! than that only shows as a blocked first ring: vision knows it is there, not how near. A robot
 //! that takes such an obstacle to be at the inner edge creeps into it a little every cycle. It
-//! saw the obstacle, though, while it approached: this memory keeps the surely-free boundary
-//! points of near obstacles in the odometry frame for a few seconds and, in a direction whose
-//! first ring is blocked, hands the controller the remembered points there (moved by the
-//! odometry since), or, when it remembers none, a blind point at the body's edge (something is
-//! there at a distance nobody knows: the robot may pass it at a slant or move away from it,
-//! never head into it).
+//! saw the obstacle, though, while it approached: this memory keeps, in the odometry frame,
+//! the surely-free boundary points of near obstacles and the floor seen surely free near the
+//! robot (each unblocked direction's sector from the template's inner edge to its clear
+//! distance, on a 10 mm grid). In a direction whose first ring is blocked it hands the
+//! controller the remembered points there (moved by the odometry since); where it remembers
+//! none, each of the direction's three rays ends where the floor remembered free along it
+//! ends, or, where the floor by the body was never seen free, on a blind point at the body's
+//! edge (something is there at a distance nobody knows: the robot may pass it at a slant or
+//! move away from it, never head into it).
 //!
-//! A point is forgotten once it is older than `KEEP_S` *and* the robot has travelled more than
-//! `KEEP_TRAVEL_MM` since it was last seen: odometry drifts with the way driven, not with the
-//! time, and a robot creeping past a cube's corner (at the slowest turning speed, 80 mm/s
-//! for a 400 mm/s robot) must not forget the corner half-way along and slide into it at a
-//! slant (a blind point allows that).
+//! Blind points are remembered too, where they were first placed: the slant at which the
+//! controller may pass one lets the robot come nearer to it once, by a few millimetres, not a
+//! few millimetres every cycle (placed afresh at the body's edge each cycle, they let a robot
+//! creep into a cube's corner at a slant, one cycle at a time).
+//!
+//! A point or a cell is forgotten once it is older than `KEEP_S` *and* the robot has travelled
+//! more than `KEEP_TRAVEL_MM` since it was last seen: odometry drifts with the way driven, not
+//! with the time, and a robot creeping past a cube's corner (at the slowest turning speed,
+//! 80 mm/s for a 400 mm/s robot) must not forget the corner half-way along and slide into it.
 
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_vision::FreeSpace;
@@ -44,6 +51,13 @@ pub struct NearSpace {
 pub struct NearField {
     /// Points in the odometry frame, with the time and the odometer when they were last seen.
     points: Vec<(Point2<f64>, f64, f64)>,
+    /// Blind points placed so far (odometry frame), kept and forgotten as `points`: a blind
+    /// point stays where it was first placed while the robot moves, so the slant at which the
+    /// controller may pass one lets the robot come nearer to it once, by a few millimetres,
+    /// not a few millimetres every cycle.
+    blind: Vec<(Point2<f64>, f64, f64)>,
+    /// The floor seen free near the robot.
+    floor: SeenFloor,
     radius_mm: f64,
     /// The way driven so far, mm, and where the robot was last cycle (odometry frame).
     odometer_mm: f64,
@@ -55,6 +69,8 @@ impl NearField {
     pub fn new(radius_mm: f64) -> Self {
         Self {
             points: Vec::new(),
+            blind: Vec::new(),
+            floor: SeenFloor::new(),
             radius_mm,
             odometer_mm: 0.0,
             last: None,
@@ -69,10 +85,18 @@ impl NearField {
         self.odometer_mm += self.last.map_or(0.0, |l| (here - l).norm());
         self.last = Some(here);
         let odometer = self.odometer_mm;
-        self.points.retain(|&(p, t, o)| {
+        let kept = |&(p, t, o): &(Point2<f64>, f64, f64)| {
             (t_s - t <= KEEP_S || odometer - o <= KEEP_TRAVEL_MM)
                 && (p - here).norm() <= 2.0 * NEAR_MM
-        });
+        };
+        self.points.retain(kept);
+        self.blind.retain(kept);
+        self.floor.odometer_mm = odometer;
+        self.floor.see(fs, odo, t_s);
+        // Until the robot has driven from its start past the template's inner edge, the floor
+        // by its body was never in view: blind points there are placed afresh each cycle,
+        // not remembered (remembered, phantoms at the body's edge would pin it to its start).
+        let settled = odometer >= fs.inner_mm - self.radius_mm;
         let n = fs.direction_rad.len();
         let half = 0.5 * TAU / n as f64;
         let mut out = NearSpace {
@@ -103,8 +127,28 @@ impl NearField {
             }
             if out.clear.len() == before {
                 for phi in [c - half, c, c + half] {
-                    out.blind
-                        .push(Vector2::new(phi.cos(), phi.sin()) * self.radius_mm);
+                    let u = Vector2::new(phi.cos(), phi.sin());
+                    // Floor seen free beside the body: the obstacle stands beyond it.
+                    let seen = self
+                        .floor
+                        .free_along(odo, u, self.radius_mm, fs.inner_mm, t_s);
+                    if seen > self.radius_mm {
+                        out.clear.push(u * seen);
+                        continue;
+                    }
+                    let at_edge = u * self.radius_mm;
+                    if settled {
+                        remember(&mut self.blind, odo * Point2::from(at_edge), t_s, odometer);
+                    } else {
+                        out.blind.push(at_edge);
+                    }
+                }
+                for (p, _, _) in &self.blind {
+                    let q = odo.inverse_transform_point(p).coords;
+                    let off = (q.y.atan2(q.x) - c + TAU / 2.0).rem_euclid(TAU) - TAU / 2.0;
+                    if off.abs() <= half {
+                        out.blind.push(q);
+                    }
                 }
             }
         }
@@ -124,6 +168,106 @@ impl NearField {
     }
 }
 
+/// Floor farther than this from the sensor axis is not remembered, mm.
+const FLOOR_MM: f64 = 350.0;
+/// Side of a cell of the remembered floor, mm.
+const CELL_MM: f64 = 10.0;
+/// Cells a side of the floor's grid. It wraps round (a cell lives at its indices modulo
+/// this), so it follows the robot: 1.28 m a side, more than the 0.7 m across what it keeps.
+const SIDE: i32 = 128;
+
+/// The floor vision found surely free near the robot (each unblocked direction's sector from
+/// the template's inner edge to its clear distance), on a fine grid in the odometry frame,
+/// kept and forgotten as the remembered points. A ray of a blocked direction that starts on
+/// such floor is not blind: its obstacle stands beyond the floor seen free.
+#[derive(Debug, Clone)]
+struct SeenFloor {
+    /// Per slot: the cell's indices (`None` for a slot never written), when it was last seen
+    /// free and the odometer then.
+    cells: Vec<(Option<[i32; 2]>, f64, f64)>,
+    odometer_mm: f64,
+}
+
+impl SeenFloor {
+    fn new() -> Self {
+        Self {
+            cells: vec![(None, 0.0, 0.0); (SIDE * SIDE) as usize],
+            odometer_mm: 0.0,
+        }
+    }
+
+    fn slot(cell: [i32; 2]) -> usize {
+        (cell[0].rem_euclid(SIDE) * SIDE + cell[1].rem_euclid(SIDE)) as usize
+    }
+
+    fn cell_of(p: Point2<f64>) -> [i32; 2] {
+        [
+            (p.x / CELL_MM).floor() as i32,
+            (p.y / CELL_MM).floor() as i32,
+        ]
+    }
+
+    /// Marks the cells whose centres lie in a sector seen surely free this cycle.
+    fn see(&mut self, fs: &FreeSpace, odo: &Isometry2<f64>, t_s: f64) {
+        let n = fs.direction_rad.len();
+        if n == 0 {
+            return;
+        }
+        let step = TAU / n as f64;
+        let axis = odo * fs.axis_mm;
+        let lo = Self::cell_of(axis - Vector2::repeat(FLOOR_MM));
+        let hi = Self::cell_of(axis + Vector2::repeat(FLOOR_MM));
+        for i in lo[0]..=hi[0] {
+            for k in lo[1]..=hi[1] {
+                let centre = Point2::new((i as f64 + 0.5) * CELL_MM, (k as f64 + 0.5) * CELL_MM);
+                let rel = odo.inverse_transform_point(&centre) - fs.axis_mm;
+                let r = rel.norm();
+                if r < fs.inner_mm || r > FLOOR_MM {
+                    continue;
+                }
+                let turns = (rel.y.atan2(rel.x) - fs.direction_rad[0]) / step;
+                let j = (turns.round() as i64).rem_euclid(n as i64) as usize;
+                if fs.a[j] > 0 && r <= fs.clear_mm[j] {
+                    self.cells[Self::slot([i, k])] = (Some([i, k]), t_s, self.odometer_mm);
+                }
+            }
+        }
+    }
+
+    fn is_free(&self, p: Point2<f64>, t_s: f64) -> bool {
+        let cell = Self::cell_of(p);
+        let (c, t, o) = self.cells[Self::slot(cell)];
+        c == Some(cell) && (t_s - t <= KEEP_S || self.odometer_mm - o <= KEEP_TRAVEL_MM)
+    }
+
+    /// How far along the ray `u` (robot frame, from the robot's centre) the floor is
+    /// remembered free without a break, from the body's edge `from_mm` out to `to_mm`; `from_mm`
+    /// when the floor by the body was not seen free.
+    fn free_along(
+        &self,
+        odo: &Isometry2<f64>,
+        u: Vector2<f64>,
+        from_mm: f64,
+        to_mm: f64,
+        t_s: f64,
+    ) -> f64 {
+        let mut d = from_mm;
+        while d + CELL_MM <= to_mm && self.is_free(odo * Point2::from(u * (d + CELL_MM)), t_s) {
+            d += CELL_MM;
+        }
+        d
+    }
+}
+
+/// Remembers a blind point at `p`, or, when one is remembered within `MERGE_MM`, refreshes that
+/// one where it is.
+fn remember(blind: &mut Vec<(Point2<f64>, f64, f64)>, p: Point2<f64>, t_s: f64, odometer: f64) {
+    match blind.iter_mut().find(|(q, _, _)| (q - p).norm() < MERGE_MM) {
+        Some(entry) => (entry.1, entry.2) = (t_s, odometer),
+        None => blind.push((p, t_s, odometer)),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,6 +281,7 @@ mod tests {
         let mut fs = FreeSpace {
             direction_rad: dirs.clone(),
             range_mm: 1000.0,
+            inner_mm: 200.0,
             ..FreeSpace::default()
         };
         for &c in &dirs {
@@ -196,11 +341,59 @@ mod tests {
         let out = m.update(&seen(150.0), &odo, 3.0);
         assert!((ahead(&out.clear) - 150.0).abs() < 1e-9);
         assert!(out.blind.is_empty());
-        // ...and forgotten once it is old and the robot has driven on: 200 mm away, where it
-        // sees nothing near, and back, its memory of the wall ahead is gone.
+        // ...and forgotten once it is old and the robot has driven on: 200 mm away, boxed in
+        // where it sees no floor, and back, its memory of the wall ahead is gone.
         let away = Isometry2::new(Vector2::new(150.0, 200.0), 0.0);
-        m.update(&seen(5000.0), &away, 3.5);
+        m.update(&boxed(), &away, 3.5);
         let out = m.update(&seen(150.0), &odo, 4.0);
         assert!((ahead(&out.blind) - 90.0).abs() < 1e-9);
+    }
+
+    /// Every direction's first ring blocked.
+    fn boxed() -> FreeSpace {
+        let mut fs = seen(150.0);
+        fs.a = vec![0; fs.a.len()];
+        fs
+    }
+
+    /// The nearest of `pts` on the ray straight ahead.
+    fn nearest_ahead(pts: &[Vector2<f64>]) -> f64 {
+        pts.iter()
+            .filter(|p| p.y.abs() < 1e-6 && p.x > 0.0)
+            .map(|p| p.x)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn a_blind_point_stays_where_it_was_first_placed() {
+        let at = |x: f64| Isometry2::new(Vector2::new(x, 0.0), 0.0);
+        let mut m = NearField::new(90.0);
+        // Near its start (driven less than the template's inner edge minus the radius,
+        // 110 mm), the floor by the body was never in view: blind points are placed afresh at
+        // the body's edge each cycle.
+        let out = m.update(&boxed(), &at(0.0), 0.0);
+        assert!((nearest_ahead(&out.blind) - 90.0).abs() < 1e-9);
+        let out = m.update(&boxed(), &at(10.0), 0.04);
+        assert!((nearest_ahead(&out.blind) - 90.0).abs() < 1e-9);
+        // Past that, one stays where it was placed: 10 mm on, the blind point ahead is 80 mm
+        // away, not at the body's edge again (the controller holds the robot off it there).
+        m.update(&boxed(), &at(120.0), 0.5);
+        let out = m.update(&boxed(), &at(130.0), 0.54);
+        assert!((nearest_ahead(&out.blind) - 80.0).abs() < 1e-9, "{out:?}");
+    }
+
+    #[test]
+    fn floor_seen_free_by_the_body_is_not_blind() {
+        // Open floor all round: nothing near to remember but the floor itself.
+        let mut m = NearField::new(90.0);
+        m.update(&seen(5000.0), &Isometry2::identity(), 0.0);
+        // 150 mm on, something blocks the first ring ahead: the floor from the body's edge
+        // to the template's inner edge was seen free on the way, so the rays ahead end at
+        // the inner edge, not on blind points at the body's edge.
+        let on = Isometry2::new(Vector2::new(150.0, 0.0), 0.0);
+        let out = m.update(&seen(150.0), &on, 0.4);
+        assert!(out.blind.is_empty(), "{out:?}");
+        let d = nearest_ahead(&out.clear);
+        assert!((190.0..=200.0).contains(&d), "{d}");
     }
 }

@@ -109,6 +109,9 @@ pub struct FreeSpace {
     /// How far the template reaches (its outer edge on the floor): a direction free
     /// throughout is free this far, and nothing is known beyond.
     pub range_mm: f64,
+    /// Where the template begins (its inner edge on the floor, from the sensor axis): the
+    /// camera sees no floor nearer than that.
+    pub inner_mm: f64,
     /// Per direction, how far the floor is free for certain: a cell judged free by eq. (6) may
     /// still be up to `1 - r_th` obstacle, so an obstacle (or, past the template, the unknown)
     /// may begin that deep inside the last free cell (computed with the obstacle filling the
@@ -434,6 +437,7 @@ impl FreeSpaceDetector {
             ratio,
             obstacle_points: Vec::new(),
             range_mm: self.template.edges_mm[i_n],
+            inner_mm: self.template.edges_mm[0],
             clear_mm: vec![0.0; j_n],
             clear_points: Vec::new(),
             front_mm: vec![self.template.edges_mm[i_n]; j_n],

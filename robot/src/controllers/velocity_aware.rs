@@ -12,7 +12,7 @@ use crate::navigation::{
     self, MapSnapshot, NavigationReport, Navigator, PlannerConfig, PlannerKind,
 };
 use crate::near_field::NearField;
-use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, SpeedChoice, VelocityAware};
+use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, GoalKind, SpeedChoice, VelocityAware};
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -69,11 +69,17 @@ impl Controller for VelocityAwareStack {
             (Some(near), Some(fs)) => Some(near.update(fs, &s.odometry_pose, s.t_s)),
             _ => None,
         };
-        let target_body_mm = match (&mut self.navigator, &s.pose, s.target_mm) {
+        let (target_body_mm, kind) = match (&mut self.navigator, &s.pose, s.target_mm) {
             (Some(nav), Some(pose), Some(target)) => {
-                nav.steer(s.freespace, pose, s.velocity_body_mm_s, target, s.t_s)
+                let to = nav.steer(s.freespace, pose, s.velocity_body_mm_s, target, s.t_s);
+                let kind = if nav.on_final_leg() {
+                    GoalKind::InSight
+                } else {
+                    GoalKind::Ahead
+                };
+                (to, kind)
             }
-            _ => s.target_body_mm,
+            _ => (s.target_body_mm, GoalKind::Ahead),
         };
         let s = Situation {
             target_body_mm,
@@ -81,7 +87,9 @@ impl Controller for VelocityAwareStack {
         };
         let v = s.velocity_body_mm_s;
         let c = &self.controller;
-        with_surroundings(&s, clear, |sur, target| c.decide(sur, target, v).v_mm_s)
+        with_surroundings(&s, clear, |sur, target| {
+            c.decide_toward(sur, target, kind, v).v_mm_s
+        })
     }
 
     fn navigation(&self) -> Option<&NavigationReport> {

@@ -60,7 +60,7 @@ impl Default for PlannerConfig {
         Self {
             kind: PlannerKind::Grid,
             cell_mm: 20.0,
-            inflation_mm: 30.0,
+            inflation_mm: 35.0,
             comfort_mm: 150.0,
             unknown_cost: 1.0,
             replan_period_s: 0.2,

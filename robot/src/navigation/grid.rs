@@ -25,7 +25,10 @@
 //!   into the floor beside an obstacle's edge, enough to close a 300 mm gap beside a cube.
 //!   The planner may cross a suspect cell at a cost, so the robot goes to look from nearer,
 //!   where a sighting either confirms the cell (blocked) or clears it (free); only confirmed
-//!   cells make a goal unreachable.
+//!   cells make a goal unreachable. For the same reason a confirmed cell is cleared only by
+//!   floor seen from nearer than `CONFIRM_MM`: a sector seen free from afar may hold the edge
+//!   of the cube beside it, and a gap closed from near and reopened from afar would send a
+//!   robot back and forth between two routes for the rest of its run.
 //!   An obstacle whose cell holds a wall of the map (anywhere across the sector, between
 //!   `free_mm[j]` and `front_mm[j] + depth`) is that wall (the map explains it) and is not
 //!   marked again: a wall seen obliquely through a long cell would otherwise be marked up to a
@@ -328,6 +331,11 @@ impl OccupancyGrid {
                     && !explained[j];
                 let lateral = d * (bearing - k * step).sin().abs();
                 if open && d <= fs.clear_mm[j] {
+                    // A cell confirmed blocked from near is cleared only from near: from
+                    // afar a sector seen free may hold the edge of a cube beside it.
+                    if d > CONFIRM_MM && grid.confirmed[i] {
+                        return;
+                    }
                     L_FREE
                 } else if obstacle
                     && lateral <= strip
@@ -492,6 +500,33 @@ mod tests {
             g.observe(&wall(700.0), &pose, 90.0, 0.5 + 0.04 * k as f64);
         }
         assert_eq!(g.state(i), CellState::Suspect);
+    }
+
+    #[test]
+    fn a_cell_confirmed_from_near_is_cleared_from_near_only() {
+        let wall = |x: f64| {
+            seen(32, move |a: f64| {
+                let c = a.cos();
+                if c > 0.6 { x / c } else { 1000.0 }
+            })
+        };
+        let mut g = grid();
+        let near = Isometry2::new(Vector2::new(400.0, 0.0), 0.0);
+        g.observe(&wall(300.0), &near, 90.0, 0.0);
+        let i = g.geometry().cell_of(Point2::new(710.0, 0.0)).unwrap();
+        assert_eq!(g.state(i), CellState::Blocked, "seen from 300 mm");
+        // Floor seen there from 700 mm away (a sector that may hold the cube's edge): it
+        // stays blocked...
+        let far = Isometry2::identity();
+        for k in 1..=8 {
+            g.observe(&seen(32, |_| 1000.0), &far, 90.0, 0.04 * k as f64);
+        }
+        assert_eq!(g.state(i), CellState::Blocked, "cleared from afar");
+        // ...and floor seen there from 300 mm clears it.
+        for k in 1..=8 {
+            g.observe(&seen(32, |_| 1000.0), &near, 90.0, 0.4 + 0.04 * k as f64);
+        }
+        assert_eq!(g.state(i), CellState::Free, "not cleared from near");
     }
 
     #[test]

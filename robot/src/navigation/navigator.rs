@@ -18,7 +18,9 @@
 //!   `progress_mm` of where it was), or for twice that long along the route (the remaining
 //!   path did not shorten by `progress_mm`; a new plan more than `REBASE_MM` longer, the world
 //!   turned out worse than hoped, starts the count again), raises the cost of the cells within
-//!   `PENALTY_RADIUS_MM` of the lookahead point by `PENALTY`, which fades like the grid's
+//!   `PENALTY_RADIUS_MM` of the point that far ahead on the plan (where the robot is held up;
+//!   not the lookahead point, which on the last leg is the goal, dear to every route alike) by
+//!   `PENALTY`, which fades like the grid's
 //!   evidence, and replans: a place where the robot keeps failing becomes dearer than
 //!   another way round.
 //! - Unreachable: while no route through free, unknown or suspect cells reaches the goal, the
@@ -149,6 +151,8 @@ pub struct Navigator {
     /// with one, and when that was last counted.
     closed_s: f64,
     closed_t_s: Option<f64>,
+    /// Whether the point the robot was last sent toward is the target itself.
+    final_leg: bool,
     report: NavigationReport,
 }
 
@@ -181,9 +185,16 @@ impl Navigator {
             failing_since_s: None,
             closed_s: 0.0,
             closed_t_s: None,
+            final_leg: true,
             report: NavigationReport::default(),
             config: planner,
         })
+    }
+
+    /// Whether the point the robot was last sent toward is the target itself (the plan's end
+    /// lies within the lookahead, or there is no plan), not a point on the way.
+    pub fn on_final_leg(&self) -> bool {
+        self.final_leg
     }
 
     /// What it did this cycle.
@@ -223,6 +234,7 @@ impl Navigator {
             self.report.unreachable = false;
         }
         self.report.cells = self.grid.counts();
+        self.final_leg = true;
         if self.report.unreachable {
             return self.stop();
         }
@@ -238,7 +250,15 @@ impl Navigator {
             .is_some_and(|w| w.stuck(here, remaining, t_s, &self.config));
         if fired {
             self.report.watchdog += 1;
-            let ahead = self.report.lookahead_mm.unwrap_or(here);
+            // The place just ahead on the plan, where the robot is held up (not the lookahead
+            // point, which on the last leg is the goal itself, dear to every route alike).
+            let ahead = self.plan.as_ref().map_or(here, |plan| {
+                let (_, s_near) = distance_to_path(&plan.path, here);
+                point_at(
+                    &plan.path,
+                    (s_near + PENALTY_RADIUS_MM).min(length(&plan.path)),
+                )
+            });
             self.penalise(ahead, t_s);
             self.plan = None;
         }
@@ -361,6 +381,7 @@ impl Navigator {
             point = point_at(path, s);
         }
         let remaining = (point - here).norm() + (total - s);
+        self.final_leg = s >= total;
         self.report.lookahead_mm = Some(point);
         self.report.remaining_mm = Some(remaining);
         let v = point - here;
