@@ -91,8 +91,11 @@ impl NearField {
         };
         self.points.retain(kept);
         self.blind.retain(kept);
-        self.floor.odometer_mm = odometer;
-        self.floor.see(fs, odo, t_s);
+        let now = Stamp {
+            t_s,
+            odometer_mm: odometer,
+        };
+        self.floor.see(fs, odo, now);
         // Until the robot has driven from its start past the template's inner edge, the floor
         // by its body was never in view: blind points there are placed afresh each cycle,
         // not remembered (remembered, phantoms at the body's edge would pin it to its start).
@@ -131,7 +134,7 @@ impl NearField {
                     // Floor seen free beside the body: the obstacle stands beyond it.
                     let seen = self
                         .floor
-                        .free_along(odo, u, self.radius_mm, fs.inner_mm, t_s);
+                        .free_along(odo, u, self.radius_mm, fs.inner_mm, now);
                     if seen > self.radius_mm {
                         out.clear.push(u * seen);
                         continue;
@@ -185,6 +188,12 @@ struct SeenFloor {
     /// Per slot: the cell's indices (`None` for a slot never written), when it was last seen
     /// free and the odometer then.
     cells: Vec<(Option<[i32; 2]>, f64, f64)>,
+}
+
+/// When something was seen: the time and the odometer then.
+#[derive(Debug, Clone, Copy)]
+struct Stamp {
+    t_s: f64,
     odometer_mm: f64,
 }
 
@@ -192,7 +201,6 @@ impl SeenFloor {
     fn new() -> Self {
         Self {
             cells: vec![(None, 0.0, 0.0); (SIDE * SIDE) as usize],
-            odometer_mm: 0.0,
         }
     }
 
@@ -208,7 +216,7 @@ impl SeenFloor {
     }
 
     /// Marks the cells whose centres lie in a sector seen surely free this cycle.
-    fn see(&mut self, fs: &FreeSpace, odo: &Isometry2<f64>, t_s: f64) {
+    fn see(&mut self, fs: &FreeSpace, odo: &Isometry2<f64>, now: Stamp) {
         let n = fs.direction_rad.len();
         if n == 0 {
             return;
@@ -228,16 +236,16 @@ impl SeenFloor {
                 let turns = (rel.y.atan2(rel.x) - fs.direction_rad[0]) / step;
                 let j = (turns.round() as i64).rem_euclid(n as i64) as usize;
                 if fs.a[j] > 0 && r <= fs.clear_mm[j] {
-                    self.cells[Self::slot([i, k])] = (Some([i, k]), t_s, self.odometer_mm);
+                    self.cells[Self::slot([i, k])] = (Some([i, k]), now.t_s, now.odometer_mm);
                 }
             }
         }
     }
 
-    fn is_free(&self, p: Point2<f64>, t_s: f64) -> bool {
+    fn is_free(&self, p: Point2<f64>, now: Stamp) -> bool {
         let cell = Self::cell_of(p);
         let (c, t, o) = self.cells[Self::slot(cell)];
-        c == Some(cell) && (t_s - t <= KEEP_S || self.odometer_mm - o <= KEEP_TRAVEL_MM)
+        c == Some(cell) && (now.t_s - t <= KEEP_S || now.odometer_mm - o <= KEEP_TRAVEL_MM)
     }
 
     /// How far along the ray `u` (robot frame, from the robot's centre) the floor is
@@ -249,10 +257,10 @@ impl SeenFloor {
         u: Vector2<f64>,
         from_mm: f64,
         to_mm: f64,
-        t_s: f64,
+        now: Stamp,
     ) -> f64 {
         let mut d = from_mm;
-        while d + CELL_MM <= to_mm && self.is_free(odo * Point2::from(u * (d + CELL_MM)), t_s) {
+        while d + CELL_MM <= to_mm && self.is_free(odo * Point2::from(u * (d + CELL_MM)), now) {
             d += CELL_MM;
         }
         d

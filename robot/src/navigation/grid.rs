@@ -474,12 +474,6 @@ mod tests {
     #[test]
     fn an_obstacle_seen_only_from_afar_is_suspect_and_seen_from_near_blocked() {
         // A wall across the robot's front, seen from 700 mm, then from 300 mm.
-        let wall = |x: f64| {
-            seen(32, move |a: f64| {
-                let c = a.cos();
-                if c > 0.6 { x / c } else { 1000.0 }
-            })
-        };
         let mut g = grid();
         let pose = Isometry2::identity();
         g.observe(&wall(700.0), &pose, 90.0, 0.0);
@@ -502,14 +496,16 @@ mod tests {
         assert_eq!(g.state(i), CellState::Suspect);
     }
 
+    /// A wall across the robot's front, `x` mm ahead, seen in 32 directions.
+    fn wall(x: f64) -> FreeSpace {
+        seen(32, move |a: f64| {
+            let c = a.cos();
+            if c > 0.6 { x / c } else { 1000.0 }
+        })
+    }
+
     #[test]
     fn a_cell_confirmed_from_near_is_cleared_from_near_only() {
-        let wall = |x: f64| {
-            seen(32, move |a: f64| {
-                let c = a.cos();
-                if c > 0.6 { x / c } else { 1000.0 }
-            })
-        };
         let mut g = grid();
         let near = Isometry2::new(Vector2::new(400.0, 0.0), 0.0);
         g.observe(&wall(300.0), &near, 90.0, 0.0);
