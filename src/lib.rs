@@ -20,8 +20,8 @@ pub mod run;
 pub mod scenario;
 pub mod sweep;
 
-pub use experiments::{Runner, load_scenario, parse_scenario, run_scenario};
-pub use run::{RunOptions, RunOutput, Simulation, Summary, TrajectoryRow};
+pub use experiments::{Runner, Session, load_scenario, parse_scenario, run_scenario};
+pub use run::{RunOptions, RunOutput, Simulation, Summary, TrajectoryRow, Truth};
 pub use scenario::{LoadError, Problem, Scenario};
 
 /// Motion models and the avoidance controllers.

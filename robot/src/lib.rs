@@ -26,6 +26,7 @@ pub mod mission;
 pub mod navigation;
 pub mod near_field;
 pub mod perception;
+pub mod remote;
 pub mod robot;
 pub mod tables;
 
@@ -48,6 +49,7 @@ pub use mission::Mission;
 pub use navigation::{CellState, GridGeometry, MapSnapshot, NavigationReport, PlannerConfig};
 pub use perception::forward::ForwardVisionConfig;
 pub use perception::{STAGES, StageEntry};
+pub use remote::{Mailbox, Remote, RemoteHandle};
 pub use robot::{Robot, stages_of};
 pub use tables::{ConfigProblem, Tables};
 

@@ -11,7 +11,7 @@ use serde::de::DeserializeOwned;
 pub type Metrics = serde_json::Map<String, serde_json::Value>;
 
 /// What an experiment does with the simulation, and what it measures.
-pub trait Experiment {
+pub trait Experiment: Send {
     /// Carries out the procedure, calling `progress(cycle, total)` as it goes. The default
     /// drives: control cycles until the goal is reached or the time is up.
     fn run(
@@ -20,6 +20,13 @@ pub trait Experiment {
         progress: &mut dyn FnMut(u64, u64),
     ) -> Result<(), RunError> {
         drive(sim, progress)
+    }
+
+    /// Whether its procedure is the drive (cycles until the goal or the time is up), so that a
+    /// run of it may be stepped from outside ([`crate::experiments::Session`]); an experiment
+    /// that moves the robot itself or takes its own frames says no.
+    fn drives(&self) -> bool {
+        true
     }
 
     /// The experiment's own metrics of a finished run.

@@ -235,6 +235,10 @@ impl Probe<'_> {
 }
 
 impl Experiment for Heading {
+    fn drives(&self) -> bool {
+        false
+    }
+
     /// Stores the reference at the checkpoint, then reads the turns, the sweep and the
     /// translations, each frame with fresh sensor noise.
     fn run(

@@ -334,6 +334,10 @@ fn score(
 }
 
 impl Experiment for LocalizationMap {
+    fn drives(&self) -> bool {
+        false
+    }
+
     /// Carries the robot to every grid point and heading; at each, one frame, localized in
     /// global mode and, from a prior `prior_error_mm` and `prior_error_deg` off, in tracking
     /// mode.

@@ -181,6 +181,10 @@ pub struct PlacesMethod {
 }
 
 impl Experiment for Places {
+    fn drives(&self) -> bool {
+        false
+    }
+
     /// Carries the robot to each place and has it localize itself there `frames_per_place`
     /// times, each time from nothing: it is told it was moved and nothing else (no prior).
     fn run(

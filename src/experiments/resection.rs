@@ -172,6 +172,10 @@ impl Resection {
 }
 
 impl Experiment for Resection {
+    fn drives(&self) -> bool {
+        false
+    }
+
     fn run(
         &mut self,
         sim: &mut Simulation,

@@ -5,4 +5,4 @@ pub mod charts;
 pub mod output;
 pub mod topview;
 
-pub use output::{default_out_dir, write_run};
+pub use output::{default_out_dir, run_topview_image, write_run};

@@ -1,7 +1,7 @@
 //! Writing a run's results: `summary.json`, `trajectory.csv`, `estimates.jsonl` and
 //! `topview.png`.
 
-use super::topview::{Marker, Panel, PathLayer, draw_panels};
+use super::topview::{FigureError, Marker, Panel, PathLayer, render_panels};
 use crate::run::RunOutput;
 use crate::run::record::{write_estimates_jsonl, write_trajectory_csv};
 use crate::scenario::Scenario;
@@ -42,6 +42,19 @@ pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Re
 
 /// The top view of one run: world, true path, estimated path, other robots, start and goal.
 pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
+    let name = file.display().to_string();
+    run_topview_image(&name, scenario, out, 1000)?
+        .save(file)
+        .with_context(|| format!("writing {name}"))
+}
+
+/// [`draw_run_topview`] into an image `width` pixels wide (`name` names it in errors).
+pub fn run_topview_image(
+    name: &str,
+    scenario: &Scenario,
+    out: &RunOutput,
+    width: u32,
+) -> Result<image::RgbImage, FigureError> {
     let truth: Vec<Point2<f64>> = out
         .trajectory
         .iter()
@@ -131,6 +144,5 @@ pub fn draw_run_topview(file: &Path, scenario: &Scenario, out: &RunOutput) -> an
         spots: Vec::new(),
         grid: out.map.as_ref(),
     };
-    draw_panels(file, &[panel], 1000)?;
-    Ok(())
+    render_panels(name, &[panel], width)
 }

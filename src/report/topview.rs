@@ -437,8 +437,8 @@ pub(crate) fn png_bytes(name: &str, img: &image::RgbImage) -> Result<Vec<u8>, Fi
     Ok(bytes)
 }
 
-/// Draws panels side by side into an image.
-fn render_panels(
+/// Draws panels side by side into an image (`name` names the figure in errors).
+pub fn render_panels(
     name: &str,
     panels: &[Panel<'_>],
     width: u32,

@@ -29,6 +29,16 @@ pub enum RunError {
     /// The scenario's experiment section does not parse (a scenario not checked first).
     #[error("scenario: {0}")]
     Scenario(String),
+    /// A run that is over was stepped again.
+    #[error(
+        "the run of {scenario:?} is over after {cycles} cycles (time up or goal reached); reset it to run again"
+    )]
+    Finished {
+        /// The scenario's name.
+        scenario: String,
+        /// The cycles it ran.
+        cycles: u64,
+    },
     /// A frame could not be written.
     #[error("writing frame {path}: {source}")]
     Frame {

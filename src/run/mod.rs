@@ -15,5 +15,5 @@ pub mod simulation;
 pub use error::RunError;
 pub use record::{Summary, TrajectoryRow};
 pub use simulation::{
-    OutputFile, RunOptions, RunOutput, Simulation, builtin_software, render_snapshot,
+    OutputFile, RunOptions, RunOutput, Simulation, Truth, builtin_software, render_snapshot,
 };

@@ -326,16 +326,31 @@ struct MotionRecord {
     inliers: usize,
 }
 
-/// Writes one JSON line a control cycle: time, true pose, the robot's pose estimate, the
-/// target it headed for, its fixes with their outcomes, the stages that found nothing (with
-/// why), its free distances, and (omnistereo) the landmarks it ranged and the motion it read.
+/// Writes one JSON line a control cycle ([`estimates_line`]).
 pub fn write_estimates_jsonl(
     rows: &[TrajectoryRow],
     estimates: &[Estimates],
     mut w: impl Write,
 ) -> std::io::Result<()> {
     for (r, e) in rows.iter().zip(estimates) {
-        let line = EstimateLine {
+        serde_json::to_writer(&mut w, &EstimateLine::of(r, e))?;
+        writeln!(w)?;
+    }
+    Ok(())
+}
+
+/// One line of `estimates.jsonl` (without its newline): time, true pose, the robot's pose
+/// estimate, the target it headed for, its fixes with their outcomes, the stages that found
+/// nothing (with why), its free distances, and (omnistereo) the landmarks it ranged and the
+/// motion it read, and (with a planner) its plan.
+pub fn estimates_line(row: &TrajectoryRow, e: &Estimates) -> String {
+    // Serializing plain records of numbers, strings and options cannot fail.
+    serde_json::to_string(&EstimateLine::of(row, e)).unwrap_or_default()
+}
+
+impl<'a> EstimateLine<'a> {
+    fn of(r: &TrajectoryRow, e: &'a Estimates) -> Self {
+        EstimateLine {
             t_s: e.t_s,
             truth: PoseRecord {
                 x_mm: r.x_mm,
@@ -367,11 +382,8 @@ pub fn write_estimates_jsonl(
                 inliers: m.inliers,
             }),
             plan: e.navigation.as_ref().map(PlanRecord::of),
-        };
-        serde_json::to_writer(&mut w, &line)?;
-        writeln!(w)?;
+        }
     }
-    Ok(())
 }
 
 #[cfg(test)]

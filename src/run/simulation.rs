@@ -14,7 +14,8 @@ use crate::scenario::{PilotChoice, Scenario};
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
 use omniloop_robot::{
-    Estimates, FixOutcome, Observation, Robot, RobotConfig, RobotError, RobotSoftware,
+    ActuatorState, Estimates, FixOutcome, Frame, Observation, OdometryReading, Robot, RobotConfig,
+    RobotError, RobotSoftware,
 };
 use omniloop_sim::render::BatchHandle;
 use omniloop_sim::{Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
@@ -113,6 +114,7 @@ pub struct Simulation {
     estimates: Vec<Estimates>,
     other_paths: Vec<Vec<Point2<f64>>>,
     options: RunOptions,
+    last_odometry: Option<OdometryReading>,
 }
 
 impl Simulation {
@@ -188,6 +190,7 @@ impl Simulation {
             trajectory: Vec::new(),
             estimates: Vec::new(),
             options: options.clone(),
+            last_odometry: None,
         })
     }
 
@@ -209,6 +212,16 @@ impl Simulation {
     /// Control cycles run so far.
     pub fn cycle(&self) -> u64 {
         self.cycle
+    }
+
+    /// The trajectory recorded so far, a row a cycle (and the final state once recorded).
+    pub fn trajectory(&self) -> &[TrajectoryRow] {
+        &self.trajectory
+    }
+
+    /// What the robot believed, a record a cycle so far.
+    pub fn estimates(&self) -> &[Estimates] {
+        &self.estimates
     }
 
     /// What the robot believed in the last cycle.
@@ -253,36 +266,70 @@ impl Simulation {
         self.world.place_robot(0, pose);
     }
 
-    /// One control cycle: the cameras see, the robot's software decides, the commands are
-    /// applied and recorded, the world advances one period, the wheels report.
+    /// One control cycle: the cameras see ([`Simulation::sense`]), then the robot's software
+    /// decides and the world moves on ([`Simulation::act`]).
     pub fn step(&mut self) -> Result<(), RunError> {
-        let t = self.world.time_s();
-        let out = match &mut self.cameras {
-            Some(c) => {
-                // Saving frames renders every camera; otherwise those the robot reads now.
-                let wanted = self.robot.cameras_now();
-                let saving = self.options.save_frames_every.is_some();
-                c.capture_some(&self.world, (!saving).then_some(wanted.as_slice()))?;
-                if let (Some(every), Some(dir)) =
-                    (self.options.save_frames_every, &self.options.frames_dir)
-                    && every > 0
-                    && self.cycle.is_multiple_of(every)
-                {
-                    c.save(dir, self.cycle)?;
-                }
-                let (frames, actuators) = (c.frames(t), c.actuator_state());
-                self.robot.cycle(&Observation {
-                    t_s: t,
-                    frames: &frames,
-                    actuators: &actuators,
-                })?
-            }
-            None => self.robot.cycle(&Observation {
-                t_s: t,
-                frames: &[],
-                actuators: &[],
-            })?,
+        self.sense()?;
+        self.act()
+    }
+
+    /// The first half of a control cycle: renders the cameras the robot's software reads now
+    /// (every camera when frames are saved) as the world is at the cycle's start, and saves
+    /// them when asked. [`Simulation::frames`] gives them until the next sense.
+    pub fn sense(&mut self) -> Result<(), RunError> {
+        let Some(c) = &mut self.cameras else {
+            return Ok(());
         };
+        let wanted = self.robot.cameras_now();
+        let saving = self.options.save_frames_every.is_some();
+        c.capture_some(&self.world, (!saving).then_some(wanted.as_slice()))?;
+        if let (Some(every), Some(dir)) = (self.options.save_frames_every, &self.options.frames_dir)
+            && every > 0
+            && self.cycle.is_multiple_of(every)
+        {
+            c.save(dir, self.cycle)?;
+        }
+        Ok(())
+    }
+
+    /// The frames of the last [`Simulation::sense`], stamped with the time now (none without
+    /// cameras).
+    pub fn frames(&self) -> Vec<Frame<'_>> {
+        let t = self.world.time_s();
+        self.cameras
+            .as_ref()
+            .map(|c| c.frames(t))
+            .unwrap_or_default()
+    }
+
+    /// The wheel odometry's reading at the end of the last cycle, as the robot's software got
+    /// it (none before the first cycle).
+    pub fn last_odometry(&self) -> Option<OdometryReading> {
+        self.last_odometry
+    }
+
+    /// The state of the robot's actuators (its pan units) now.
+    pub fn actuator_state(&self) -> Vec<ActuatorState> {
+        self.cameras
+            .as_ref()
+            .map(|c| c.actuator_state())
+            .unwrap_or_default()
+    }
+
+    /// The second half of a control cycle: the robot's software decides on the frames of the
+    /// last [`Simulation::sense`], its commands are applied and recorded, the world advances
+    /// one period, the wheels report.
+    pub fn act(&mut self) -> Result<(), RunError> {
+        let t = self.world.time_s();
+        let cameras = self.cameras.as_ref();
+        let frames = cameras.map(|c| c.frames(t)).unwrap_or_default();
+        let actuators = cameras.map(|c| c.actuator_state()).unwrap_or_default();
+        let out = self.robot.cycle(&Observation {
+            t_s: t,
+            frames: &frames,
+            actuators: &actuators,
+        })?;
+        drop(frames);
         let state = self.world.robot_state(0);
         let (command, heading_for) = match &mut self.pilot {
             Some(p) => (
@@ -315,7 +362,9 @@ impl Simulation {
         }
         self.cycle += 1;
         let after = self.world.robot_state(0);
-        self.robot.odometry(&self.odometry.read(&after, dt));
+        let reading = self.odometry.read(&after, dt);
+        self.robot.odometry(&reading);
+        self.last_odometry = Some(reading);
         let p = Point2::from(after.pose.translation.vector);
         self.truth.targets(p, heading_for, self.world.time_s());
         Ok(())
@@ -382,20 +431,69 @@ impl Simulation {
         }
     }
 
+    /// The truth now: the robot's true pose and velocity, its contacts so far and whether
+    /// it has reached the goal (the simulator's side, for scoring and recording only).
+    pub fn truth(&self) -> Truth {
+        let s = self.world.robot_state(0);
+        Truth {
+            t_s: self.world.time_s(),
+            pose: s.pose,
+            velocity_mm_s: s.velocity_mm_s,
+            omega_rad_s: s.omega_rad_s,
+            contacts: self.world.stats(0).contacts,
+            reached_goal: self.truth.time_to_goal_s().is_some(),
+            targets_reached: self.truth.targets_reached(),
+        }
+    }
+
     /// Ends the run: the summary of what the truth shows, and everything recorded.
     pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
-        for (k, path) in self.other_paths.iter_mut().enumerate() {
-            path.push(Point2::from(
-                self.world.robot_state(k + 1).pose.translation.vector,
-            ));
+        let ends = self.other_robot_ends();
+        for (path, end) in self.other_paths.iter_mut().zip(ends) {
+            path.push(end);
         }
+        RunOutput {
+            summary: self.summary(wall_time_s),
+            map: self.robot.map(),
+            trajectory: self.trajectory,
+            estimates: self.estimates,
+            other_paths: self.other_paths,
+            files: Vec::new(),
+        }
+    }
+
+    /// What [`Simulation::finish`] would give now, the run going on (its records copied).
+    pub fn output(&self, wall_time_s: f64) -> RunOutput {
+        let mut other_paths = self.other_paths.clone();
+        for (path, end) in other_paths.iter_mut().zip(self.other_robot_ends()) {
+            path.push(end);
+        }
+        RunOutput {
+            summary: self.summary(wall_time_s),
+            map: self.robot.map(),
+            trajectory: self.trajectory.clone(),
+            estimates: self.estimates.clone(),
+            other_paths,
+            files: Vec::new(),
+        }
+    }
+
+    /// Where the other robots are now.
+    fn other_robot_ends(&self) -> Vec<Point2<f64>> {
+        (0..self.others.len())
+            .map(|k| Point2::from(self.world.robot_state(k + 1).pose.translation.vector))
+            .collect()
+    }
+
+    /// The summary of what the truth shows so far.
+    fn summary(&self, wall_time_s: f64) -> Summary {
         let stats = self.world.stats(0);
         let navigation = self
             .estimates
             .iter()
             .rev()
             .find_map(|e| e.navigation.as_ref());
-        let summary = Summary {
+        Summary {
             scenario: self.scenario.name.clone(),
             seed: self.scenario.seed,
             controller: match self.pilot {
@@ -422,16 +520,27 @@ impl Simulation {
             unreachable: navigation.map(|n| n.unreachable),
             watchdog_fired: navigation.map(|n| n.watchdog),
             experiment: serde_json::Map::new(),
-        };
-        RunOutput {
-            summary,
-            trajectory: self.trajectory,
-            estimates: self.estimates,
-            other_paths: self.other_paths,
-            files: Vec::new(),
-            map: self.robot.map(),
         }
     }
+}
+
+/// The truth at a moment of a run: the simulator's side, never given to the robot's software.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Truth {
+    /// Simulated time, s.
+    pub t_s: f64,
+    /// The robot's true pose (mm, rad).
+    pub pose: Isometry2<f64>,
+    /// Its true velocity in the world frame.
+    pub velocity_mm_s: Vector2<f64>,
+    /// Its true rotation rate.
+    pub omega_rad_s: f64,
+    /// How many times it started touching a wall, cube, pillar or robot so far.
+    pub contacts: u32,
+    /// Whether it has reached the goal (within the tolerance, after every waypoint).
+    pub reached_goal: bool,
+    /// How many of the goal's targets (waypoints, then the goal) it has reached.
+    pub targets_reached: Option<usize>,
 }
 
 /// The built-in robot software of a configuration.

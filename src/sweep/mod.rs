@@ -13,7 +13,7 @@ pub mod set;
 pub mod workers;
 
 pub use files::{known_metric, write_outputs};
-pub use plan::{Job, Plan, PlanError, Seeds, describe, plan};
+pub use plan::{Job, Plan, PlanError, Seeds, describe, plan, with_values};
 pub use report::{Aggregate, Row, rows};
 pub use set::{Set, SetError};
 pub use workers::{Outcome, SweepOptions, run_jobs, shared_gpu};

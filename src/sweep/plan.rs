@@ -182,6 +182,30 @@ pub fn plan(file: &Path, sets: &[Set], seeds: &Seeds) -> Result<Plan, PlanError>
     })
 }
 
+/// The scenario `text` (read from `file`, named in messages) with each key set to its value,
+/// validated as a sweep's combination is: each problem names the key it came from
+/// (`--set KEY=VALUE:1:COL: ...`). Returns the scenario and its text with the values in.
+pub fn with_values(
+    file: &Path,
+    text: &str,
+    values: &[(String, Value)],
+) -> Result<(Scenario, String), Vec<String>> {
+    let doc: Table =
+        toml::from_str(text).map_err(|e| vec![format!("{}: {}", file.display(), e.message())])?;
+    let mut sets = Vec::with_capacity(values.len());
+    for (key, value) in values {
+        sets.push(Set::single(key, value.clone()).map_err(|e| vec![e.to_string()])?);
+    }
+    let vals: Vec<Value> = values.iter().map(|(_, v)| v.clone()).collect();
+    let scenario = combination(file, &doc, &sets, &vals)?;
+    let mut doc = doc;
+    for (s, v) in sets.iter().zip(&vals) {
+        s.apply(&mut doc, v).map_err(|m| vec![m])?;
+    }
+    let text = toml::to_string(&doc).map_err(|e| vec![format!("{}: {e}", file.display())])?;
+    Ok((scenario, text))
+}
+
 /// Every combination of the sets' values, the first set slowest.
 fn combinations(sets: &[Set]) -> Vec<Vec<Value>> {
     let mut out: Vec<Vec<Value>> = vec![Vec::new()];

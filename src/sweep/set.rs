@@ -91,6 +91,24 @@ impl Set {
         })
     }
 
+    /// One key with one value, as `--set KEY=VALUE` would give it (the library's and Python's
+    /// way to set a value without writing it as text).
+    pub fn single(key: &str, value: Value) -> Result<Self, SetError> {
+        let arg = format!("{key}={value}");
+        let path = parse_path(key.trim()).map_err(|message| SetError {
+            arg: arg.clone(),
+            column: 1,
+            message,
+        })?;
+        Ok(Self {
+            arg,
+            key: key.trim().to_string(),
+            values: vec![value],
+            columns: vec![key.len() + 2],
+            path,
+        })
+    }
+
     /// Writes `value` at the key into `doc`, creating missing tables on the way.
     pub fn apply(&self, doc: &mut Table, value: &Value) -> Result<(), String> {
         let mut table = doc;
