@@ -22,3 +22,12 @@ if ! command -v cargo >/dev/null 2>&1; then
   echo "omniloop: cargo not found; install Rust 1.95 or newer from https://rustup.rs" >&2
   exit 1
 fi
+
+# The Python tests run in a virtual environment of their own (scripts/test.sh makes it).
+if ! command -v python3 >/dev/null 2>&1 || ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
+  echo "omniloop: installing python3 and python3-venv for the Python package's tests"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends python3 python3-venv
+fi

@@ -253,10 +253,17 @@ fn loops(src: &Path) -> Vec<Vec<String>> {
 
 fn workspace_crates() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    ["src", "sim/src", "vision/src", "control/src", "robot/src"]
-        .iter()
-        .map(|d| root.join(d))
-        .collect()
+    [
+        "src",
+        "sim/src",
+        "vision/src",
+        "control/src",
+        "robot/src",
+        "python/src",
+    ]
+    .iter()
+    .map(|d| root.join(d))
+    .collect()
 }
 
 #[test]

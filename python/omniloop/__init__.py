@@ -1,0 +1,51 @@
+"""omniloop: a closed-loop testbed for omnidirectional robots with catadioptric vision.
+
+The loop itself, from Python::
+
+    import omniloop
+
+    scenario = omniloop.Scenario.load("scenarios/smoke.toml")
+    sim = omniloop.Simulation(scenario)          # Python is the robot's software
+    obs = sim.reset()
+    while not obs.done:
+        obs = sim.step((300.0, 0.0, 0.0))        # vx_mm_s, vy_mm_s, omega_rad_s (body frame)
+    print(sim.summary()["wall_contacts"])
+
+- ``Scenario.load(path)``, ``Scenario.from_toml(text)``, ``scenario.with_values({...})``;
+  a bad scenario raises ``ScenarioError`` (a ``ValueError``) with ``FILE:LINE:COLUMN: ...``.
+- ``run(scenario, seed=None, renderer="cpu", out=None)``: the built-in robot, as
+  ``omniloop run`` runs it; ``.summary`` and ``.trajectory``.
+- ``Simulation(scenario, seed=None, renderer="cpu", robot="python")``: ``reset``, ``step``,
+  ``truth``, ``summary``, ``write``, ``topview``; ``robot="builtin"`` steps the built-in stack.
+- ``VectorSimulation(scenario, num_envs, ...)``: N runs stepped together in parallel.
+- ``omniloop.gym``: the Gymnasium environments (``pip install omniloop[gym]``).
+
+Units are millimetres, seconds and radians. The robot never sees the truth: an
+``Observation`` holds what its sensors give; ``Simulation.truth()`` is the simulator's side.
+"""
+
+from ._omniloop import (
+    Observation,
+    Odometry,
+    RunResult,
+    Scenario,
+    ScenarioError,
+    Simulation,
+    VectorSimulation,
+    __version__,
+    default_scenario,
+    run,
+)
+
+__all__ = [
+    "Observation",
+    "Odometry",
+    "RunResult",
+    "Scenario",
+    "ScenarioError",
+    "Simulation",
+    "VectorSimulation",
+    "__version__",
+    "default_scenario",
+    "run",
+]

@@ -1,0 +1,308 @@
+"""Gymnasium environments of omniloop scenarios (``pip install "omniloop[gym]"``).
+
+Importing this module registers ``omniloop/Scenario-v0``::
+
+    import gymnasium
+    import omniloop.gym
+
+    env = gymnasium.make("omniloop/Scenario-v0", scenario="scenarios/smoke.toml")
+    obs, info = env.reset(seed=1)
+
+- Observation: a ``Dict`` space with one ``uint8`` ``H x W x 3`` image per camera (keyed by
+  sensor name), ``"odometry"`` (``float32[3]``: the wheel odometry's body-frame velocity x, y
+  in mm/s and rotation rate in rad/s, with the scenario's errors) and ``"goal"``
+  (``float32[2]``: the goal in the body frame, mm, where the robot's own dead reckoning puts
+  it; absent when the scenario has no goal).
+- Action: a ``Box`` of body-frame velocities within the scenario's limits:
+  ``(vx_mm_s, vy_mm_s, omega_rad_s)`` with ``|v| <= robot.max_speed_mm_s`` per axis and
+  ``|omega| <= max_omega_rad_s`` (default pi rad/s), or ``(v_mm_s, omega_rad_s)`` for a
+  differential robot (its turn rate limit from ``[robot.differential]``). Actions outside are
+  clipped to the box.
+- Reward: progress toward the goal over the step in metres (the true distance before minus
+  after), minus ``contact_penalty`` (default 1.0) for each new contact with a wall, cube,
+  pillar or robot; without a goal, the contact penalty alone.
+- ``terminated`` when the goal is reached (on the truth, within its tolerance);
+  ``truncated`` when ``run.duration_s`` is up.
+- ``info``: the truth (``t_s``, ``x_mm``, ``y_mm``, ``theta_rad``, ``contacts``,
+  ``reached_goal``, ...): the simulator's side, for scoring; never in the observation.
+- ``render_mode="rgb_array"``: ``render()`` returns a top view of the moment.
+
+Seeds: ``reset(seed=s)`` runs with seed ``s``; ``reset()`` without one runs the scenario's
+seed the first time and the previous episode's seed plus one after, so that every episode is
+reproducible. The vector environment gives run ``i`` seed ``s + i`` and, after an episode,
+its previous seed plus ``num_envs``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+
+try:
+    import gymnasium
+    from gymnasium import spaces
+    from gymnasium.vector import AutoresetMode, VectorEnv
+    from gymnasium.vector.utils import batch_space
+except ImportError as e:  # pragma: no cover - depends on the environment
+    raise ImportError(
+        "omniloop.gym needs Gymnasium (>= 1.1): pip install \"omniloop[gym]\""
+    ) from e
+
+from . import Observation, Scenario, Simulation, VectorSimulation
+
+ENV_ID = "omniloop/Scenario-v0"
+
+ScenarioLike = Union[Scenario, str, "os.PathLike[str]"]
+
+
+def _scenario(scenario: ScenarioLike) -> Scenario:
+    if isinstance(scenario, Scenario):
+        return scenario
+    if isinstance(scenario, (str, os.PathLike)):
+        return Scenario.load(scenario)
+    raise TypeError(
+        f"scenario must be an omniloop.Scenario or a path, not {type(scenario).__name__}"
+    )
+
+
+class _Task:
+    """What the single and the vector environment share: spaces, observation, reward."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        contact_penalty: float,
+        max_omega_rad_s: Optional[float],
+    ) -> None:
+        if not (math.isfinite(contact_penalty) and contact_penalty >= 0.0):
+            raise ValueError(f"contact_penalty={contact_penalty}: a finite number >= 0")
+        robot = scenario.robot
+        self.sensors = [(s["name"], s["height_px"], s["width_px"]) for s in robot["sensors"]]
+        goal = robot["goal"]
+        self.goal = None if goal is None else (goal["x_mm"], goal["y_mm"])
+        self.contact_penalty = float(contact_penalty)
+        vmax = robot["max_speed_mm_s"]
+        diff = robot["differential"]
+        if diff is not None:
+            wmax = diff["max_turn_rate_rad_s"] if max_omega_rad_s is None else max_omega_rad_s
+            high = np.array([vmax, wmax], dtype=np.float32)
+        else:
+            wmax = math.pi if max_omega_rad_s is None else max_omega_rad_s
+            high = np.array([vmax, vmax, wmax], dtype=np.float32)
+        if not (math.isfinite(wmax) and wmax > 0.0):
+            raise ValueError(f"max_omega_rad_s={max_omega_rad_s}: a finite number > 0")
+        self.action_space = spaces.Box(-high, high, dtype=np.float32)
+        parts: dict[str, spaces.Space] = {
+            name: spaces.Box(0, 255, (h, w, 3), dtype=np.uint8) for name, h, w in self.sensors
+        }
+        if "odometry" in parts or "goal" in parts:
+            raise ValueError("a camera may not be called `odometry` or `goal` in a Gym env")
+        parts["odometry"] = spaces.Box(-np.inf, np.inf, (3,), dtype=np.float32)
+        if self.goal is not None:
+            parts["goal"] = spaces.Box(-np.inf, np.inf, (2,), dtype=np.float32)
+        self.observation_space = spaces.Dict(parts)
+
+    def observation(self, obs: Observation) -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {name: obs.frames[name] for name, _, _ in self.sensors}
+        o = obs.odometry
+        out["odometry"] = np.array([o.vx_mm_s, o.vy_mm_s, o.omega_rad_s], dtype=np.float32)
+        if self.goal is not None:
+            x, y, theta = obs.odometry_pose
+            dx, dy = self.goal[0] - x, self.goal[1] - y
+            c, s = math.cos(theta), math.sin(theta)
+            out["goal"] = np.array([c * dx + s * dy, -s * dx + c * dy], dtype=np.float32)
+        return out
+
+    def distance_m(self, truth: dict[str, Any]) -> float:
+        if self.goal is None:
+            return 0.0
+        return math.hypot(self.goal[0] - truth["x_mm"], self.goal[1] - truth["y_mm"]) / 1000.0
+
+    def reward(self, before: dict[str, Any], after: dict[str, Any]) -> float:
+        progress = self.distance_m(before) - self.distance_m(after)
+        return progress - self.contact_penalty * (after["contacts"] - before["contacts"])
+
+    def command(self, action: Any) -> np.ndarray:
+        a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a.shape != self.action_space.shape:
+            raise ValueError(
+                f"action of shape {a.shape}: the action space is {self.action_space}"
+            )
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"action {a} is not finite")
+        return np.clip(a, self.action_space.low, self.action_space.high)
+
+
+class OmniloopEnv(gymnasium.Env):
+    """One omniloop scenario as a Gymnasium environment (see the module's documentation)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
+
+    def __init__(
+        self,
+        scenario: ScenarioLike,
+        renderer: str = "cpu",
+        render_mode: Optional[str] = None,
+        contact_penalty: float = 1.0,
+        max_omega_rad_s: Optional[float] = None,
+        render_width_px: int = 640,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
+        self.scenario = _scenario(scenario)
+        self._task = _Task(self.scenario, contact_penalty, max_omega_rad_s)
+        self.observation_space = self._task.observation_space
+        self.action_space = self._task.action_space
+        self.render_mode = render_mode
+        self.render_width_px = render_width_px
+        self.metadata = {**self.metadata, "render_fps": round(1.0 / self.scenario.control_period_s)}
+        self.sim = Simulation(self.scenario, renderer=renderer)
+        self._episode_seed: Optional[int] = None
+        self._truth = self.sim.truth()
+
+    def reset(
+        self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        if seed is not None:
+            episode = int(seed)
+        elif self._episode_seed is None:
+            episode = self.scenario.seed
+        else:
+            episode = self._episode_seed + 1
+        self._episode_seed = episode
+        obs = self.sim.reset(seed=episode)
+        self._truth = self.sim.truth()
+        return self._task.observation(obs), dict(self._truth)
+
+    def step(
+        self, action: Any
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        if self._episode_seed is None:
+            raise RuntimeError("call reset() before step()")
+        obs = self.sim.step(self._task.command(action))
+        truth = self.sim.truth()
+        reward = self._task.reward(self._truth, truth)
+        self._truth = truth
+        terminated = bool(truth["reached_goal"])
+        truncated = bool(obs.done and not terminated)
+        return self._task.observation(obs), float(reward), terminated, truncated, dict(truth)
+
+    def render(self) -> Optional[np.ndarray]:
+        if self.render_mode == "rgb_array":
+            return self.sim.topview(self.render_width_px)
+        return None
+
+
+class OmniloopVectorEnv(VectorEnv):
+    """N runs of one scenario stepped together in Rust, in parallel on the cores (and in
+    shared GPU batches on a GPU renderer); Gymnasium's next-step autoreset: the step after an
+    episode ends resets that run and returns its first observation with reward 0."""
+
+    metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(
+        self,
+        scenario: ScenarioLike,
+        num_envs: int,
+        renderer: str = "cpu",
+        contact_penalty: float = 1.0,
+        max_omega_rad_s: Optional[float] = None,
+    ) -> None:
+        self.scenario = _scenario(scenario)
+        self._task = _Task(self.scenario, contact_penalty, max_omega_rad_s)
+        self.num_envs = int(num_envs)
+        self.single_observation_space = self._task.observation_space
+        self.single_action_space = self._task.action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.render_mode = None
+        self.vec = VectorSimulation(self.scenario, self.num_envs, renderer=renderer)
+        self._seeds: Optional[list[int]] = None
+        self._truths = self.vec.truth()
+        self._autoreset = np.zeros(self.num_envs, dtype=bool)
+
+    def reset(
+        self,
+        *,
+        seed: Optional[Union[int, Sequence[int]]] = None,
+        options: Optional[dict[str, Any]] = None,
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=None if seed is None or not isinstance(seed, int) else seed)
+        n = self.num_envs
+        if seed is None:
+            base = self.scenario.seed if self._seeds is None else self._seeds[0] + n
+            seeds = [base + i for i in range(n)]
+        elif isinstance(seed, int):
+            seeds = [seed + i for i in range(n)]
+        else:
+            seeds = [int(s) for s in seed]
+            if len(seeds) != n:
+                raise ValueError(f"{len(seeds)} seeds for {n} runs")
+        self._seeds = seeds
+        obs = [self.vec.reset(i, s) for i, s in enumerate(seeds)]
+        self._truths = self.vec.truth()
+        self._autoreset[:] = False
+        return self._batch(obs), self._infos(self._truths)
+
+    def step(
+        self, actions: Any
+    ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        if self._seeds is None:
+            raise RuntimeError("call reset() before step()")
+        actions = np.asarray(actions, dtype=np.float64)
+        n = self.num_envs
+        if actions.shape[0] != n:
+            raise ValueError(f"{actions.shape[0]} actions for {n} runs")
+        commands = np.stack([self._task.command(a) for a in actions])
+        resetting = self._autoreset.copy()
+        for i in np.flatnonzero(resetting):
+            self._seeds[i] += n
+            self.vec.reset(int(i), self._seeds[i])
+        obs = self.vec.step(commands, active=[not r for r in resetting])
+        truths = self.vec.truth()
+        rewards = np.zeros(n, dtype=np.float64)
+        terminated = np.zeros(n, dtype=bool)
+        truncated = np.zeros(n, dtype=bool)
+        for i in range(n):
+            if resetting[i]:
+                continue
+            rewards[i] = self._task.reward(self._truths[i], truths[i])
+            terminated[i] = truths[i]["reached_goal"]
+            truncated[i] = obs[i].done and not terminated[i]
+        self._truths = truths
+        self._autoreset = terminated | truncated
+        return self._batch(obs), rewards, terminated, truncated, self._infos(truths)
+
+    def _batch(self, obs: list[Observation]) -> dict[str, np.ndarray]:
+        each = [self._task.observation(o) for o in obs]
+        return {k: np.stack([e[k] for e in each]) for k in self.single_observation_space.keys()}
+
+    def _infos(self, truths: list[dict[str, Any]]) -> dict[str, Any]:
+        infos: dict[str, Any] = {}
+        for key in truths[0]:
+            values = [t[key] for t in truths]
+            if any(v is None for v in values):
+                continue
+            infos[key] = np.array(values)
+            infos["_" + key] = np.ones(self.num_envs, dtype=bool)
+        return infos
+
+
+def make_vec(
+    scenario: ScenarioLike, num_envs: int, renderer: str = "cpu", **kwargs: Any
+) -> OmniloopVectorEnv:
+    """A vector environment of ``num_envs`` runs of ``scenario`` (see ``OmniloopVectorEnv``)."""
+    return OmniloopVectorEnv(scenario, num_envs, renderer=renderer, **kwargs)
+
+
+gymnasium.register(
+    id=ENV_ID,
+    entry_point="omniloop.gym:OmniloopEnv",
+    vector_entry_point="omniloop.gym:OmniloopVectorEnv",
+)
+
+__all__ = ["ENV_ID", "OmniloopEnv", "OmniloopVectorEnv", "make_vec"]

@@ -1,0 +1,190 @@
+//! `omniloop.Scenario`: a validated scenario, loaded from a file or text, with values set by
+//! the dotted keys of `omniloop sweep --set`.
+
+use crate::convert::{ScenarioError, toml_value};
+use omniloop::scenario::LoadError;
+use omniloop::{Scenario, load_scenario, parse_scenario};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::{Path, PathBuf};
+
+/// The file name messages give a scenario made from text.
+const TEXT_FILE: &str = "<string>";
+
+/// A scenario, checked as `omniloop check` checks it.
+#[pyclass(module = "omniloop", name = "Scenario", frozen)]
+#[derive(Clone)]
+pub struct PyScenario {
+    pub scenario: Scenario,
+    /// Its TOML text (with any values set).
+    text: String,
+    /// The file it came from (`<string>` for text), named in messages.
+    file: PathBuf,
+}
+
+fn load_error(e: LoadError) -> PyErr {
+    match e {
+        LoadError::Io { file, source } if source.kind() == std::io::ErrorKind::NotFound => {
+            PyFileNotFoundError::new_err(format!("no scenario file {}", file.display()))
+        }
+        LoadError::Io { .. } => PyOSError::new_err(e.to_string()),
+        LoadError::Invalid { .. } => ScenarioError::new_err(e.to_string()),
+    }
+}
+
+#[pymethods]
+impl PyScenario {
+    /// Reads, parses and validates a scenario file; raises `ScenarioError` with every problem
+    /// as `FILE:LINE:COLUMN: field PATH: message`.
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        let scenario = load_scenario(&path).map_err(load_error)?;
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| PyOSError::new_err(format!("reading {}: {e}", path.display())))?;
+        Ok(Self {
+            scenario,
+            text,
+            file: path,
+        })
+    }
+
+    /// Parses and validates scenario text (messages name it `<string>`); `name` is its name
+    /// when the text gives none (default `scenario`).
+    #[staticmethod]
+    #[pyo3(signature = (text, name = "scenario"))]
+    fn from_toml(text: &str, name: &str) -> PyResult<Self> {
+        let file = PathBuf::from(TEXT_FILE);
+        let scenario = parse_scenario(text, &file, name).map_err(load_error)?;
+        Ok(Self {
+            scenario,
+            text: text.to_string(),
+            file,
+        })
+    }
+
+    /// A new scenario with each dotted key (`"robot.max_speed_mm_s"`,
+    /// `"robot.sensors[0].noise_sigma"`, `"seed"`) set to its value, validated as
+    /// `omniloop sweep --set` validates; raises `ScenarioError` naming the key.
+    fn with_values(&self, values: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let mut pairs = Vec::with_capacity(values.len());
+        for (k, v) in values.iter() {
+            let key: String = k.extract().map_err(|_| {
+                pyo3::exceptions::PyValueError::new_err("with_values: every key must be a str")
+            })?;
+            let value = toml_value(&key, &v)?;
+            pairs.push((key, value));
+        }
+        let (mut scenario, text) = omniloop::sweep::with_values(&self.file, &self.text, &pairs)
+            .map_err(|e| ScenarioError::new_err(e.join("\n")))?;
+        if !pairs.iter().any(|(k, _)| k == "name") {
+            scenario.name = self.scenario.name.clone();
+        }
+        Ok(Self {
+            scenario,
+            text,
+            file: self.file.clone(),
+        })
+    }
+
+    /// The scenario's TOML text (with the values set).
+    fn to_toml(&self) -> String {
+        self.text.clone()
+    }
+
+    /// Its name (the file stem unless it names itself).
+    #[getter]
+    fn name(&self) -> String {
+        self.scenario.name.clone()
+    }
+
+    /// The file it came from (`None` for text).
+    #[getter]
+    fn path(&self) -> Option<PathBuf> {
+        (self.file != Path::new(TEXT_FILE)).then(|| self.file.clone())
+    }
+
+    /// Its seed.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.scenario.seed
+    }
+
+    /// Longest simulated time, s (`run.duration_s`).
+    #[getter]
+    fn duration_s(&self) -> f64 {
+        self.scenario.run.duration_s
+    }
+
+    /// One control cycle, s (`run.control_period_s`).
+    #[getter]
+    fn control_period_s(&self) -> f64 {
+        self.scenario.run.control_period_s
+    }
+
+    /// Most control cycles a run lasts.
+    #[getter]
+    fn max_cycles(&self) -> u64 {
+        self.scenario.max_cycles()
+    }
+
+    /// What the robot knows of itself: `start` (x_mm, y_mm, theta_rad), `radius_mm`,
+    /// `max_speed_mm_s`, `accel_limit_mm_s2`, `angular_accel_limit_rad_s2`, `differential`
+    /// (`None`, or `track_mm` and `max_turn_rate_rad_s`), `sensors` (name, width_px,
+    /// height_px, kind, pan unit), and `goal` (`None`, or `x_mm`, `y_mm`, `tolerance_mm`,
+    /// `waypoints_mm`).
+    #[getter]
+    fn robot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.scenario;
+        let r = &s.robot;
+        let d = PyDict::new(py);
+        let start = s.start();
+        d.set_item(
+            "start",
+            (start.x_mm, start.y_mm, start.heading_deg.to_radians()),
+        )?;
+        d.set_item("radius_mm", r.radius_mm)?;
+        d.set_item("max_speed_mm_s", r.max_speed_mm_s)?;
+        d.set_item("accel_limit_mm_s2", r.accel_limit_mm_s2)?;
+        d.set_item("angular_accel_limit_rad_s2", r.angular_accel_limit_rad_s2)?;
+        match &r.differential {
+            Some(diff) => {
+                let dd = PyDict::new(py);
+                dd.set_item("track_mm", diff.track_mm)?;
+                dd.set_item("max_turn_rate_rad_s", diff.max_turn_rate_deg_s.to_radians())?;
+                d.set_item("differential", dd)?;
+            }
+            None => d.set_item("differential", py.None())?,
+        }
+        let sensors = PyList::empty(py);
+        for spec in &r.sensors {
+            let sd = PyDict::new(py);
+            sd.set_item("name", &spec.name)?;
+            sd.set_item("width_px", spec.width_px)?;
+            sd.set_item("height_px", spec.height_px)?;
+            sd.set_item("kind", spec.optics.kind())?;
+            sd.set_item("pan_unit", spec.optics.pinhole().is_some())?;
+            sensors.append(sd)?;
+        }
+        d.set_item("sensors", sensors)?;
+        match &s.goal {
+            Some(g) => {
+                let gd = PyDict::new(py);
+                gd.set_item("x_mm", g.x_mm)?;
+                gd.set_item("y_mm", g.y_mm)?;
+                gd.set_item("tolerance_mm", g.tolerance_mm)?;
+                gd.set_item("waypoints_mm", g.waypoints_mm.clone())?;
+                d.set_item("goal", gd)?;
+            }
+            None => d.set_item("goal", py.None())?,
+        }
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scenario({:?}, seed={})",
+            self.scenario.name, self.scenario.seed
+        )
+    }
+}

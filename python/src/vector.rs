@@ -1,0 +1,238 @@
+//! `omniloop.VectorSimulation`: N runs of one scenario stepped together, in parallel on the
+//! cores (and in shared GPU batches when the renderer is a GPU, as sweeps do). The Gymnasium
+//! vector environment (`omniloop.gym.make_vec`) is built on it.
+
+use crate::convert::run_error;
+use crate::scenario::PyScenario;
+use crate::simulation::{
+    Command, Driver, Observation, State, observation, renderer_choice, truth_dict,
+};
+use omniloop_sim::RendererChoice;
+use omniloop_sim::render::{BatchHandle, BatchServer};
+use pyo3::exceptions::{PyIndexError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
+/// N runs of one scenario, stepped together.
+#[pyclass(module = "omniloop", name = "VectorSimulation")]
+pub struct PyVectorSimulation {
+    scenario: PyScenario,
+    renderer: RendererChoice,
+    driver: Driver,
+    states: Mutex<Vec<State>>,
+    /// The GPU the runs' frames are traced on in batches (kept alive while they run).
+    _gpu: Mutex<Option<BatchServer>>,
+    gpu: Option<BatchHandle>,
+}
+
+impl PyVectorSimulation {
+    fn lock(&self) -> MutexGuard<'_, Vec<State>> {
+        self.states.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    fn build(&self, seed: u64) -> Result<State, omniloop::run::RunError> {
+        State::new(
+            &self.scenario.scenario,
+            seed,
+            self.renderer,
+            self.driver,
+            self.gpu.clone(),
+        )
+    }
+}
+
+#[pymethods]
+impl PyVectorSimulation {
+    /// `num_envs` runs of `scenario`, run `i` with seed `seed + i` (default: the scenario's
+    /// seed), on `renderer`, with `robot` `"python"` or `"builtin"` (see `Simulation`).
+    #[new]
+    #[pyo3(signature = (scenario, num_envs, seed = None, renderer = "cpu", robot = "python"))]
+    fn new(
+        py: Python<'_>,
+        scenario: PyRef<'_, PyScenario>,
+        num_envs: usize,
+        seed: Option<u64>,
+        renderer: &str,
+        robot: &str,
+    ) -> PyResult<Self> {
+        if !(1..=4096).contains(&num_envs) {
+            return Err(PyValueError::new_err(format!(
+                "num_envs={num_envs}: from 1 to 4096 runs"
+            )));
+        }
+        let choice = renderer_choice(renderer)?;
+        let driver = Driver::parse(robot)?;
+        let server = omniloop::sweep::shared_gpu(choice)
+            .map_err(|e| PyRuntimeError::new_err(format!("renderer={renderer:?}: {e}")))?;
+        let gpu = server.as_ref().map(BatchServer::handle);
+        let scenario = scenario.clone();
+        let base = seed.unwrap_or(scenario.scenario.seed);
+        let mut me = Self {
+            scenario,
+            renderer: choice,
+            driver,
+            states: Mutex::new(Vec::new()),
+            _gpu: Mutex::new(server),
+            gpu,
+        };
+        let states = py
+            .detach(|| {
+                (0..num_envs as u64)
+                    .into_par_iter()
+                    .map(|i| me.build(base.wrapping_add(i)))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(run_error)?;
+        me.states = Mutex::new(states);
+        Ok(me)
+    }
+
+    /// How many runs.
+    fn __len__(&self) -> usize {
+        self.lock().len()
+    }
+
+    /// Starts run `index` again with `seed` (default: its seed) and returns its first
+    /// observation.
+    #[pyo3(signature = (index, seed = None))]
+    fn reset(&self, py: Python<'_>, index: usize, seed: Option<u64>) -> PyResult<Observation> {
+        let old_seed = {
+            let states = self.lock();
+            let s = states
+                .get(index)
+                .ok_or_else(|| PyIndexError::new_err(format!("run {index} of {}", states.len())))?;
+            s.seed()
+        };
+        let fresh = py
+            .detach(|| self.build(seed.unwrap_or(old_seed)))
+            .map_err(run_error)?;
+        let mut states = self.lock();
+        states[index] = fresh;
+        observation(py, &states[index])
+    }
+
+    /// Every run's observation now.
+    fn observe(&self, py: Python<'_>) -> PyResult<Vec<Observation>> {
+        self.lock().iter().map(|s| observation(py, s)).collect()
+    }
+
+    /// One control cycle of every run whose `active` flag is true (default: all), in
+    /// parallel: `commands` holds a command a run (a sequence or an `N x 3` / `N x 2` array;
+    /// `None` with `robot="builtin"`). A finished run that is active raises `RuntimeError`.
+    /// Returns every run's observation.
+    #[pyo3(signature = (commands = None, active = None))]
+    fn step(
+        &self,
+        py: Python<'_>,
+        commands: Option<&Bound<'_, PyAny>>,
+        active: Option<Vec<bool>>,
+    ) -> PyResult<Vec<Observation>> {
+        let cmds = self.commands(commands, active)?;
+        let result = py.detach(|| {
+            let mut states = self.lock();
+            states
+                .par_iter_mut()
+                .zip(cmds)
+                .map(|(s, c)| match c {
+                    Some(c) => s.step(c),
+                    None => Ok(()),
+                })
+                .collect::<Result<Vec<()>, _>>()
+        });
+        result.map_err(run_error)?;
+        self.observe(py)
+    }
+
+    /// Every run's truth now (see `Simulation.truth`).
+    fn truth<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let dicts = self
+            .lock()
+            .iter()
+            .map(|s| truth_dict(py, &s.truth()))
+            .collect::<PyResult<Vec<Bound<'py, PyDict>>>>()?;
+        PyList::new(py, dicts)
+    }
+
+    /// Each run's seed.
+    #[getter]
+    fn seeds(&self) -> Vec<u64> {
+        self.lock().iter().map(State::seed).collect()
+    }
+
+    /// Whether each run is over.
+    #[getter]
+    fn done(&self) -> Vec<bool> {
+        self.lock().iter().map(State::done).collect()
+    }
+
+    /// The scenario being run.
+    #[getter]
+    fn scenario(&self) -> PyScenario {
+        self.scenario.clone()
+    }
+}
+
+impl PyVectorSimulation {
+    /// Each run's checked command: `None` for a run left as it is; `Some(None)` for the
+    /// built-in robot's step.
+    fn commands(
+        &self,
+        commands: Option<&Bound<'_, PyAny>>,
+        active: Option<Vec<bool>>,
+    ) -> PyResult<Vec<Option<Option<Command>>>> {
+        let states = self.lock();
+        let n = states.len();
+        let active = active.unwrap_or_else(|| vec![true; n]);
+        if active.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "active has {} flags for {n} runs",
+                active.len()
+            )));
+        }
+        let rows: Option<Vec<Bound<'_, PyAny>>> = match (self.driver, commands) {
+            (Driver::Builtin, Some(c)) if !c.is_none() => {
+                return Err(PyValueError::new_err(
+                    "robot=\"builtin\" decides its own commands: call step() without any",
+                ));
+            }
+            (Driver::Builtin, _) => None,
+            (Driver::Python, Some(c)) if !c.is_none() => {
+                let rows: Vec<Bound<'_, PyAny>> = c.try_iter()?.collect::<PyResult<_>>()?;
+                if rows.len() != n {
+                    return Err(PyValueError::new_err(format!(
+                        "{} commands for {n} runs: one a run",
+                        rows.len()
+                    )));
+                }
+                Some(rows)
+            }
+            (Driver::Python, _) => {
+                return Err(PyValueError::new_err("step() needs a command a run"));
+            }
+        };
+        let mut out = Vec::with_capacity(n);
+        for (i, (state, on)) in states.iter().zip(active).enumerate() {
+            if !on {
+                out.push(None);
+                continue;
+            }
+            if state.done() {
+                return Err(PyRuntimeError::new_err(format!(
+                    "run {i} is over: reset it (or leave it inactive) before stepping again"
+                )));
+            }
+            let cmd = match &rows {
+                Some(rows) => Some(
+                    state
+                        .command(&rows[i], None, None)
+                        .map_err(|e| PyValueError::new_err(format!("run {i}: {e}")))?,
+                ),
+                None => None,
+            };
+            out.push(Some(cmd));
+        }
+        Ok(out)
+    }
+}

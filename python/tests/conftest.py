@@ -1,0 +1,36 @@
+"""Shared paths and scenarios of the Python tests (run from anywhere: `pytest python/tests`)."""
+
+from pathlib import Path
+
+import pytest
+
+import omniloop
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENARIOS = ROOT / "scenarios"
+
+
+@pytest.fixture(scope="session")
+def smoke() -> omniloop.Scenario:
+    """Across the field to a goal past two cubes and a moving robot; no camera."""
+    return omniloop.Scenario.load(SCENARIOS / "smoke.toml")
+
+
+@pytest.fixture(scope="session")
+def corner() -> omniloop.Scenario:
+    """E1's 55-degree corner, velocity-aware: a hyperbolic mirror camera at 256x220."""
+    return omniloop.Scenario.load(SCENARIOS / "corner55_velocity_aware.toml")
+
+
+@pytest.fixture(scope="session")
+def pinhole() -> omniloop.Scenario:
+    """A forward pinhole camera on a pan unit, one second long."""
+    return omniloop.Scenario.load(SCENARIOS / "render_pinhole.toml")
+
+
+def to_goal(goal_body_mm, speed_mm_s: float = 400.0):
+    """A proportional step toward a goal given in the body frame: (vx, vy, omega)."""
+    gx, gy = float(goal_body_mm[0]), float(goal_body_mm[1])
+    d = max((gx * gx + gy * gy) ** 0.5, 1e-9)
+    v = min(speed_mm_s, 2.0 * d)
+    return (v * gx / d, v * gy / d, 0.0)

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Every test of omniloop: the Rust workspace's (unit, end-to-end, the import-loop check), then
+# the Python package's, in a virtual environment (.venv, made on first use) where
+# `pip install ./python` builds the extension with the tests' own cargo profile, so that the
+# workspace is compiled once for both.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cargo test --workspace
+
+venv="${OMNILOOP_VENV:-.venv}"
+if [ ! -x "$venv/bin/python" ]; then
+  echo "omniloop: making the virtual environment $venv for the Python tests"
+  python3 -m venv "$venv"
+  "$venv/bin/python" -m pip install -q --upgrade pip
+fi
+# The dev profile is the one `cargo test` just built: the extension reuses its artifacts.
+MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test]"
+"$venv/bin/python" -m pytest -q python/tests
