@@ -42,24 +42,49 @@ impl RunResult {
 
 /// Runs `scenario` with the built-in robot as `omniloop run` does (its experiment's
 /// procedure, its metrics), with `seed` (default: the scenario's) on `renderer`; `out` also
-/// writes the run's files there.
+/// writes the run's files there; `progress(cycle, total)` is called as the run goes (at most
+/// a hundred times).
 #[pyfunction]
-#[pyo3(signature = (scenario, seed = None, renderer = "cpu", out = None))]
+#[pyo3(signature = (scenario, seed = None, renderer = "cpu", out = None, progress = None))]
 fn run(
     py: Python<'_>,
     scenario: &PyScenario,
     seed: Option<u64>,
     renderer: &str,
     out: Option<PathBuf>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<RunResult> {
     let choice = simulation::renderer_choice(renderer)?;
     let mut s = scenario.scenario.clone();
     if let Some(seed) = seed {
         s.seed = seed;
     }
+    let mut failed: Option<PyErr> = None;
+    let mut shown = 0;
+    let report = |cycle: u64, total: u64| {
+        let Some(callback) = &progress else { return };
+        let step = (cycle * 100) / total.max(1);
+        if failed.is_some() || (step == shown && cycle != total) {
+            return;
+        }
+        shown = step;
+        Python::attach(|py| {
+            if let Err(e) = callback.call1(py, (cycle, total)) {
+                failed = Some(e);
+            }
+        });
+    };
     let output = py
-        .detach(|| omniloop::Runner::new(&s).renderer(choice).run())
+        .detach(|| {
+            omniloop::Runner::new(&s)
+                .renderer(choice)
+                .progress(report)
+                .run()
+        })
         .map_err(run_error)?;
+    if let Some(e) = failed {
+        return Err(e);
+    }
     if let Some(dir) = &out {
         py.detach(|| omniloop::report::write_run(dir, &s, &output))
             .map_err(|e| PyOSError::new_err(format!("{e:#}")))?;

@@ -4,6 +4,7 @@ import csv
 import math
 
 import numpy as np
+import pytest
 
 import omniloop
 
@@ -33,3 +34,20 @@ def test_the_same_seed_gives_the_same_trajectory(smoke):
     b = omniloop.run(smoke, seed=5).trajectory
     for name in a:
         np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+def test_progress_is_reported_in_order(smoke):
+    calls = []
+    omniloop.run(smoke, progress=lambda cycle, total: calls.append((cycle, total)))
+    assert 10 <= len(calls) <= 101
+    cycles = [c for c, _ in calls]
+    assert cycles == sorted(cycles) and calls[0][0] >= 1
+    assert all(total == smoke.max_cycles for _, total in calls)
+
+
+def test_an_error_in_the_progress_callback_reaches_the_caller(smoke):
+    def fail(cycle, total):
+        raise KeyError("stop")
+
+    with pytest.raises(KeyError, match="stop"):
+        omniloop.run(smoke, progress=fail)
