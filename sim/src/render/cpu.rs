@@ -96,6 +96,8 @@ struct Sectors {
     items: Vec<Item>,
     /// (sector, item) pairs before sorting.
     pairs: Vec<(u16, Item)>,
+    /// Each quad prism's sides, prepared once a frame.
+    quad_sides: Vec<trace::QuadSides>,
 }
 
 fn wrap(a: f32) -> f32 {
@@ -132,6 +134,9 @@ impl Sectors {
     /// Bins the scene's primitives for a sensor axis at `axis` whose rays start up to `rho` mm
     /// from it.
     fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32) {
+        self.quad_sides.clear();
+        self.quad_sides
+            .extend(scene.quads.iter().map(trace::quad_sides));
         let pairs = &mut self.pairs;
         pairs.clear();
         let mut add = |prim: Prim, d_min: f32, centre: f32, half: f32| {
@@ -306,7 +311,13 @@ fn trace_culled(
         }
         let h = match item.prim {
             Prim::Box(i) => trace::hit_box(scene, &scene.boxes[i as usize], o, d, t_max),
-            Prim::Quad(i) => trace::hit_quad(&scene.quads[i as usize], o, d, t_max),
+            Prim::Quad(i) => trace::hit_quad_sides(
+                &scene.quads[i as usize],
+                &sectors.quad_sides[i as usize],
+                o,
+                d,
+                t_max,
+            ),
             Prim::Cylinder(i) => trace::hit_cylinder(&scene.cylinders[i as usize], o, d, t_max),
         };
         if let Some(h) = h {

@@ -46,7 +46,8 @@ impl SensorNoise {
             for c in 0..3 {
                 let v = bytes[c] as f32 + sigma * self.table[idx];
                 idx = (idx + stride) & mask;
-                out[c] = (v + 0.5).floor().clamp(0.0, 255.0) as u8;
+                // Truncating a value clamped to 0..=255 is flooring it: no libm call.
+                out[c] = (v + 0.5).clamp(0.0, 255.0) as u8;
             }
             out[3] = bytes[3];
         }

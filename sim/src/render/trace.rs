@@ -133,13 +133,15 @@ pub fn hit_box(s: &Scene, b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> 
     Some(Hit { t: tn, n, rgb })
 }
 
-/// Entry of the ray into a quadrilateral prism (Cyrus-Beck over its sides, then the slab from
-/// the floor to its top), if before `t_max`.
-pub fn hit_quad(q: &QuadPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
-    let mut tn = f32::NEG_INFINITY;
-    let mut tf = f32::INFINITY;
-    let mut n = [0.0, 0.0, 0.0];
-    for i in 0..4 {
+/// The sides of a quadrilateral prism, prepared once a scene: each side's outward unit normal
+/// and its first corner (`nx, ny, ax, ay`), or `None` for a side too short to have one.
+#[derive(Debug, Clone, Copy)]
+pub struct QuadSides(pub [Option<[f32; 4]>; 4]);
+
+/// The sides of `q` (counter-clockwise corners).
+pub fn quad_sides(q: &QuadPrim) -> QuadSides {
+    let mut sides = [None; 4];
+    for (i, side) in sides.iter_mut().enumerate() {
         let a = q.corner(i);
         let b = q.corner((i + 1) % 4);
         let ex = b[0] - a[0];
@@ -149,9 +151,25 @@ pub fn hit_quad(q: &QuadPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
             continue;
         }
         // Outward normal of a counter-clockwise side.
-        let nx = ey / len;
-        let ny = -ex / len;
-        let num = nx * (o[0] - a[0]) + ny * (o[1] - a[1]);
+        *side = Some([ey / len, -ex / len, a[0], a[1]]);
+    }
+    QuadSides(sides)
+}
+
+/// Entry of the ray into a quadrilateral prism (Cyrus-Beck over its sides, then the slab from
+/// the floor to its top), if before `t_max`.
+pub fn hit_quad(q: &QuadPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
+    hit_quad_sides(q, &quad_sides(q), o, d, t_max)
+}
+
+/// [`hit_quad`] with the prism's sides prepared ([`quad_sides`]): the same operations, so the
+/// same result to the bit.
+pub fn hit_quad_sides(q: &QuadPrim, sides: &QuadSides, o: V3, d: V3, t_max: f32) -> Option<Hit> {
+    let mut tn = f32::NEG_INFINITY;
+    let mut tf = f32::INFINITY;
+    let mut n = [0.0, 0.0, 0.0];
+    for [nx, ny, ax, ay] in sides.0.iter().flatten().copied() {
+        let num = nx * (o[0] - ax) + ny * (o[1] - ay);
         let den = nx * d[0] + ny * d[1];
         if den.abs() < 1e-12 {
             if num > 0.0 {
