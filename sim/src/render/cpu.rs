@@ -29,10 +29,42 @@ struct PixelRay {
 #[derive(Debug, Clone)]
 pub struct SensorRays {
     width: u32,
-    height: u32,
     rays: Vec<PixelRay>,
     axis: [f32; 2],
     max_offset_mm: f32,
+    /// Which pixels' rays may meet the robot's own body, for the body's radius and height
+    /// (bits): the body is fixed to the sensor, so this holds for every pose.
+    body: Option<([u32; 2], Vec<bool>)>,
+}
+
+/// Whether the ray `o + t d` (`t > 0`) comes within `r` of the vertical axis through the
+/// origin somewhere at a height between 0 and `top` (in `f64`: a conservative test).
+fn may_meet_cylinder(o: V3, d: V3, r: f32, top: f32) -> bool {
+    let (ox, oy, oz) = (o[0] as f64, o[1] as f64, o[2] as f64);
+    let (dx, dy, dz) = (d[0] as f64, d[1] as f64, d[2] as f64);
+    // The part of the ray between the heights 0 and top.
+    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+    if dz.abs() < 1e-12 {
+        if oz < 0.0 || oz > top as f64 {
+            return false;
+        }
+    } else {
+        let (a, b) = ((0.0 - oz) / dz, (top as f64 - oz) / dz);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    if t0 > t1 {
+        return false;
+    }
+    // Closest horizontal approach to the axis on [t0, t1].
+    let a = dx * dx + dy * dy;
+    let t = if a < 1e-24 {
+        t0
+    } else {
+        (-(ox * dx + oy * dy) / a).clamp(t0, t1.min(1e12))
+    };
+    let (x, y) = (ox + t * dx, oy + t * dy);
+    x * x + y * y <= (r as f64) * (r as f64)
 }
 
 impl SensorRays {
@@ -65,13 +97,38 @@ impl SensorRays {
         }
         Self {
             width: w,
-            height: h,
             rays,
             axis: [sensor.mount_mm[0] as f32, sensor.mount_mm[1] as f32],
             max_offset_mm: sensor.optics.max_origin_offset_mm() as f32,
+            body: None,
         }
     }
+
+    /// Whether each pixel's ray may meet an upright cylinder of `radius` and height `top` at
+    /// the robot's centre, with [`BODY_MARGIN_MM`] to spare (exact arithmetic on the cached
+    /// robot-frame rays; the margin covers the rounding of the world-frame test it spares).
+    fn prepare_body(&mut self, radius: f32, top: f32) {
+        let key = [radius.to_bits(), top.to_bits()];
+        if self.body.as_ref().is_none_or(|(k, _)| *k != key) {
+            let r = radius + BODY_MARGIN_MM;
+            let z_top = top + BODY_MARGIN_MM;
+            let flags = self
+                .rays
+                .iter()
+                .map(|ray| ray.valid && may_meet_cylinder(ray.o, ray.d, r, z_top))
+                .collect();
+            self.body = Some((key, flags));
+        }
+    }
+
+    /// The flags of the last [`SensorRays::prepare_body`].
+    fn body_flags(&self) -> &[bool] {
+        self.body.as_ref().map_or(&[], |(_, f)| f.as_slice())
+    }
 }
+
+/// Margin (mm) by which a ray must miss the body, in the robot frame, to be left untested.
+const BODY_MARGIN_MM: f32 = 1.0;
 
 const SECTORS: usize = 256;
 
@@ -251,7 +308,7 @@ impl CpuRenderer {
     pub fn render(
         &mut self,
         scene: &Scene,
-        rays: &SensorRays,
+        rays: &mut SensorRays,
         pose: &Isometry2<f64>,
         pixels: &mut [u32],
     ) {
@@ -267,14 +324,28 @@ impl CpuRenderer {
         ];
         let rho = rays.max_offset_mm;
         self.sectors.rebuild(scene, axis, rho);
+        // The robot's own body: the cylinder standing at its centre. The pixels whose rays
+        // surely miss it (the same for every pose) leave it untested.
+        let body = scene
+            .cylinders
+            .iter()
+            .position(|cy| cy.geom[0] == px && cy.geom[1] == py);
+        if let Some(i) = body {
+            let [_, _, r, top] = scene.cylinders[i].geom;
+            rays.prepare_body(r, top);
+        }
+        let rays: &SensorRays = rays;
+        let flags = rays.body_flags();
         let sectors = &self.sectors;
         let theta = theta as f32;
         let scale = SECTORS as f32 / std::f32::consts::TAU;
+        let width = rays.width as usize;
         pixels
-            .par_chunks_mut(rays.width as usize)
-            .zip(rays.rays.par_chunks(rays.width as usize))
-            .for_each(|(row, row_rays)| {
-                for (out, r) in row.iter_mut().zip(row_rays) {
+            .par_chunks_mut(width)
+            .zip(rays.rays.par_chunks(width))
+            .enumerate()
+            .for_each(|(v, (row, row_rays))| {
+                for (u, (out, r)) in row.iter_mut().zip(row_rays).enumerate() {
                     if !r.valid {
                         *out = BLACK;
                         continue;
@@ -286,13 +357,19 @@ impl CpuRenderer {
                     ];
                     let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
                     let sector = ((wrap(r.azimuth + theta) * scale) as usize).min(SECTORS - 1);
-                    *out = trace_culled(scene, sectors, sector, o, d, r.d_xy, rho);
+                    let skip = match body {
+                        Some(i) if !flags[v * width + u] => i as u32,
+                        _ => u32::MAX,
+                    };
+                    *out = trace_culled(scene, sectors, sector, o, d, r.d_xy, rho, skip);
                 }
             });
-        let _ = rays.height;
     }
 }
 
+/// Traces one world ray against the floor and the primitives of its sector (nearest first,
+/// stopping where none can be nearer), leaving out cylinder `skip_cylinder`.
+#[allow(clippy::too_many_arguments)]
 fn trace_culled(
     scene: &Scene,
     sectors: &Sectors,
@@ -301,6 +378,7 @@ fn trace_culled(
     d: V3,
     d_xy: f32,
     rho: f32,
+    skip_cylinder: u32,
 ) -> u32 {
     let mut best: Option<Hit> = trace::hit_floor(scene, o, d);
     let mut t_max = best.map_or(f32::INFINITY, |h| h.t);
@@ -318,6 +396,7 @@ fn trace_culled(
                 d,
                 t_max,
             ),
+            Prim::Cylinder(i) if i == skip_cylinder => None,
             Prim::Cylinder(i) => trace::hit_cylinder(&scene.cylinders[i as usize], o, d, t_max),
         };
         if let Some(h) = h {
@@ -357,4 +436,34 @@ pub fn render_reference(scene: &Scene, rays: &SensorRays, pose: &Isometry2<f64>)
             trace::trace_all(scene, o, d)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::scene::CylinderPrim;
+
+    #[test]
+    fn a_ray_that_meets_the_body_is_never_left_untested() {
+        let body = CylinderPrim {
+            geom: [0.0, 0.0, 90.0, 110.0],
+            color: [0.5, 0.5, 0.5, 0.0],
+        };
+        let (mut hits, mut spared) = (0, 0);
+        for k in 0..20_000u32 {
+            // Rays from above and beside the body in every direction (a fixed spiral).
+            let a = k as f32 * 0.618_034 * std::f32::consts::TAU;
+            let e = -1.4 + 2.6 * ((k * 7919) % 20_000) as f32 / 20_000.0;
+            let o = [25.0 * a.cos(), 25.0 * a.sin(), 120.0 + (k % 90) as f32];
+            let d = [e.cos() * a.cos(), e.cos() * a.sin(), e.sin()];
+            let flagged = may_meet_cylinder(o, d, 90.0 + BODY_MARGIN_MM, 110.0 + BODY_MARGIN_MM);
+            if trace::hit_cylinder(&body, o, d, f32::INFINITY).is_some() {
+                hits += 1;
+                assert!(flagged, "ray {k} meets the body but was not flagged");
+            } else if !flagged {
+                spared += 1;
+            }
+        }
+        assert!(hits > 1000 && spared > 5000, "hits {hits}, spared {spared}");
+    }
 }

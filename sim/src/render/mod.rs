@@ -161,7 +161,7 @@ impl Renderer {
                         self.rays.len() - 1
                     }
                 };
-                c.render(scene, &self.rays[k].1, pose, &mut self.pixels);
+                c.render(scene, &mut self.rays[k].1, pose, &mut self.pixels);
             }
         }
         Ok(&self.pixels)
