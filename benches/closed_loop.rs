@@ -1,5 +1,6 @@
 //! Closed-loop benchmark: control cycles per second of the E1 corner runs (render, free space,
-//! controller, physics, recording) with the CPU renderer and, when an adapter exists, the GPU.
+//! controller, physics, recording) with the CPU renderer on one core and on all cores and, when
+//! an adapter exists, the GPU.
 //!
 //!     cargo bench --bench closed_loop
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
@@ -15,41 +16,52 @@ fn main() {
         "{:<28} {:<44} {:>8} {:>10}",
         "scenario", "renderer", "cycles", "cycles/s"
     );
-    for choice in [RendererChoice::Cpu, RendererChoice::Gpu] {
-        for name in ["corner55_goal_direction", "corner55_velocity_aware"] {
-            let path = common::scenario_path(&format!("{name}.toml"));
-            let s = load_scenario(&path).expect("scenario loads");
-            let options = RunOptions {
-                renderer: choice,
-                ..RunOptions::default()
-            };
-            // Best of three runs (the machine may be shared).
-            let mut best: Option<omniloop::Summary> = None;
-            for _ in 0..3 {
-                match run_scenario(&s, &options, |_| {}, |_, _| {}) {
-                    Ok(out) => {
-                        if best
-                            .as_ref()
-                            .is_none_or(|b| out.summary.cycles_per_s > b.cycles_per_s)
-                        {
-                            best = Some(out.summary);
-                        }
-                    }
-                    Err(e) => {
-                        println!("{name:<28} {choice:?}: not measured ({e})");
-                        break;
+    // The CPU renderer on one core (a pool of one thread: what a run gets per core in a
+    // sweep), then on all of them, then the GPU.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a one-thread pool");
+    one.install(|| measure(RendererChoice::Cpu));
+    measure(RendererChoice::Cpu);
+    measure(RendererChoice::Gpu);
+}
+
+/// Best of three runs of each E1 scenario with `choice`, a line each.
+fn measure(choice: RendererChoice) {
+    for name in ["corner55_goal_direction", "corner55_velocity_aware"] {
+        let path = common::scenario_path(&format!("{name}.toml"));
+        let s = load_scenario(&path).expect("scenario loads");
+        let options = RunOptions {
+            renderer: choice,
+            ..RunOptions::default()
+        };
+        // Best of three runs (the machine may be shared).
+        let mut best: Option<omniloop::Summary> = None;
+        for _ in 0..3 {
+            match run_scenario(&s, &options, |_| {}, |_, _| {}) {
+                Ok(out) => {
+                    if best
+                        .as_ref()
+                        .is_none_or(|b| out.summary.cycles_per_s > b.cycles_per_s)
+                    {
+                        best = Some(out.summary);
                     }
                 }
+                Err(e) => {
+                    println!("{name:<28} {choice:?}: not measured ({e})");
+                    break;
+                }
             }
-            if let Some(m) = best {
-                println!(
-                    "{:<28} {:<44} {:>8} {:>10.0}",
-                    name,
-                    m.renderer.unwrap_or_default(),
-                    m.cycles,
-                    m.cycles_per_s
-                );
-            }
+        }
+        if let Some(m) = best {
+            println!(
+                "{:<28} {:<44} {:>8} {:>10.0}",
+                name,
+                m.renderer.unwrap_or_default(),
+                m.cycles,
+                m.cycles_per_s
+            );
         }
     }
 }

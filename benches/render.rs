@@ -1,7 +1,7 @@
 //! Renderer benchmark: median time per frame (and frames per second) of the field scene seen
-//! through the corner paper's hyperbolic mirror, at 256x220 and 512x512, on the CPU and, when an
-//! adapter exists, the GPU (readback included, noise excluded); then batches of 1, 16 and 256
-//! frames (the GPU traces a batch in one dispatch).
+//! through the corner paper's hyperbolic mirror, at 256x220 and 512x512, on the CPU (one core,
+//! then all cores) and, when an adapter exists, the GPU (readback included, noise excluded);
+//! then batches of 1, 16 and 256 frames (the GPU traces a batch in one dispatch).
 //!
 //!     cargo bench --bench render
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
@@ -45,35 +45,51 @@ fn main() {
     }
     let big = big_spec.build();
 
+    println!(
+        "{:<48} {:>10} {:>12} {:>10}",
+        "renderer", "image", "median ms", "fps"
+    );
+    // The CPU renderer on one core (a pool of one thread), then on all cores, then the GPU.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a one-thread pool");
+    one.install(|| frame_times(&mut Renderer::cpu(), &scene, &[&small, &big], &pose));
     let mut renderers = vec![Renderer::cpu()];
     match Renderer::new(RendererChoice::Gpu, |_| {}) {
         Ok(g) => renderers.push(g),
         Err(e) => println!("GPU: not measured ({e})"),
     }
-    println!(
-        "{:<48} {:>10} {:>12} {:>10}",
-        "renderer", "image", "median ms", "fps"
-    );
     for r in renderers.iter_mut() {
-        for sensor in [&small, &big] {
-            // Warm-up (caches, pipeline, buffers).
-            for _ in 0..5 {
-                r.render_packed(&scene, sensor, &pose).expect("render");
-            }
-            let frames = if sensor.width_px > 256 { 60 } else { 200 };
-            let m = median_ms(frames, || {
-                r.render_packed(&scene, sensor, &pose).expect("render");
-            });
-            println!(
-                "{:<48} {:>10} {:>12.3} {:>10.1}",
-                r.name(),
-                format!("{}x{}", sensor.width_px, sensor.height_px),
-                m,
-                1e3 / m
-            );
-        }
+        frame_times(r, &scene, &[&small, &big], &pose);
     }
     batches(&mut renderers, &scene, &small, &pose);
+}
+
+/// The median time of a clean frame of each sensor, a line each.
+fn frame_times(
+    r: &mut Renderer,
+    scene: &Scene,
+    sensors: &[&omniloop_sim::Sensor],
+    pose: &nalgebra::Isometry2<f64>,
+) {
+    for sensor in sensors {
+        // Warm-up (caches, pipeline, buffers).
+        for _ in 0..5 {
+            r.render_packed(scene, sensor, pose).expect("render");
+        }
+        let frames = if sensor.width_px > 256 { 60 } else { 200 };
+        let m = median_ms(frames, || {
+            r.render_packed(scene, sensor, pose).expect("render");
+        });
+        println!(
+            "{:<48} {:>10} {:>12.3} {:>10.1}",
+            r.name(),
+            format!("{}x{}", sensor.width_px, sensor.height_px),
+            m,
+            1e3 / m
+        );
+    }
 }
 
 /// Frames/s of batches of 1, 16 and 256 frames of the small sensor, each frame at its own pose
