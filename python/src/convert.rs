@@ -29,9 +29,9 @@ pub fn run_error(e: RunError) -> PyErr {
 /// An RGBA image as an `H x W x 3` `uint8` array (the alpha channel, always opaque, dropped).
 pub fn rgb_array<'py>(py: Python<'py>, img: &image::RgbaImage) -> Bound<'py, PyArray3<u8>> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let mut rgb = Vec::with_capacity(w * h * 3);
-    for px in img.as_raw().chunks_exact(4) {
-        rgb.extend_from_slice(&px[..3]);
+    let mut rgb = vec![0u8; w * h * 3];
+    for (out, px) in rgb.chunks_exact_mut(3).zip(img.as_raw().chunks_exact(4)) {
+        out.copy_from_slice(&px[..3]);
     }
     rgb_from_vec(py, h, w, rgb)
 }

@@ -294,30 +294,49 @@ impl Odometry {
 }
 
 /// What the robot's sensors give at the start of a control cycle.
-#[pyclass(module = "omniloop", name = "Observation", frozen, get_all)]
+#[pyclass(module = "omniloop", name = "Observation", frozen)]
 pub struct Observation {
     /// Time of the cycle, s.
+    #[pyo3(get)]
     t_s: f64,
     /// Control cycles run before it.
+    #[pyo3(get)]
     cycle: u64,
     /// Sensor name -> `H x W x 3` `uint8` image.
+    #[pyo3(get)]
     frames: Py<PyDict>,
     /// The last odometry reading.
+    #[pyo3(get)]
     odometry: Py<Odometry>,
     /// Where dead reckoning of the odometry puts the robot, from the start it is told:
     /// `(x_mm, y_mm, theta_rad)` in the world frame.
+    #[pyo3(get)]
     odometry_pose: (f64, f64, f64),
     /// Camera name -> pan angle, rad, for cameras on pan units.
+    #[pyo3(get)]
     actuators: Py<PyDict>,
     /// Whether the run is over (time up, or the goal reached where the run stops there).
+    #[pyo3(get)]
     done: bool,
-    /// With `robot="builtin"`: what the robot believed after the last cycle (its
-    /// `estimates.jsonl` record without the truth); `None` otherwise.
-    estimates: Py<PyAny>,
+    /// With `robot="builtin"`: the last cycle's `estimates.jsonl` line, read into a dict only
+    /// when asked for.
+    record: Option<String>,
 }
 
 #[pymethods]
 impl Observation {
+    /// With `robot="builtin"`: what the robot believed after the last cycle (its
+    /// `estimates.jsonl` record without the truth); `None` otherwise.
+    #[getter]
+    fn estimates<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(line) = &self.record else {
+            return Ok(None);
+        };
+        let record = json_to_py(py, line)?.cast_into::<PyDict>()?;
+        record.del_item("truth")?;
+        Ok(Some(record))
+    }
+
     fn __repr__(&self, py: Python<'_>) -> String {
         let frames: Vec<String> = self
             .frames
@@ -359,16 +378,9 @@ pub fn observation(py: Python<'_>, state: &State) -> PyResult<Observation> {
         let ActuatorState::Pan { sensor, pan_rad } = a;
         actuators.set_item(sensor, pan_rad)?;
     }
-    let estimates = match state.remote {
-        Some(_) => py.None(),
-        None => match last_record(py, state)? {
-            Some(record) => {
-                let record = record.cast_into::<PyDict>()?;
-                record.del_item("truth")?;
-                record.into_any().unbind()
-            }
-            None => py.None(),
-        },
+    let record = match state.remote {
+        Some(_) => None,
+        None => last_line(state),
     };
     let p = state.odometry_pose();
     Ok(Observation {
@@ -379,19 +391,23 @@ pub fn observation(py: Python<'_>, state: &State) -> PyResult<Observation> {
         odometry_pose: (p.translation.x, p.translation.y, p.rotation.angle()),
         actuators: actuators.unbind(),
         done: state.done(),
-        estimates,
+        record,
     })
+}
+
+/// The last cycle's `estimates.jsonl` line (truth included), if a cycle ran.
+fn last_line(state: &State) -> Option<String> {
+    let sim = state.session().simulation();
+    let estimates = sim.estimates();
+    let k = estimates.len().checked_sub(1)?;
+    Some(estimates_line(&sim.trajectory()[k], &estimates[k]))
 }
 
 /// The last cycle's `estimates.jsonl` record as a dict (truth included), if a cycle ran.
 fn last_record<'py>(py: Python<'py>, state: &State) -> PyResult<Option<Bound<'py, PyAny>>> {
-    let sim = state.session().simulation();
-    let estimates = sim.estimates();
-    let Some(k) = estimates.len().checked_sub(1) else {
-        return Ok(None);
-    };
-    let line = estimates_line(&sim.trajectory()[k], &estimates[k]);
-    json_to_py(py, &line).map(Some)
+    last_line(state)
+        .map(|line| json_to_py(py, &line))
+        .transpose()
 }
 
 /// The truth as a dict.
