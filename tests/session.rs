@@ -18,7 +18,7 @@ fn a_session_of_the_builtin_robot_stepped_to_its_end_is_the_whole_run() {
     while !session.finished() {
         session.step().unwrap();
     }
-    let out = session.output().unwrap();
+    let out = session.output_with_files().unwrap();
     assert_eq!(out.trajectory, whole.trajectory);
     assert_eq!(out.summary.cycles, whole.summary.cycles);
     assert_eq!(out.summary.wall_contacts, whole.summary.wall_contacts);
@@ -56,7 +56,7 @@ fn commands_from_outside_drive_the_robot() {
     assert!(moved > 100.0, "moved {moved} mm forward");
     let reading = sim.last_odometry().unwrap();
     assert!(reading.v_body_mm_s.x > 200.0, "{reading:?}");
-    assert_eq!(session.output().unwrap().summary.controller, "outside");
+    assert_eq!(session.output().summary.controller, "outside");
 }
 
 #[test]

@@ -556,7 +556,7 @@ impl PySimulation {
 
     /// The run's `summary.json` so far, as a dict.
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let out = self.lock().session().output().map_err(run_error)?;
+        let out = self.lock().session().output();
         let text = serde_json::to_string(&out.summary)
             .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
         json_to_py(py, &text)
@@ -572,7 +572,7 @@ impl PySimulation {
     /// `trajectory.csv`, `estimates.jsonl`, `topview.png`, the experiment's files) into `dir`.
     fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<()> {
         let state = self.lock();
-        let out = state.session().output().map_err(run_error)?;
+        let out = state.session().output_with_files().map_err(run_error)?;
         let scenario = state.session().simulation().scenario().clone();
         drop(state);
         py.detach(|| omniloop::report::write_run(&dir, &scenario, &out))

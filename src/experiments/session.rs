@@ -96,13 +96,20 @@ impl Session {
     }
 
     /// Everything recorded so far, as [`crate::Runner::run`] gives it at the end: the summary
-    /// with the experiment's metrics, the records, the experiment's files.
-    pub fn output(&self) -> Result<RunOutput, RunError> {
+    /// with the experiment's metrics and the records (the experiment's files are
+    /// [`Session::output_with_files`]'s: drawing them is not needed for a summary).
+    pub fn output(&self) -> RunOutput {
         let mut out = self.sim.output(self.started.elapsed().as_secs_f64());
         if self.loop_s > 0.0 {
             out.summary.cycles_per_s = out.summary.cycles as f64 / self.loop_s;
         }
         out.summary.experiment = self.experiment.metrics(&out);
+        out
+    }
+
+    /// [`Session::output`] with the experiment's own files (tables, figures), to write.
+    pub fn output_with_files(&self) -> Result<RunOutput, RunError> {
+        let mut out = self.output();
         out.files = self.experiment.files(self.sim.scenario(), &out)?;
         Ok(out)
     }
