@@ -262,6 +262,32 @@ pub struct RobotConfig {
 }
 
 impl RobotConfig {
+    /// A robot of the tests: at the origin, a 90 mm body at 400 mm/s and 300 mm/s^2, a 40 ms
+    /// cycle, no camera, goal or map, seed 1 (each test changes what it needs).
+    #[cfg(test)]
+    pub(crate) fn for_tests() -> Self {
+        Self {
+            start: Isometry2::identity(),
+            body: BodySpec {
+                radius_mm: 90.0,
+                max_speed_mm_s: 400.0,
+                accel_limit_mm_s2: 300.0,
+                angular_accel_limit_rad_s2: 10.0,
+            },
+            control_period_s: 0.04,
+            cameras: Vec::new(),
+            calibrations: Vec::new(),
+            columns: Vec::new(),
+            forward_camera: None,
+            vision: VisionSpec::default(),
+            control: ControlSpec::default(),
+            goal: None,
+            map: WorldMap::default(),
+            stereo: None,
+            seed: 1,
+        }
+    }
+
     /// The camera vision uses: `vision.sensor`, or the first camera.
     pub fn vision_camera(&self) -> Option<&str> {
         match &self.vision.sensor {

@@ -87,29 +87,13 @@ impl RobotSoftware for Remote {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{BodySpec, ControlSpec, VisionSpec, WorldMap};
     use nalgebra::Vector2;
 
     fn config() -> RobotConfig {
         RobotConfig {
             start: Isometry2::new(Vector2::new(100.0, -50.0), 0.0),
-            body: BodySpec {
-                radius_mm: 90.0,
-                max_speed_mm_s: 400.0,
-                accel_limit_mm_s2: 1000.0,
-                angular_accel_limit_rad_s2: 8.0,
-            },
-            control_period_s: 0.04,
             cameras: vec!["cam".into()],
-            calibrations: Vec::new(),
-            columns: Vec::new(),
-            forward_camera: None,
-            vision: VisionSpec::default(),
-            control: ControlSpec::default(),
-            goal: None,
-            map: WorldMap::default(),
-            stereo: None,
-            seed: 1,
+            ..RobotConfig::for_tests()
         }
     }
 

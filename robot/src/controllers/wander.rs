@@ -208,7 +208,7 @@ impl Controller for Wander {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{BodySpec, MapSegment, VisionSpec};
+    use crate::config::{BodySpec, MapSegment};
 
     fn config() -> RobotConfig {
         let seg = |a: [f64; 2], b: [f64; 2]| MapSegment {
@@ -225,20 +225,13 @@ mod tests {
                 angular_accel_limit_rad_s2: 8.0,
             },
             control_period_s: 0.05,
-            cameras: Vec::new(),
-            calibrations: Vec::new(),
-            columns: Vec::new(),
-            forward_camera: None,
-            vision: VisionSpec::default(),
-            control: ControlSpec::default(),
-            goal: None,
             map: WorldMap {
                 landmarks: Vec::new(),
                 segments: vec![seg([1000.0, -1000.0], [1000.0, 1000.0])],
                 ..WorldMap::default()
             },
-            stereo: None,
             seed: 3,
+            ..RobotConfig::for_tests()
         }
     }
 

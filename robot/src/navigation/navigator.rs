@@ -534,29 +534,15 @@ fn point_at(path: &[Point2<f64>], s: f64) -> Point2<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{BodySpec, ControlSpec, GoalSpec, MapSegment, VisionSpec, WorldMap};
+    use crate::config::{GoalSpec, MapSegment, WorldMap};
     use std::f64::consts::TAU;
 
     fn robot(map: WorldMap, goal: [f64; 2]) -> RobotConfig {
         RobotConfig {
             start: Isometry2::new(Vector2::new(-1000.0, 0.0), 0.0),
-            body: BodySpec {
-                radius_mm: 90.0,
-                max_speed_mm_s: 400.0,
-                accel_limit_mm_s2: 300.0,
-                angular_accel_limit_rad_s2: 10.0,
-            },
-            control_period_s: 0.04,
-            cameras: Vec::new(),
-            calibrations: Vec::new(),
-            columns: Vec::new(),
-            forward_camera: None,
-            vision: VisionSpec::default(),
-            control: ControlSpec::default(),
             goal: Some(GoalSpec::to(goal, 100.0)),
             map,
-            stereo: None,
-            seed: 1,
+            ..RobotConfig::for_tests()
         }
     }
 
