@@ -496,6 +496,23 @@ mod tests {
         }
     }
 
+    /// Surroundings seen to 1000 mm with no obstacle point: clear points and blind ones.
+    fn unobstructed<'a>(
+        dirs: &'a [f64],
+        free: &'a [f64],
+        clear: &'a [Vec2],
+        blind: &'a [Vec2],
+    ) -> Surroundings<'a> {
+        Surroundings {
+            direction_rad: dirs,
+            free_mm: free,
+            range_mm: 1000.0,
+            obstacle_points: &[],
+            clear_points: clear,
+            blind_points: blind,
+        }
+    }
+
     /// Blind points at the body's edge (90 mm) in the directions `from_deg..=to_deg`, three a
     /// sector of 32 as the near-field memory gives them, and clear space (1000 mm) elsewhere.
     fn blind_arc(from_deg: i32, to_deg: i32) -> (Vec<f64>, Vec<f64>, Vec<Vec2>, Vec<Vec2>) {
@@ -522,14 +539,7 @@ mod tests {
         let c = controller(SpeedChoice::Chosen, false, 400.0);
         let decide = |from: i32, to: i32, goal: Vec2| {
             let (dirs, free, clear, blind) = blind_arc(from, to);
-            let s = Surroundings {
-                direction_rad: &dirs,
-                free_mm: &free,
-                range_mm: 1000.0,
-                obstacle_points: &[],
-                clear_points: &clear,
-                blind_points: &blind,
-            };
+            let s = unobstructed(&dirs, &free, &clear, &blind);
             (c.decide(&s, goal, Vec2::zeros()).v_mm_s, blind)
         };
         // A corner: walls behind and to the right, blind from 225 through 45 degrees (a half
@@ -566,14 +576,8 @@ mod tests {
             .map(|a| Vec2::new(a.cos(), a.sin()) * 1000.0)
             .collect();
         let p = Vec2::new(75.0, 0.0);
-        let s = Surroundings {
-            direction_rad: &dirs,
-            free_mm: &free,
-            range_mm: 1000.0,
-            obstacle_points: &[],
-            clear_points: &clear,
-            blind_points: &[p],
-        };
+        let blind = [p];
+        let s = unobstructed(&dirs, &free, &clear, &blind);
         let slant = 40f64.to_radians();
         let goal = Vec2::new(slant.cos(), slant.sin()) * 1000.0;
         let v = c.decide(&s, goal, Vec2::zeros()).v_mm_s;
