@@ -8,7 +8,7 @@
 //! binning is conservative, so the image is the same as tracing every primitive.
 
 use super::scene::Scene;
-use super::trace::{self, BLACK, Hit, V3};
+use super::trace::{self, BLACK, FloorPaint, Hit, V3};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
 use rayon::prelude::*;
@@ -141,8 +141,29 @@ enum Prim {
 
 #[derive(Debug, Clone, Copy)]
 struct Item {
+    /// Horizontal distance (mm) from the sensor axis to the nearest point of the footprint.
     d_min: f32,
+    /// Horizontal distance (mm) from the sensor axis to the farthest point of the footprint,
+    /// plus the rays' largest offset from the axis and [`CULL_MARGIN_MM`].
+    reach: f32,
+    /// Height (mm) of the primitive's top, plus [`CULL_MARGIN_MM`].
+    top: f32,
     prim: Prim,
+}
+
+/// Margin (mm) by which a ray must pass over a primitive to leave it untested: far more than
+/// the rounding of the `f32` hit tests it spares.
+const CULL_MARGIN_MM: f32 = 1.0;
+
+impl Item {
+    /// Whether a ray from height `oz` (mm) with direction `d` (horizontal length `d_xy`) stays
+    /// above the primitive's top until it is farther from the axis than the whole footprint:
+    /// above the top while `t < (oz - top) / -d_z`, beyond the footprint once
+    /// `t d_xy - rho > d_max`, that is `t > reach / d_xy`.
+    fn passes_over(&self, oz: f32, dz: f32, d_xy: f32) -> bool {
+        let above = oz - self.top;
+        above > 0.0 && (dz >= 0.0 || above * d_xy > self.reach * -dz)
+    }
 }
 
 /// Primitives binned by azimuth around the sensor axis, each bin sorted by distance. The
@@ -155,11 +176,22 @@ struct Sectors {
     pairs: Vec<(u16, Item)>,
     /// Each quad prism's sides, prepared once a frame.
     quad_sides: Vec<trace::QuadSides>,
+    /// The shaded, packed colour of each floor paint: one per floor rectangle, then outside,
+    /// line and bare floor.
+    palette: Vec<u32>,
 }
 
 fn wrap(a: f32) -> f32 {
     let t = std::f32::consts::TAU;
     a - (a / t).floor() * t
+}
+
+/// Distance from the origin to the farthest of `corners`.
+fn farthest(corners: &[[f32; 2]]) -> f32 {
+    corners
+        .iter()
+        .map(|c| (c[0] * c[0] + c[1] * c[1]).sqrt())
+        .fold(0.0, f32::max)
 }
 
 /// Distance from the origin to a convex polygon given relative to it (counter-clockwise), and
@@ -194,10 +226,27 @@ impl Sectors {
         self.quad_sides.clear();
         self.quad_sides
             .extend(scene.quads.iter().map(trace::quad_sides));
+        let floor = |paint| {
+            let rgb = trace::paint_color(scene, paint);
+            let n = trace::FLOOR_NORMAL;
+            trace::pack(trace::shade(scene, &Hit { t: 0.0, n, rgb }))
+        };
+        let paints = (0..scene.floor_rects.len()).map(FloorPaint::Mark).chain([
+            FloorPaint::Outside,
+            FloorPaint::Line,
+            FloorPaint::Floor,
+        ]);
+        self.palette.clear();
+        self.palette.extend(paints.map(floor));
         let pairs = &mut self.pairs;
         pairs.clear();
-        let mut add = |prim: Prim, d_min: f32, centre: f32, half: f32| {
-            let item = Item { d_min, prim };
+        let mut add = |prim: Prim, d_min: f32, d_max: f32, top: f32, centre: f32, half: f32| {
+            let item = Item {
+                d_min,
+                reach: d_max + rho + CULL_MARGIN_MM,
+                top: top + CULL_MARGIN_MM,
+                prim,
+            };
             if d_min <= 2.0 * rho + 1.0 || half >= std::f32::consts::PI {
                 pairs.extend((0..SECTORS).map(|k| (k as u16, item)));
                 return;
@@ -212,37 +261,55 @@ impl Sectors {
         };
         for (i, b) in scene.boxes.iter().enumerate() {
             let [cx, cy, hx, hy] = b.geom;
-            let [c, s, _, _] = b.frame;
+            let [c, s, _, top] = b.frame;
             let rx = axis[0] - cx;
             let ry = axis[1] - cy;
             let lx = (c * rx + s * ry).abs() - hx;
             let ly = (-s * rx + c * ry).abs() - hy;
             let d_min = (lx.max(0.0).powi(2) + ly.max(0.0).powi(2)).sqrt();
+            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
+                [
+                    cx + c * sx * hx - s * sy * hy - axis[0],
+                    cy + s * sx * hx + c * sy * hy - axis[1],
+                ]
+            });
+            let d_max = farthest(&corners);
             if lx <= 0.0 && ly <= 0.0 {
-                add(Prim::Box(i as u32), 0.0, 0.0, std::f32::consts::PI);
+                add(
+                    Prim::Box(i as u32),
+                    0.0,
+                    d_max,
+                    top,
+                    0.0,
+                    std::f32::consts::PI,
+                );
                 continue;
             }
             let centre = (cy - axis[1]).atan2(cx - axis[0]);
             let mut half: f32 = 0.0;
-            for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                let px = cx + c * sx * hx - s * sy * hy - axis[0];
-                let py = cy + s * sx * hx + c * sy * hy - axis[1];
+            for [px, py] in corners {
                 let mut da = py.atan2(px) - centre;
                 da -= (da / std::f32::consts::TAU).round() * std::f32::consts::TAU;
                 half = half.max(da.abs());
             }
-            add(Prim::Box(i as u32), d_min, centre, half);
+            add(Prim::Box(i as u32), d_min, d_max, top, centre, half);
         }
         for (i, q) in scene.quads.iter().enumerate() {
-            let corners: Vec<[f32; 2]> = (0..4)
-                .map(|k| {
-                    let c = q.corner(k);
-                    [c[0] - axis[0], c[1] - axis[1]]
-                })
-                .collect();
+            let corners = [0, 1, 2, 3].map(|k| {
+                let c = q.corner(k);
+                [c[0] - axis[0], c[1] - axis[1]]
+            });
             let (d_min, inside) = polygon_distance(&corners);
+            let (d_max, top) = (farthest(&corners), q.z[0]);
             if inside {
-                add(Prim::Quad(i as u32), 0.0, 0.0, std::f32::consts::PI);
+                add(
+                    Prim::Quad(i as u32),
+                    0.0,
+                    d_max,
+                    top,
+                    0.0,
+                    std::f32::consts::PI,
+                );
                 continue;
             }
             let (sx, sy) = corners
@@ -255,20 +322,29 @@ impl Sectors {
                 da -= (da / std::f32::consts::TAU).round() * std::f32::consts::TAU;
                 half = half.max(da.abs());
             }
-            add(Prim::Quad(i as u32), d_min, centre, half);
+            add(Prim::Quad(i as u32), d_min, d_max, top, centre, half);
         }
         for (i, cyl) in scene.cylinders.iter().enumerate() {
-            let [cx, cy, r, _] = cyl.geom;
+            let [cx, cy, r, top] = cyl.geom;
             let dx = cx - axis[0];
             let dy = cy - axis[1];
             let dc = (dx * dx + dy * dy).sqrt();
             if dc <= r {
-                add(Prim::Cylinder(i as u32), 0.0, 0.0, std::f32::consts::PI);
+                add(
+                    Prim::Cylinder(i as u32),
+                    0.0,
+                    dc + r,
+                    top,
+                    0.0,
+                    std::f32::consts::PI,
+                );
                 continue;
             }
             add(
                 Prim::Cylinder(i as u32),
                 dc - r,
+                dc + r,
+                top,
                 dy.atan2(dx),
                 (r / dc).asin(),
             );
@@ -380,12 +456,17 @@ fn trace_culled(
     rho: f32,
     skip_cylinder: u32,
 ) -> u32 {
-    let mut best: Option<Hit> = trace::hit_floor(scene, o, d);
-    let mut t_max = best.map_or(f32::INFINITY, |h| h.t);
+    // The floor's colour is looked up only if nothing nearer hides it.
+    let t_floor = trace::floor_t(o, d);
+    let mut best: Option<Hit> = None;
+    let mut t_max = t_floor.unwrap_or(f32::INFINITY);
     let range = sectors.offsets[sector] as usize..sectors.offsets[sector + 1] as usize;
     for item in &sectors.items[range] {
         if item.d_min >= t_max * d_xy + rho + 1.0 {
             break;
+        }
+        if item.passes_over(o[2], d[2], d_xy) {
+            continue;
         }
         let h = match item.prim {
             Prim::Box(i) => trace::hit_box(scene, &scene.boxes[i as usize], o, d, t_max),
@@ -404,9 +485,19 @@ fn trace_culled(
             best = Some(h);
         }
     }
-    match best {
-        Some(h) => trace::pack(trace::shade(scene, &h)),
-        None => trace::pack([
+    match (best, t_floor) {
+        (Some(h), _) => trace::pack(trace::shade(scene, &h)),
+        (None, Some(t)) => {
+            let paint = trace::floor_paint(scene, o[0] + t * d[0], o[1] + t * d[1]);
+            let n = scene.floor_rects.len();
+            sectors.palette[match paint {
+                FloorPaint::Mark(i) => i,
+                FloorPaint::Outside => n,
+                FloorPaint::Line => n + 1,
+                FloorPaint::Floor => n + 2,
+            }]
+        }
+        (None, None) => trace::pack([
             scene.globals.sky_rgb[0],
             scene.globals.sky_rgb[1],
             scene.globals.sky_rgb[2],
@@ -442,6 +533,45 @@ pub fn render_reference(scene: &Scene, rays: &SensorRays, pose: &Isometry2<f64>)
 mod tests {
     use super::*;
     use crate::render::scene::CylinderPrim;
+
+    #[test]
+    fn a_ray_that_meets_a_primitive_never_passes_over_it() {
+        // A pillar 600 mm from the axis: rays from mirror heights in every direction.
+        let pillar = CylinderPrim {
+            geom: [600.0, 0.0, 60.0, 150.0],
+            color: [0.5, 0.5, 0.5, 0.0],
+        };
+        let rho = 20.0;
+        let item = Item {
+            d_min: 540.0,
+            reach: 660.0 + rho + CULL_MARGIN_MM,
+            top: 150.0 + CULL_MARGIN_MM,
+            prim: Prim::Cylinder(0),
+        };
+        let (mut hits, mut culled) = (0, 0);
+        for k in 0..40_000u32 {
+            let a = -0.2 + 0.4 * (k % 200) as f32 / 200.0;
+            let e = -0.6 + 0.8 * (k / 200) as f32 / 200.0;
+            let o = [
+                rho * (k as f32).cos(),
+                rho * (k as f32).sin(),
+                151.0 + (k % 70) as f32,
+            ];
+            let d = [e.cos() * a.cos(), e.cos() * a.sin(), e.sin()];
+            let d_xy = (d[0] * d[0] + d[1] * d[1]).sqrt();
+            let over = item.passes_over(o[2], d[2], d_xy);
+            if trace::hit_cylinder(&pillar, o, d, f32::INFINITY).is_some() {
+                hits += 1;
+                assert!(!over, "ray {k} meets the pillar but passes over it");
+            } else if over {
+                culled += 1;
+            }
+        }
+        assert!(
+            hits > 1000 && culled > 10_000,
+            "hits {hits}, culled {culled}"
+        );
+    }
 
     #[test]
     fn a_ray_that_meets_the_body_is_never_left_untested() {

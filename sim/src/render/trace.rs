@@ -25,13 +25,26 @@ pub struct Hit {
     pub rgb: V3,
 }
 
-/// Colour of the floor at `(x, y)`: a mark painted on it (the last that covers the point),
+/// What covers the floor at a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FloorPaint {
+    /// A mark painted on the floor (index into `Scene::floor_rects`).
+    Mark(usize),
+    /// Outside every floor region.
+    Outside,
+    /// A field line.
+    Line,
+    /// The bare floor.
+    Floor,
+}
+
+/// What covers the floor at `(x, y)`: a mark painted on it (the last that covers the point),
 /// floor region, field lines or outside.
-pub fn floor_color(s: &Scene, x: f32, y: f32) -> V3 {
+pub fn floor_paint(s: &Scene, x: f32, y: f32) -> FloorPaint {
     let g = &s.globals;
     let mut inside = g.flags[1] == 0;
     let mut mark = None;
-    for r in &s.floor_rects {
+    for (i, r) in s.floor_rects.iter().enumerate() {
         let dx = x - r.geom[0];
         let dy = y - r.geom[1];
         let lx = r.frame[0] * dx + r.frame[1] * dy;
@@ -41,17 +54,17 @@ pub fn floor_color(s: &Scene, x: f32, y: f32) -> V3 {
             inside |= in_rect;
         } else if r.frame[2] == SQUARE_MARK {
             if in_rect {
-                mark = Some(r);
+                mark = Some(i);
             }
         } else if lx * lx + ly * ly <= r.geom[2] * r.geom[2] {
-            mark = Some(r);
+            mark = Some(i);
         }
     }
     if let Some(m) = mark {
-        return [m.color[0], m.color[1], m.color[2]];
+        return FloorPaint::Mark(m);
     }
     if !inside {
-        return [g.outside_rgb[0], g.outside_rgb[1], g.outside_rgb[2]];
+        return FloorPaint::Outside;
     }
     if g.flags[0] != 0 {
         let ax = x.abs();
@@ -62,12 +75,41 @@ pub fn floor_color(s: &Scene, x: f32, y: f32) -> V3 {
             let centre = ax <= 0.5 * w;
             let circle = ((x * x + y * y).sqrt() - cr).abs() <= 0.5 * w;
             if boundary || centre || circle {
-                return [g.line_rgb[0], g.line_rgb[1], g.line_rgb[2]];
+                return FloorPaint::Line;
             }
         }
     }
-    [g.floor_rgb[0], g.floor_rgb[1], g.floor_rgb[2]]
+    FloorPaint::Floor
 }
+
+/// The colour of a floor paint.
+pub fn paint_color(s: &Scene, paint: FloorPaint) -> V3 {
+    let g = &s.globals;
+    let c = match paint {
+        FloorPaint::Mark(i) => s.floor_rects[i].color,
+        FloorPaint::Outside => g.outside_rgb,
+        FloorPaint::Line => g.line_rgb,
+        FloorPaint::Floor => g.floor_rgb,
+    };
+    [c[0], c[1], c[2]]
+}
+
+/// Colour of the floor at `(x, y)` ([`floor_paint`]'s colour).
+pub fn floor_color(s: &Scene, x: f32, y: f32) -> V3 {
+    paint_color(s, floor_paint(s, x, y))
+}
+
+/// The distance along the ray to the floor, if it goes down to it.
+pub fn floor_t(o: V3, d: V3) -> Option<f32> {
+    if d[2] >= 0.0 {
+        return None;
+    }
+    let t = -o[2] / d[2];
+    (t > T_EPS).then_some(t)
+}
+
+/// The normal of the floor.
+pub const FLOOR_NORMAL: V3 = [0.0, 0.0, 1.0];
 
 /// Slab interval of `o + t d` in `[lo, hi]`; `None` when parallel and outside.
 fn slab(o: f32, d: f32, lo: f32, hi: f32) -> Option<(f32, f32)> {
@@ -245,18 +287,12 @@ pub fn hit_cylinder(cy: &CylinderPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> 
 
 /// The floor hit, if the ray goes down.
 pub fn hit_floor(s: &Scene, o: V3, d: V3) -> Option<Hit> {
-    if d[2] >= 0.0 {
-        return None;
-    }
-    let t = -o[2] / d[2];
-    if t <= T_EPS {
-        return None;
-    }
+    let t = floor_t(o, d)?;
     let x = o[0] + t * d[0];
     let y = o[1] + t * d[1];
     Some(Hit {
         t,
-        n: [0.0, 0.0, 1.0],
+        n: FLOOR_NORMAL,
         rgb: floor_color(s, x, y),
     })
 }
