@@ -1,7 +1,8 @@
 //! Renderer benchmark: median time per frame (and frames per second) of the field scene seen
 //! through the corner paper's hyperbolic mirror, at 256x220 and 512x512, on the CPU (one core,
-//! then all cores) and, when an adapter exists, the GPU (readback included, noise excluded);
-//! then batches of 1, 16 and 256 frames (the GPU traces a batch in one dispatch).
+//! then all cores) and, when an adapter exists, the GPU (readback and the sensor noise included,
+//! as a run draws them); then batches of 1, 16, 256 and 1024 noisy frames (the GPU traces a
+//! batch in one dispatch).
 //!
 //!     cargo bench --bench render
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
@@ -9,7 +10,8 @@
 mod common;
 
 use omniloop::load_scenario;
-use omniloop_sim::{FrameRequest, Renderer, RendererChoice, Scene, World};
+use omniloop_sim::render::noise::frame_key;
+use omniloop_sim::{FrameNoise, FrameRequest, Renderer, RendererChoice, Scene, SensorNoise, World};
 use std::time::Instant;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -66,7 +68,7 @@ fn main() {
     batches(&mut renderers, &scene, &small, &pose);
 }
 
-/// The median time of a clean frame of each sensor, a line each.
+/// The median time of a noisy frame of each sensor, a line each.
 fn frame_times(
     r: &mut Renderer,
     scene: &Scene,
@@ -75,12 +77,15 @@ fn frame_times(
 ) {
     for sensor in sensors {
         // Warm-up (caches, pipeline, buffers).
+        let mut noise = SensorNoise::new(1);
         for _ in 0..5 {
-            r.render_packed(scene, sensor, pose).expect("render");
+            r.render(scene, sensor, pose, Some(&mut noise))
+                .expect("render");
         }
         let frames = if sensor.width_px > 256 { 60 } else { 200 };
         let m = median_ms(frames, || {
-            r.render_packed(scene, sensor, pose).expect("render");
+            r.render(scene, sensor, pose, Some(&mut noise))
+                .expect("render");
         });
         println!(
             "{:<48} {:>10} {:>12.3} {:>10.1}",
@@ -92,7 +97,7 @@ fn frame_times(
     }
 }
 
-/// Frames/s of batches of 1, 16 and 256 frames of the small sensor, each frame at its own pose
+/// Frames/s of batches of 1, 16, 256 and 1024 noisy frames of the small sensor, each frame at its own pose
 /// (a step apart along x): on the GPU one dispatch and one readback a batch, on the CPU the
 /// frames one after the other.
 fn batches(
@@ -105,7 +110,7 @@ fn batches(
         "\n{:<48} {:>10} {:>12} {:>10}",
         "batched (256x220)", "batch", "median ms", "frames/s"
     );
-    let poses: Vec<nalgebra::Isometry2<f64>> = (0..256)
+    let poses: Vec<nalgebra::Isometry2<f64>> = (0..1024)
         .map(|k| {
             let mut p = *pose;
             p.translation.x += 2.0 * k as f64;
@@ -113,20 +118,25 @@ fn batches(
         })
         .collect();
     for r in renderers.iter_mut() {
-        for n in [1usize, 16, 256] {
+        for n in [1usize, 16, 256, 1024] {
             if !r.is_gpu() && n > 16 {
                 continue;
             }
             let requests: Vec<FrameRequest> = poses[..n]
                 .iter()
-                .map(|p| FrameRequest {
+                .enumerate()
+                .map(|(k, p)| FrameRequest {
                     scene,
                     sensor,
                     pose: p,
+                    noise: Some(FrameNoise {
+                        key: frame_key(1, k as u64),
+                        sigma: sensor.noise_sigma as f32,
+                    }),
                 })
                 .collect();
             r.render_batch_packed(&requests).expect("render");
-            let reps = if n >= 256 { 5 } else { 20 };
+            let reps = if n >= 256 { 3 } else { 20 };
             let m = median_ms(reps, || {
                 r.render_batch_packed(&requests).expect("render");
             });

@@ -304,7 +304,8 @@ fn gpu_and_cpu_renders_agree() {
     for (name, pose) in compared_scenes() {
         let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
         for spec in &s.robot.sensors {
-            // Noise on: both draw it from the same seeded generator.
+            // Noise on: the GPU draws it in the shader, the CPU after tracing, from the same
+            // counter (the frame's key, the pixel, the channel).
             let a = render_snapshot(&s, &mut cpu, Some(&spec.name), pose, true).unwrap();
             let b = render_snapshot(&s, &mut gpu, Some(&spec.name), pose, true).unwrap();
             let total = (a.width() * a.height()) as usize;
@@ -359,6 +360,7 @@ fn a_gpu_batch_equals_its_frames_traced_one_by_one() {
             scene,
             sensor,
             pose,
+            noise: None,
         })
         .collect();
     let batch = gpu.render_batch_packed(&requests).unwrap();

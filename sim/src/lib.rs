@@ -19,7 +19,9 @@ pub use corridor::Corridor;
 pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use floor_rect::FloorRect;
 pub use layout::{Board, Cube, FieldSpec, Layout, Pillar, Wall};
-pub use render::{FrameRequest, RenderError, Renderer, RendererChoice, Scene, SensorNoise};
+pub use render::{
+    FrameNoise, FrameRequest, RenderError, Renderer, RendererChoice, Scene, SensorNoise,
+};
 pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};
 pub use world::{RobotBodySpec, RobotState, RobotStats, World};

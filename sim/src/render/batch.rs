@@ -6,6 +6,7 @@
 
 use super::error::RenderError;
 use super::gpu::{FrameRequest, GpuRenderer};
+use super::noise::FrameNoise;
 use super::scene::Scene;
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
@@ -17,6 +18,7 @@ struct Pending {
     scene: Scene,
     sensor: Sensor,
     pose: Isometry2<f64>,
+    noise: Option<FrameNoise>,
     reply: Sender<Result<Vec<u32>, String>>,
 }
 
@@ -103,12 +105,14 @@ impl BatchClient {
         scene: &Scene,
         sensor: &Sensor,
         pose: &Isometry2<f64>,
+        noise: Option<FrameNoise>,
     ) -> Result<Vec<u32>, RenderError> {
         let (reply, rx) = channel();
         let frame = Pending {
             scene: scene.clone(),
             sensor: sensor.clone(),
             pose: *pose,
+            noise,
             reply,
         };
         let gone = || RenderError::Device("the batch renderer stopped".into());
@@ -179,6 +183,7 @@ fn flush(gpu: &mut GpuRenderer, pending: &mut Vec<Pending>) {
             scene: &p.scene,
             sensor: &p.sensor,
             pose: &p.pose,
+            noise: p.noise,
         })
         .collect();
     match gpu.render_batch(&requests) {

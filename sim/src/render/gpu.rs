@@ -8,6 +8,7 @@
 //! room and are reused otherwise.
 
 use super::error::RenderError;
+use super::noise::{FrameNoise, gauss_table};
 use super::scene::{
     BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals,
 };
@@ -30,7 +31,7 @@ struct SensorParams {
 }
 
 impl SensorParams {
-    fn new(s: &Sensor, pose: &Isometry2<f64>) -> Self {
+    fn new(s: &Sensor, pose: &Isometry2<f64>, sigma: f32) -> Self {
         let mut p1 = [0.0f32; 4];
         let mut p2 = [0.0f32; 4];
         let p0;
@@ -75,7 +76,7 @@ impl SensorParams {
         let theta = pose.rotation.angle();
         Self {
             size: [s.width_px, s.height_px, kind, 0],
-            intr: [s.cx_px as f32, s.cy_px as f32, focal as f32, 0.0],
+            intr: [s.cx_px as f32, s.cy_px as f32, focal as f32, sigma],
             p0,
             p1,
             p2,
@@ -90,7 +91,8 @@ impl SensorParams {
     }
 }
 
-/// One frame's header in a batch (`Frame` of `trace.wgsl`).
+/// One frame's header in a batch (`Frame` of `trace.wgsl`); the noise's sigma rides in the
+/// sensor's `intr.w`, its key in `offsets2.w`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 struct FrameParams {
@@ -98,11 +100,11 @@ struct FrameParams {
     sensor: SensorParams,
     /// First box, cylinder, board, stripe edge.
     offsets: [u32; 4],
-    /// First floor rectangle, quad, pixel; unused.
+    /// First floor rectangle, quad, pixel; the noise's key.
     offsets2: [u32; 4],
 }
 
-/// One frame to trace: the scene, the sensor and the robot's pose.
+/// One frame to trace: the scene, the sensor, the robot's pose and the frame's noise.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameRequest<'a> {
     /// The scene.
@@ -111,6 +113,8 @@ pub struct FrameRequest<'a> {
     pub sensor: &'a Sensor,
     /// The robot's pose.
     pub pose: &'a Isometry2<f64>,
+    /// The frame's sensor noise, drawn by the shader as on the CPU (`None`: a clean frame).
+    pub noise: Option<FrameNoise>,
 }
 
 /// The concatenated primitives and headers of a batch.
@@ -133,16 +137,17 @@ impl Batch {
             |n: usize| u32::try_from(n).map_err(|_| RenderError::Device("batch too large".into()));
         for r in requests {
             let sc = r.scene;
+            let (key, sigma) = r.noise.map_or((0, 0.0), |n| (n.key, n.sigma));
             b.frames.push(FrameParams {
                 globals: sc.globals,
-                sensor: SensorParams::new(r.sensor, r.pose),
+                sensor: SensorParams::new(r.sensor, r.pose, sigma),
                 offsets: [
                     at(b.boxes.len())?,
                     at(b.cylinders.len())?,
                     at(b.boards.len())?,
                     at(b.stripes.len())?,
                 ],
-                offsets2: [at(b.rects.len())?, at(b.quads.len())?, at(b.pixels)?, 0],
+                offsets2: [at(b.rects.len())?, at(b.quads.len())?, at(b.pixels)?, key],
             });
             b.boxes.extend_from_slice(&sc.boxes);
             b.cylinders.extend_from_slice(&sc.cylinders);
@@ -217,6 +222,8 @@ pub struct GpuRenderer {
     stripes: Storage,
     rects: Storage,
     quads: Storage,
+    /// The noise's Gaussian table, written once.
+    gauss: wgpu::Buffer,
     pixels: wgpu::Buffer,
     readback: wgpu::Buffer,
     pixel_capacity: u64,
@@ -298,6 +305,7 @@ impl GpuRenderer {
                 entry(6, ro),
                 entry(7, B::Storage { read_only: false }),
                 entry(8, ro),
+                entry(9, ro),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -325,6 +333,14 @@ impl GpuRenderer {
         let stripes = Storage::new(&device, "stripes", 64 * 4, STORAGE_RW);
         let rects = Storage::new(&device, "rects", 8 * 48, STORAGE_RW);
         let quads = Storage::new(&device, "quads", 16 * 64, STORAGE_RW);
+        let table: &[u8] = bytemuck::cast_slice(gauss_table());
+        let gauss = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("gauss"),
+            size: table.len() as u64,
+            usage: STORAGE_RW,
+            mapped_at_creation: false,
+        });
+        queue.write_buffer(&gauss, 0, table);
         let (pixels, readback) = Self::pixel_buffers(&device, 256 * 256 * 4);
         Ok(Self {
             device,
@@ -339,6 +355,7 @@ impl GpuRenderer {
             stripes,
             rects,
             quads,
+            gauss,
             pixels,
             readback,
             pixel_capacity: 256 * 256 * 4,
@@ -367,12 +384,14 @@ impl GpuRenderer {
         &self.adapter_name
     }
 
-    /// Renders one frame into `out` (packed RGBA8, `width * height` pixels).
+    /// Renders one frame with `noise` (none: clean) into `out` (packed RGBA8, `width *
+    /// height` pixels).
     pub fn render(
         &mut self,
         scene: &Scene,
         sensor: &Sensor,
         pose: &Isometry2<f64>,
+        noise: Option<FrameNoise>,
         out: &mut [u32],
     ) -> Result<(), RenderError> {
         let n = (sensor.width_px * sensor.height_px) as usize;
@@ -381,6 +400,7 @@ impl GpuRenderer {
             scene,
             sensor,
             pose,
+            noise,
         };
         self.trace(&[request], |all| out.copy_from_slice(all))
     }
@@ -482,6 +502,7 @@ impl GpuRenderer {
             (6, &self.rects.buffer),
             (7, &self.pixels),
             (8, &self.quads.buffer),
+            (9, &self.gauss),
         ];
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()

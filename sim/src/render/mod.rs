@@ -13,7 +13,7 @@ pub use batch::{BatchClient, BatchHandle, BatchServer};
 pub use cpu::{CpuRenderer, SensorRays};
 pub use error::RenderError;
 pub use gpu::{FrameRequest, GpuRenderer};
-pub use noise::SensorNoise;
+pub use noise::{FrameNoise, SensorNoise};
 pub use scene::Scene;
 
 use crate::sensor::Sensor;
@@ -141,11 +141,24 @@ impl Renderer {
         sensor: &Sensor,
         pose: &Isometry2<f64>,
     ) -> Result<&[u32], RenderError> {
+        self.trace(scene, sensor, pose, None)?;
+        Ok(&self.pixels)
+    }
+
+    /// Traces a frame into the scratch buffer: on a GPU with `noise` drawn by the shader
+    /// (returns true), on the CPU clean (returns false: the noise is the caller's to draw).
+    fn trace(
+        &mut self,
+        scene: &Scene,
+        sensor: &Sensor,
+        pose: &Isometry2<f64>,
+        noise: Option<FrameNoise>,
+    ) -> Result<bool, RenderError> {
         let n = (sensor.width_px * sensor.height_px) as usize;
         self.pixels.resize(n, 0);
         match &mut self.backend {
-            Backend::Gpu(g) => g.render(scene, sensor, pose, &mut self.pixels)?,
-            Backend::Shared(client) => self.pixels = client.render(scene, sensor, pose)?,
+            Backend::Gpu(g) => g.render(scene, sensor, pose, noise, &mut self.pixels)?,
+            Backend::Shared(client) => self.pixels = client.render(scene, sensor, pose, noise)?,
             Backend::Cpu(c) => {
                 // One cache entry a sensor name, traced again when the sensor changed (a camera
                 // on a pan unit).
@@ -162,13 +175,14 @@ impl Renderer {
                     }
                 };
                 c.render(scene, &mut self.rays[k].1, pose, &mut self.pixels);
+                return Ok(false);
             }
         }
-        Ok(&self.pixels)
+        Ok(true)
     }
 
-    /// Renders the clean frames of `requests` as packed RGBA8, in order: on the GPU in one
-    /// dispatch with one readback, on the CPU one after the other.
+    /// Renders the frames of `requests` (each with its noise, if any) as packed RGBA8, in
+    /// order: on the GPU in one dispatch with one readback, on the CPU one after the other.
     pub fn render_batch_packed(
         &mut self,
         requests: &[FrameRequest<'_>],
@@ -176,13 +190,27 @@ impl Renderer {
         if let Backend::Gpu(g) = &mut self.backend {
             return g.render_batch(requests);
         }
-        requests
-            .iter()
-            .map(|r| Ok(self.render_packed(r.scene, r.sensor, r.pose)?.to_vec()))
-            .collect()
+        let mut out = Vec::with_capacity(requests.len());
+        for r in requests {
+            let drawn = self.trace(r.scene, r.sensor, r.pose, r.noise)?;
+            match r.noise {
+                Some(n) if !drawn => {
+                    let mut rgba = vec![0u8; self.pixels.len() * 4];
+                    noise::apply(&self.pixels, n, &mut rgba);
+                    out.push(
+                        rgba.chunks_exact(4)
+                            .map(|p| u32::from_le_bytes([p[0], p[1], p[2], p[3]]))
+                            .collect(),
+                    );
+                }
+                _ => out.push(self.pixels.clone()),
+            }
+        }
+        Ok(out)
     }
 
-    /// Renders a frame with the sensor's noise drawn from `noise` (or none when `None`).
+    /// Renders a frame with the sensor's noise, the next frame of `noise` (or none when
+    /// `None`): the GPU draws it in the shader, the CPU after tracing, the same values.
     pub fn render(
         &mut self,
         scene: &Scene,
@@ -191,12 +219,12 @@ impl Renderer {
         noise: Option<&mut SensorNoise>,
     ) -> Result<RgbaImage, RenderError> {
         let mut img = RgbaImage::new(sensor.width_px, sensor.height_px);
-        let sigma = sensor.noise_sigma as f32;
-        let pixels = self.render_packed(scene, sensor, pose)?;
-        match noise {
-            Some(n) => n.apply(pixels, sigma, &mut img),
-            None => {
-                for (p, out) in pixels.iter().zip(img.chunks_exact_mut(4)) {
+        let frame_noise = noise.map(|n| n.next_frame(sensor.noise_sigma as f32));
+        let drawn = self.trace(scene, sensor, pose, frame_noise)?;
+        match frame_noise {
+            Some(fnz) if !drawn => noise::apply(&self.pixels, fnz, &mut img),
+            _ => {
+                for (p, out) in self.pixels.iter().zip(img.chunks_exact_mut(4)) {
                     out.copy_from_slice(&p.to_le_bytes());
                 }
             }

@@ -17,7 +17,7 @@ struct Globals {
 
 struct SensorParams {
     size: vec4<u32>,        // width, height, kind, unused
-    intr: vec4<f32>,        // cx, cy, focal, unused
+    intr: vec4<f32>,        // cx, cy, focal, noise sigma (0: none)
     p0: vec4<f32>,
     p1: vec4<f32>,
     p2: vec4<f32>,
@@ -37,7 +37,7 @@ struct Frame {
     g: Globals,
     sensor: SensorParams,
     offsets: vec4<u32>,     // first box, cylinder, board, stripe edge
-    offsets2: vec4<u32>,    // first floor rect, quad, pixel, unused
+    offsets2: vec4<u32>,    // first floor rect, quad, pixel; noise key
 };
 
 @group(0) @binding(0) var<storage, read> frames: array<Frame>;
@@ -48,6 +48,8 @@ struct Frame {
 @group(0) @binding(6) var<storage, read> floor_rects: array<FloorRectPrim>;
 @group(0) @binding(7) var<storage, read_write> pixels: array<u32>;
 @group(0) @binding(8) var<storage, read> quads: array<QuadPrim>;
+// Standard normal quantiles (sim/src/render/noise.rs: gauss_table).
+@group(0) @binding(9) var<storage, read> gauss: array<f32>;
 
 // The invocation's frame (global_invocation_id.z), read once in main.
 var<private> g: Globals;
@@ -316,6 +318,35 @@ fn pack(c: vec3<f32>) -> u32 {
     return q.x | (q.y << 8u) | (q.z << 16u) | (255u << 24u);
 }
 
+// Wellons' lowbias32 integer hash (noise.rs: mix32).
+fn mix32(x0: u32) -> u32 {
+    var x = x0;
+    x = x ^ (x >> 16u);
+    x = x * 0x7feb352du;
+    x = x ^ (x >> 15u);
+    x = x * 0x846ca68bu;
+    return x ^ (x >> 16u);
+}
+
+// clamp(floor(level + sigma z + 0.5), 0, 255) (noise.rs: noisy_level).
+fn noisy(level: u32, sigma: f32, z: f32) -> u32 {
+    return u32(clamp(f32(level) + sigma * z + 0.5, 0.0, 255.0));
+}
+
+// Pixel `i` of the frame with its sensor noise, drawn as noise.rs draws it from the frame's
+// key: a pure function of the key, the pixel and the channel.
+fn with_noise(p: u32, i: u32) -> u32 {
+    let sigma = sensor.intr.w;
+    if (sigma <= 0.0) { return p; }
+    let m = mix32(i) ^ off2.w;
+    let h1 = mix32(m);
+    let h2 = mix32(m ^ 0x9e3779b9u);
+    let r = noisy(p & 0xffu, sigma, gauss[h1 & 0xffffu]);
+    let gr = noisy((p >> 8u) & 0xffu, sigma, gauss[h1 >> 16u]);
+    let b = noisy((p >> 16u) & 0xffu, sigma, gauss[h2 & 0xffffu]);
+    return r | (gr << 8u) | (b << 16u) | (p & 0xff000000u);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let fr = frames[id.z];
@@ -326,12 +357,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = sensor.size.x;
     let h = sensor.size.y;
     if (id.x >= w || id.y >= h) { return; }
-    let index = off2.z + id.y * w + id.x;
+    let local = id.y * w + id.x;
+    let index = off2.z + local;
     let x = f32(id.x) + 0.5 - sensor.intr.x;
     let y = sensor.intr.y - (f32(id.y) + 0.5);
     let ray = scene_ray(x, y);
     if (!ray.ok) {
-        pixels[index] = BLACK;
+        pixels[index] = with_noise(BLACK, local);
         return;
     }
     // Robot frame -> world.
@@ -363,9 +395,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if (hc.ok) { best = hc; t_max = hc.t; }
     }
     if (!best.ok) {
-        pixels[index] = pack(g.sky_rgb.xyz);
+        pixels[index] = with_noise(pack(g.sky_rgb.xyz), local);
         return;
     }
     let k = (g.light.w + g.light2.x * max(dot(best.n, g.light.xyz), 0.0)) * g.light2.y;
-    pixels[index] = pack(best.rgb * k);
+    pixels[index] = with_noise(pack(best.rgb * k), local);
 }
