@@ -13,6 +13,13 @@
 //!   is pulled toward the measured one, and the estimate of the previous cycle moved by it.
 //!
 //! Measurements farther from the prediction than the gate (400 mm, 20 degrees) are not trusted.
+//!
+//! A pose fix that comes with its expected position error `s` (trilateration's) pulls the
+//! position by the Kalman gain `k = P / (P + s^2)` instead, where `P` is the variance of the
+//! estimate's position: `s^2` after the first such fix, `(1 - k) P` after each, grown by
+//! `(0.05 d)^2` for every `d` mm the odometry moves (our choice: 5% of the distance, one sigma).
+//! Fixes of a robot standing still are then averaged rather than followed, so errors that
+//! change with its heading (pixel quantization of far landmarks) cancel.
 
 use crate::boundary::OdometryReading;
 use crate::estimates::{FixOutcome, Measurement};
@@ -23,6 +30,8 @@ use omniloop_control::{DeadReckoning, wrap_pi};
 const GATE_MM: f64 = 400.0;
 /// ... or turned by more than this, rad (20 degrees).
 const GATE_RAD: f64 = 0.35;
+/// Position error the odometry adds per millimetre driven (one sigma).
+const ODOMETRY_DRIFT: f64 = 0.05;
 
 /// The pose the estimate was last set to, and the dead-reckoned pose at that moment (`None`:
 /// the origin of dead reckoning, i.e. the start).
@@ -42,6 +51,8 @@ pub struct PoseEstimator {
     gain: f64,
     /// The estimate and the dead-reckoned pose at the end of the previous cycle.
     last_cycle: Option<(Isometry2<f64>, Isometry2<f64>)>,
+    /// Variance of the estimate's position, mm^2, once a fix with an expected error set it.
+    position_var_mm2: Option<f64>,
     used: usize,
     rejected: usize,
 }
@@ -60,6 +71,7 @@ impl PoseEstimator {
             takes_fixes,
             gain,
             last_cycle: None,
+            position_var_mm2: None,
             used: 0,
             rejected: 0,
         }
@@ -68,6 +80,9 @@ impl PoseEstimator {
     /// Takes a wheel odometry reading (integrated with the trapezoidal rule).
     pub fn odometry(&mut self, r: &OdometryReading) {
         self.reckoning.update(r.v_body_mm_s, r.omega_rad_s, r.dt_s);
+        if let Some(v) = &mut self.position_var_mm2 {
+            *v += (ODOMETRY_DRIFT * r.v_body_mm_s.norm() * r.dt_s).powi(2);
+        }
     }
 
     /// The dead-reckoned pose in the odometry frame (the start at the origin), which fixes do
@@ -95,6 +110,7 @@ impl PoseEstimator {
         self.anchor = None;
         self.anchored_by_fix = false;
         self.last_cycle = None;
+        self.position_var_mm2 = None;
     }
 
     /// Marks the end of a control cycle (the reference of the next relative-motion fix).
@@ -114,6 +130,16 @@ impl PoseEstimator {
 
     /// Folds in a measurement; says what became of it.
     pub fn fuse(&mut self, m: &Measurement) -> FixOutcome {
+        self.fuse_with_error(m, None)
+    }
+
+    /// Folds in a measurement whose position is expected to be `expected_error_mm` off (one
+    /// sigma) when known; says what became of it.
+    pub fn fuse_with_error(
+        &mut self,
+        m: &Measurement,
+        expected_error_mm: Option<f64>,
+    ) -> FixOutcome {
         if !self.takes_fixes {
             return FixOutcome::Ignored;
         }
@@ -122,7 +148,7 @@ impl PoseEstimator {
                 pose,
                 alternative,
                 unambiguous,
-            } => self.fuse_pose(pose, alternative, unambiguous),
+            } => self.fuse_pose(pose, alternative, unambiguous, expected_error_mm),
             Measurement::Heading { heading_rad } => self.fuse_heading(heading_rad),
             Measurement::Position { position } => {
                 let h = self.estimate().map(|p| p.rotation.angle());
@@ -168,7 +194,9 @@ impl PoseEstimator {
         pose: Isometry2<f64>,
         alternative: Option<Isometry2<f64>>,
         unambiguous: bool,
+        expected_error_mm: Option<f64>,
     ) -> Result<FixOutcome, String> {
+        let fix_var = expected_error_mm.map(|s| (s * s).max(1e-6));
         let predicted = match self.estimate() {
             Some(p) if self.anchored_by_fix => p,
             _ => {
@@ -181,6 +209,7 @@ impl PoseEstimator {
                 }
                 self.set(pose);
                 self.anchored_by_fix = true;
+                self.position_var_mm2 = fix_var;
                 return Ok(FixOutcome::Anchored);
             }
         };
@@ -191,8 +220,20 @@ impl PoseEstimator {
         };
         let dh = wrap_pi(z.rotation.angle() - predicted.rotation.angle());
         self.gate(d(&z), dh)?;
+        let k = match (fix_var, self.position_var_mm2) {
+            (Some(r), Some(p)) => {
+                let k = p / (p + r);
+                self.position_var_mm2 = Some((1.0 - k) * p);
+                k
+            }
+            (Some(r), None) => {
+                self.position_var_mm2 = Some(r);
+                self.gain
+            }
+            (None, _) => self.gain,
+        };
         let t = predicted.translation.vector
-            + (z.translation.vector - predicted.translation.vector) * self.gain;
+            + (z.translation.vector - predicted.translation.vector) * k;
         let h = predicted.rotation.angle() + self.gain * dh;
         self.set(Isometry2::new(t, h));
         Ok(FixOutcome::Used)
@@ -273,6 +314,33 @@ mod tests {
 
     fn x(e: &PoseEstimator) -> f64 {
         e.estimate().unwrap().translation.x
+    }
+
+    #[test]
+    fn fixes_with_an_expected_error_are_averaged_while_standing_and_followed_after_driving() {
+        let start = Isometry2::new(Vector2::new(0.0, 0.0), 0.0);
+        let mut e = PoseEstimator::new(start, true, 0.3);
+        let fix = |x: f64| Measurement::Pose {
+            pose: Isometry2::new(Vector2::new(x, 0.0), 0.0),
+            alternative: None,
+            unambiguous: true,
+        };
+        // Standing still: fixes 60 mm either side of the truth, each told 50 mm off.
+        for k in 0..40 {
+            let x = if k % 2 == 0 { 60.0 } else { -60.0 };
+            assert_ne!(e.fuse_with_error(&fix(x), Some(50.0)), FixOutcome::Ignored);
+        }
+        // A fixed gain of 0.3 would end about 60 (1 - 0.3) / (1 + 0.7) = 25 mm off; the
+        // variance-weighted mean of 40 fixes is within a few mm.
+        assert!(x(&e).abs() < 5.0, "{}", x(&e));
+        let settled = e.position_var_mm2.unwrap();
+        assert!(settled < 50.0 * 50.0 / 30.0, "{settled}");
+        // 2 m driven: the estimate is uncertain again and a fix moves it most of the way.
+        drive(&mut e, 200.0, 0.0, 10.0);
+        assert!(e.position_var_mm2.unwrap() > 90.0 * 90.0);
+        let before = x(&e);
+        e.fuse_with_error(&fix(before + 100.0), Some(50.0));
+        assert!(x(&e) - before > 70.0, "{} -> {}", before, x(&e));
     }
 
     #[test]

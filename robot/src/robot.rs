@@ -137,7 +137,9 @@ impl RobotSoftware for Robot {
             .into_iter()
             .map(|s| Fix {
                 source: s.source,
-                outcome: self.estimator.fuse(&s.measurement),
+                outcome: self
+                    .estimator
+                    .fuse_with_error(&s.measurement, s.expected_error_mm),
                 measurement: s.measurement,
                 quality: s.quality,
             })

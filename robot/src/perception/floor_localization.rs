@@ -136,6 +136,7 @@ impl Stage for FloorLocalizationStage {
                     unambiguous: e.quality.resolved_by_goals,
                 },
                 quality: Some(e.quality),
+                expected_error_mm: None,
             }),
             Localization::NotLocalized(reason) => out.not_found.push(NotFound {
                 source: self.name(),

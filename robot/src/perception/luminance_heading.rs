@@ -156,6 +156,7 @@ impl Stage for LuminanceHeadingStage {
                         heading_rad: heading + deg.to_radians(),
                     },
                     quality: None,
+                    expected_error_mm: None,
                 });
                 // Ours: a match this good puts the robot at the checkpoint itself.
                 if shift.matched.percent >= self.config.at_checkpoint_match_percent {
@@ -165,6 +166,7 @@ impl Stage for LuminanceHeadingStage {
                             position: checkpoint.at,
                         },
                         quality: None,
+                        expected_error_mm: None,
                     });
                 }
             }

@@ -25,7 +25,7 @@ use omniloop_vision::VisionError;
 use omniloop_vision::omnistereo::{
     AngularProfile, FeaturePair, LandmarkRange, MirrorRim, OmnistereoConfig, RangedMark,
     StereoGeometry, densest_cluster, detect_marks, range_marks, translation_candidates,
-    trilaterate,
+    trilaterate_with_error,
 };
 
 /// The registry's entry.
@@ -153,15 +153,16 @@ impl OmnistereoStage {
                 }
             })
             .collect();
-        match trilaterate(&seen, self.config.trilateration) {
-            Ok(axis) => out.fixes.push(Sighting {
+        match trilaterate_with_error(&seen, self.config.trilateration) {
+            Ok(fix) => out.fixes.push(Sighting {
                 source: self.name(),
                 measurement: Measurement::Pose {
-                    pose: self.robot_pose(axis),
+                    pose: self.robot_pose(fix.pose),
                     alternative: None,
                     unambiguous: true,
                 },
                 quality: None,
+                expected_error_mm: Some(fix.sigma_mm),
             }),
             Err(e) => out.not_found.push(NotFound {
                 source: self.name(),

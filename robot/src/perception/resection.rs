@@ -320,6 +320,7 @@ impl ResectionStage {
                             unambiguous: true,
                         },
                         quality: None,
+                        expected_error_mm: None,
                     });
                     self.state = State::Done;
                     return;

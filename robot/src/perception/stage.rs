@@ -46,6 +46,9 @@ pub struct Sighting {
     pub measurement: Measurement,
     /// Its quality record, when the stage keeps one.
     pub quality: Option<LocalizationQuality>,
+    /// The expected error of the position it gives (one sigma, mm), when the stage knows it:
+    /// the estimator then weighs the fix against its own uncertainty.
+    pub expected_error_mm: Option<f64>,
 }
 
 /// What the estimator believes at the start of a cycle, as the stages may use it.

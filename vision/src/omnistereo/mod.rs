@@ -33,4 +33,6 @@ pub use interframe::{
 pub use marks::{ColourMark, MarkConfig, detect_marks};
 pub use range::{RangedMark, StereoGeometry, range_marks};
 pub use rim::MirrorRim;
-pub use trilateration::{LandmarkRange, TrilaterationMode, trilaterate};
+pub use trilateration::{
+    LandmarkRange, Trilateration, TrilaterationMode, trilaterate, trilaterate_with_error,
+};

@@ -43,6 +43,25 @@ pub fn trilaterate(
     seen: &[LandmarkRange],
     mode: TrilaterationMode,
 ) -> Result<Isometry2<f64>, VisionError> {
+    trilaterate_with_error(seen, mode).map(|t| t.pose)
+}
+
+/// A trilaterated pose and the expected error of its position.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trilateration {
+    /// The pose (world frame).
+    pub pose: Isometry2<f64>,
+    /// Expected position error, mm: `sqrt(trace(C) / 2)` with `C = (J^T W J)^-1` the
+    /// covariance of the weighted least squares at the solution, the ranges' expected errors
+    /// as their sigmas (our choice; the paper gives none).
+    pub sigma_mm: f64,
+}
+
+/// [`trilaterate`] with the expected error of the position.
+pub fn trilaterate_with_error(
+    seen: &[LandmarkRange],
+    mode: TrilaterationMode,
+) -> Result<Trilateration, VisionError> {
     let mut used: Vec<LandmarkRange> = seen.to_vec();
     used.sort_by(|a, b| a.range_mm.total_cmp(&b.range_mm));
     if mode == TrilaterationMode::Nearest3 {
@@ -65,7 +84,23 @@ pub fn trilaterate(
         s += h.sin();
         c += h.cos();
     }
-    Ok(Isometry2::new(p.coords, s.atan2(c)))
+    let information = normal_matrix(&used, p);
+    let covariance = information
+        .try_inverse()
+        .ok_or_else(|| VisionError::NotFound("singular trilateration".into()))?;
+    Ok(Trilateration {
+        pose: Isometry2::new(p.coords, s.atan2(c)),
+        sigma_mm: (0.5 * covariance.trace()).max(0.0).sqrt(),
+    })
+}
+
+/// `J^T W J` of the range residuals at `p` (the weights are the ranges' inverse variances).
+fn normal_matrix(used: &[LandmarkRange], p: Point2<f64>) -> Matrix2<f64> {
+    used.iter().fold(Matrix2::zeros(), |m, l| {
+        let d = p - l.centre_mm;
+        let j = d / d.norm().max(1e-9);
+        m + j * j.transpose() / (l.sigma_mm * l.sigma_mm).max(1e-6)
+    })
 }
 
 /// Solves `2 (c_i - c_0) . p = r_0^2 - r_i^2 + |c_i|^2 - |c_0|^2` by least squares.
@@ -168,6 +203,28 @@ mod tests {
                 assert!(dh.abs() < 1e-9, "{mode:?}: heading off by {dh}");
             }
         }
+    }
+
+    #[test]
+    fn the_expected_error_is_the_spread_of_the_position() {
+        // Ranges off by uniform noise of half-width a (sigma a / sqrt 3), told as such.
+        let mut rng = StdRng::seed_from_u64(3);
+        let pose = Isometry2::new(Vector2::new(600.0, -400.0), 0.2);
+        let a = 30.0;
+        let (mut sum2, mut predicted) = (0.0, 0.0);
+        let trials = 2000;
+        for _ in 0..trials {
+            let mut s = seen(pose, a, &mut rng);
+            s.iter_mut().for_each(|l| l.sigma_mm = a / 3f64.sqrt());
+            let t = trilaterate_with_error(&s, TrilaterationMode::Nearest3).unwrap();
+            sum2 += (t.pose.translation.vector - pose.translation.vector).norm_squared() / 2.0;
+            predicted += t.sigma_mm / trials as f64;
+        }
+        let actual = (sum2 / trials as f64).sqrt();
+        assert!(
+            (predicted / actual - 1.0).abs() < 0.15,
+            "predicted {predicted:.2} mm, actual {actual:.2} mm"
+        );
     }
 
     #[test]
