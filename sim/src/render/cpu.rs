@@ -186,6 +186,18 @@ fn wrap(a: f32) -> f32 {
     a - (a / t).floor() * t
 }
 
+/// The sector span of a primitive that surrounds the axis: every azimuth.
+const AROUND: (f32, f32) = (0.0, std::f32::consts::PI);
+
+/// The largest angle (rad) between `centre` and the azimuth of one of `corners`.
+fn half_angle(corners: &[[f32; 2]], centre: f32) -> f32 {
+    corners.iter().fold(0.0, |half: f32, c| {
+        let mut da = c[1].atan2(c[0]) - centre;
+        da -= (da / std::f32::consts::TAU).round() * std::f32::consts::TAU;
+        half.max(da.abs())
+    })
+}
+
 /// Distance from the origin to the farthest of `corners`.
 fn farthest(corners: &[[f32; 2]]) -> f32 {
     corners
@@ -240,7 +252,7 @@ impl Sectors {
         self.palette.extend(paints.map(floor));
         let pairs = &mut self.pairs;
         pairs.clear();
-        let mut add = |prim: Prim, d_min: f32, d_max: f32, top: f32, centre: f32, half: f32| {
+        let mut add = |prim: Prim, d_min: f32, d_max: f32, top: f32, (centre, half): (f32, f32)| {
             let item = Item {
                 d_min,
                 reach: d_max + rho + CULL_MARGIN_MM,
@@ -275,24 +287,12 @@ impl Sectors {
             });
             let d_max = farthest(&corners);
             if lx <= 0.0 && ly <= 0.0 {
-                add(
-                    Prim::Box(i as u32),
-                    0.0,
-                    d_max,
-                    top,
-                    0.0,
-                    std::f32::consts::PI,
-                );
+                add(Prim::Box(i as u32), 0.0, d_max, top, AROUND);
                 continue;
             }
             let centre = (cy - axis[1]).atan2(cx - axis[0]);
-            let mut half: f32 = 0.0;
-            for [px, py] in corners {
-                let mut da = py.atan2(px) - centre;
-                da -= (da / std::f32::consts::TAU).round() * std::f32::consts::TAU;
-                half = half.max(da.abs());
-            }
-            add(Prim::Box(i as u32), d_min, d_max, top, centre, half);
+            let half = half_angle(&corners, centre);
+            add(Prim::Box(i as u32), d_min, d_max, top, (centre, half));
         }
         for (i, q) in scene.quads.iter().enumerate() {
             let corners = [0, 1, 2, 3].map(|k| {
@@ -302,27 +302,15 @@ impl Sectors {
             let (d_min, inside) = polygon_distance(&corners);
             let (d_max, top) = (farthest(&corners), q.z[0]);
             if inside {
-                add(
-                    Prim::Quad(i as u32),
-                    0.0,
-                    d_max,
-                    top,
-                    0.0,
-                    std::f32::consts::PI,
-                );
+                add(Prim::Quad(i as u32), 0.0, d_max, top, AROUND);
                 continue;
             }
             let (sx, sy) = corners
                 .iter()
                 .fold((0.0, 0.0), |(x, y), c| (x + c[0], y + c[1]));
             let centre = sy.atan2(sx);
-            let mut half: f32 = 0.0;
-            for c in &corners {
-                let mut da = c[1].atan2(c[0]) - centre;
-                da -= (da / std::f32::consts::TAU).round() * std::f32::consts::TAU;
-                half = half.max(da.abs());
-            }
-            add(Prim::Quad(i as u32), d_min, d_max, top, centre, half);
+            let half = half_angle(&corners, centre);
+            add(Prim::Quad(i as u32), d_min, d_max, top, (centre, half));
         }
         for (i, cyl) in scene.cylinders.iter().enumerate() {
             let [cx, cy, r, top] = cyl.geom;
@@ -330,14 +318,7 @@ impl Sectors {
             let dy = cy - axis[1];
             let dc = (dx * dx + dy * dy).sqrt();
             if dc <= r {
-                add(
-                    Prim::Cylinder(i as u32),
-                    0.0,
-                    dc + r,
-                    top,
-                    0.0,
-                    std::f32::consts::PI,
-                );
+                add(Prim::Cylinder(i as u32), 0.0, dc + r, top, AROUND);
                 continue;
             }
             add(
@@ -345,8 +326,7 @@ impl Sectors {
                 dc - r,
                 dc + r,
                 top,
-                dy.atan2(dx),
-                (r / dc).asin(),
+                (dy.atan2(dx), (r / dc).asin()),
             );
         }
         // A stable sort keeps the scene's order among equal distances, so that exact ties
