@@ -84,22 +84,13 @@ pub fn trilaterate_with_error(
         s += h.sin();
         c += h.cos();
     }
-    let information = normal_matrix(&used, p);
+    let (information, _) = normal_equations(&used, p);
     let covariance = information
         .try_inverse()
         .ok_or_else(|| VisionError::NotFound("singular trilateration".into()))?;
     Ok(Trilateration {
         pose: Isometry2::new(p.coords, s.atan2(c)),
         sigma_mm: (0.5 * covariance.trace()).max(0.0).sqrt(),
-    })
-}
-
-/// `J^T W J` of the range residuals at `p` (the weights are the ranges' inverse variances).
-fn normal_matrix(used: &[LandmarkRange], p: Point2<f64>) -> Matrix2<f64> {
-    used.iter().fold(Matrix2::zeros(), |m, l| {
-        let d = p - l.centre_mm;
-        let j = d / d.norm().max(1e-9);
-        m + j * j.transpose() / (l.sigma_mm * l.sigma_mm).max(1e-6)
     })
 }
 
@@ -119,8 +110,9 @@ fn linear_solution(used: &[LandmarkRange]) -> Result<Point2<f64>, VisionError> {
     solve(ata, atb).map(Point2::from)
 }
 
-/// One weighted Gauss-Newton step on `|p - c_i| - r_i`.
-fn gauss_newton_step(used: &[LandmarkRange], p: Point2<f64>) -> Result<Point2<f64>, VisionError> {
+/// `J^T W J` and `J^T W r` of the range residuals `r_i = |p - c_i| - r_i` at `p` (the weights
+/// are the ranges' inverse variances).
+fn normal_equations(used: &[LandmarkRange], p: Point2<f64>) -> (Matrix2<f64>, Vector2<f64>) {
     let mut jtj = Matrix2::zeros();
     let mut jtr = Vector2::zeros();
     for l in used {
@@ -131,6 +123,12 @@ fn gauss_newton_step(used: &[LandmarkRange], p: Point2<f64>) -> Result<Point2<f6
         jtj += w * j * j.transpose();
         jtr += w * j * (n - l.range_mm);
     }
+    (jtj, jtr)
+}
+
+/// One weighted Gauss-Newton step on `|p - c_i| - r_i`.
+fn gauss_newton_step(used: &[LandmarkRange], p: Point2<f64>) -> Result<Point2<f64>, VisionError> {
+    let (jtj, jtr) = normal_equations(used, p);
     Ok(p - solve(jtj, jtr)?)
 }
 
