@@ -18,8 +18,9 @@ use rayon::prelude::*;
 struct PixelRay {
     o: V3,
     d: V3,
-    /// Azimuth of `d` in the robot frame.
-    azimuth: f32,
+    /// Azimuth of `d` in the robot frame, in turns as a 32-bit fraction (so that adding the
+    /// robot's heading wraps by itself).
+    azimuth: u32,
     /// Horizontal length of `d`.
     d_xy: f32,
     valid: bool,
@@ -80,7 +81,7 @@ impl SensorRays {
                         PixelRay {
                             o: [r.origin.x as f32, r.origin.y as f32, r.origin.z as f32],
                             d,
-                            azimuth: d[1].atan2(d[0]),
+                            azimuth: turns(d[1].atan2(d[0]) as f64),
                             d_xy: (d[0] * d[0] + d[1] * d[1]).sqrt(),
                             valid: true,
                         }
@@ -88,7 +89,7 @@ impl SensorRays {
                     None => PixelRay {
                         o: [0.0; 3],
                         d: [0.0; 3],
-                        azimuth: 0.0,
+                        azimuth: 0,
                         d_xy: 0.0,
                         valid: false,
                     },
@@ -179,7 +180,20 @@ struct Sectors {
     /// The shaded, packed colour of each floor paint: one per floor rectangle, then outside,
     /// line and bare floor.
     palette: Vec<u32>,
+    /// The packed colour of the sky.
+    sky: u32,
+    /// The highest top of any primitive plus [`CULL_MARGIN_MM`]: a ray from above it that does
+    /// not go down meets nothing.
+    top_mm: f32,
 }
+
+/// An angle (rad) as a fraction of a turn in 32 bits (wrapping).
+fn turns(a: f64) -> u32 {
+    (a / std::f64::consts::TAU * 4_294_967_296.0).rem_euclid(4_294_967_296.0) as u64 as u32
+}
+
+/// The bits of a turn below a sector's index.
+const SECTOR_SHIFT: u32 = 32 - SECTORS.trailing_zeros();
 
 fn wrap(a: f32) -> f32 {
     let t = std::f32::consts::TAU;
@@ -250,6 +264,12 @@ impl Sectors {
         ]);
         self.palette.clear();
         self.palette.extend(paints.map(floor));
+        let g = &scene.globals;
+        self.sky = trace::pack([g.sky_rgb[0], g.sky_rgb[1], g.sky_rgb[2]]);
+        let tops = (scene.boxes.iter().map(|b| b.frame[3]))
+            .chain(scene.quads.iter().map(|q| q.z[0]))
+            .chain(scene.cylinders.iter().map(|c| c.geom[3]));
+        self.top_mm = tops.fold(f32::NEG_INFINITY, f32::max) + CULL_MARGIN_MM;
         let pairs = &mut self.pairs;
         pairs.clear();
         let mut add = |prim: Prim, d_min: f32, d_max: f32, top: f32, (centre, half): (f32, f32)| {
@@ -265,9 +285,10 @@ impl Sectors {
             }
             let half = half + (rho / d_min).min(1.0).asin();
             let width = std::f32::consts::TAU / SECTORS as f32;
-            let start = ((wrap(centre - half)) / width).floor() as i64;
+            // One sector to spare on either side: rays find their sector from 32-bit turns.
+            let start = ((wrap(centre - half)) / width).floor() as i64 - 1;
             let n = ((2.0 * half) / width).ceil() as i64 + 1;
-            for k in start..=start + n {
+            for k in start..=start + n + 1 {
                 pairs.push((k.rem_euclid(SECTORS as i64) as u16, item));
             }
         };
@@ -393,8 +414,7 @@ impl CpuRenderer {
         let rays: &SensorRays = rays;
         let flags = rays.body_flags();
         let sectors = &self.sectors;
-        let theta = theta as f32;
-        let scale = SECTORS as f32 / std::f32::consts::TAU;
+        let heading = turns(theta);
         let width = rays.width as usize;
         pixels
             .par_chunks_mut(width)
@@ -412,7 +432,7 @@ impl CpuRenderer {
                         r.o[2],
                     ];
                     let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
-                    let sector = ((wrap(r.azimuth + theta) * scale) as usize).min(SECTORS - 1);
+                    let sector = (r.azimuth.wrapping_add(heading) >> SECTOR_SHIFT) as usize;
                     let skip = match body {
                         Some(i) if !flags[v * width + u] => i as u32,
                         _ => u32::MAX,
@@ -436,6 +456,10 @@ fn trace_culled(
     rho: f32,
     skip_cylinder: u32,
 ) -> u32 {
+    // A ray that leaves above everything and does not come down passes over every item.
+    if d[2] >= 0.0 && o[2] > sectors.top_mm {
+        return sectors.sky;
+    }
     // The floor's colour is looked up only if nothing nearer hides it.
     let t_floor = trace::floor_t(o, d);
     let mut best: Option<Hit> = None;
@@ -477,11 +501,7 @@ fn trace_culled(
                 FloorPaint::Floor => n + 2,
             }]
         }
-        (None, None) => trace::pack([
-            scene.globals.sky_rgb[0],
-            scene.globals.sky_rgb[1],
-            scene.globals.sky_rgb[2],
-        ]),
+        (None, None) => sectors.sky,
     }
 }
 
