@@ -177,6 +177,11 @@ struct Sectors {
     pairs: Vec<(u16, Item)>,
     /// Each quad prism's sides, prepared once a frame.
     quad_sides: Vec<trace::QuadSides>,
+    /// Each quad prism's shaded, packed colour on each face ([`trace::QuadFace::index`]).
+    quad_faces: Vec<[u32; 6]>,
+    /// Each box's shaded, packed colour on each face ([`trace::BoxFace::index`]); a striped
+    /// board's are shaded as it is hit.
+    box_faces: Vec<[u32; 6]>,
     /// The shaded, packed colour of each floor paint: one per floor rectangle, then outside,
     /// line and bare floor.
     palette: Vec<u32>,
@@ -252,6 +257,23 @@ impl Sectors {
         self.quad_sides.clear();
         self.quad_sides
             .extend(scene.quads.iter().map(trace::quad_sides));
+        self.box_faces.clear();
+        self.box_faces.extend(scene.boxes.iter().map(|b| {
+            let rgb = [b.color[0], b.color[1], b.color[2]];
+            trace::BoxFace::ALL.map(|f| {
+                let n = f.normal(b);
+                trace::pack(trace::shade(scene, &Hit { t: 0.0, n, rgb }))
+            })
+        }));
+        self.quad_faces.clear();
+        self.quad_faces
+            .extend(scene.quads.iter().zip(&self.quad_sides).map(|(q, sides)| {
+                let rgb = [q.color[0], q.color[1], q.color[2]];
+                trace::QuadFace::ALL.map(|f| {
+                    let n = f.normal(sides);
+                    trace::pack(trace::shade(scene, &Hit { t: 0.0, n, rgb }))
+                })
+            }));
         let floor = |paint| {
             let rgb = trace::paint_color(scene, paint);
             let n = trace::FLOOR_NORMAL;
@@ -462,7 +484,7 @@ fn trace_culled(
     }
     // The floor's colour is looked up only if nothing nearer hides it.
     let t_floor = trace::floor_t(o, d);
-    let mut best: Option<Hit> = None;
+    let mut best = Best::Nothing;
     let mut t_max = t_floor.unwrap_or(f32::INFINITY);
     let range = sectors.offsets[sector] as usize..sectors.offsets[sector + 1] as usize;
     for item in &sectors.items[range] {
@@ -472,26 +494,45 @@ fn trace_culled(
         if item.passes_over(o[2], d[2], d_xy) {
             continue;
         }
-        let h = match item.prim {
-            Prim::Box(i) => trace::hit_box(scene, &scene.boxes[i as usize], o, d, t_max),
-            Prim::Quad(i) => trace::hit_quad_sides(
-                &scene.quads[i as usize],
-                &sectors.quad_sides[i as usize],
-                o,
-                d,
-                t_max,
-            ),
-            Prim::Cylinder(i) if i == skip_cylinder => None,
-            Prim::Cylinder(i) => trace::hit_cylinder(&scene.cylinders[i as usize], o, d, t_max),
+        let (t, found) = match item.prim {
+            Prim::Box(i) => {
+                let i = i as usize;
+                let b = &scene.boxes[i];
+                if b.color[3] >= 0.0 {
+                    match trace::hit_box(scene, b, o, d, t_max) {
+                        Some(h) => (h.t, Best::Hit(h)),
+                        None => continue,
+                    }
+                } else {
+                    match trace::hit_box_face(b, o, d, t_max) {
+                        Some((t, face, _)) => (t, Best::Packed(sectors.box_faces[i][face.index()])),
+                        None => continue,
+                    }
+                }
+            }
+            Prim::Quad(i) => {
+                let i = i as usize;
+                let q = &scene.quads[i];
+                match trace::hit_quad_face(q, &sectors.quad_sides[i], o, d, t_max) {
+                    Some((t, face)) => (t, Best::Packed(sectors.quad_faces[i][face.index()])),
+                    None => continue,
+                }
+            }
+            Prim::Cylinder(i) if i == skip_cylinder => continue,
+            Prim::Cylinder(i) => {
+                match trace::hit_cylinder(&scene.cylinders[i as usize], o, d, t_max) {
+                    Some(h) => (h.t, Best::Hit(h)),
+                    None => continue,
+                }
+            }
         };
-        if let Some(h) = h {
-            t_max = h.t;
-            best = Some(h);
-        }
+        t_max = t;
+        best = found;
     }
     match (best, t_floor) {
-        (Some(h), _) => trace::pack(trace::shade(scene, &h)),
-        (None, Some(t)) => {
+        (Best::Hit(h), _) => trace::pack(trace::shade(scene, &h)),
+        (Best::Packed(p), _) => p,
+        (Best::Nothing, Some(t)) => {
             let paint = trace::floor_paint(scene, o[0] + t * d[0], o[1] + t * d[1]);
             let n = scene.floor_rects.len();
             sectors.palette[match paint {
@@ -501,8 +542,16 @@ fn trace_culled(
                 FloorPaint::Floor => n + 2,
             }]
         }
-        (None, None) => sectors.sky,
+        (Best::Nothing, None) => sectors.sky,
     }
+}
+
+/// The nearest hit so far: none, one to shade, or one whose shaded colour is known.
+#[derive(Debug, Clone, Copy)]
+enum Best {
+    Nothing,
+    Hit(Hit),
+    Packed(u32),
 }
 
 /// Renders every primitive for every pixel, without binning (the reference of the tests).

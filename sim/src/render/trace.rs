@@ -127,35 +127,10 @@ fn slab(o: f32, d: f32, lo: f32, hi: f32) -> Option<(f32, f32)> {
 
 /// Entry of the ray into a box, if before `t_max`.
 pub fn hit_box(s: &Scene, b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
-    let [cx, cy, hx, hy] = b.geom;
-    let [c, sn, base, top] = b.frame;
-    let rx = o[0] - cx;
-    let ry = o[1] - cy;
-    let lox = c * rx + sn * ry;
-    let loy = -sn * rx + c * ry;
-    let ldx = c * d[0] + sn * d[1];
-    let ldy = -sn * d[0] + c * d[1];
-    let (x0, x1) = slab(lox, ldx, -hx, hx)?;
-    let (y0, y1) = slab(loy, ldy, -hy, hy)?;
-    let (z0, z1) = slab(o[2], d[2], base, top)?;
-    let tn = x0.max(y0).max(z0);
-    let tf = x1.min(y1).min(z1);
-    if tn > tf || tn <= T_EPS || tn >= t_max {
-        return None;
-    }
-    let n = if tn == x0 {
-        let nx = -ldx.signum();
-        [c * nx, sn * nx, 0.0]
-    } else if tn == y0 {
-        let ny = -ldy.signum();
-        [-sn * ny, c * ny, 0.0]
-    } else {
-        [0.0, 0.0, -d[2].signum()]
-    };
+    let (tn, face, f) = hit_box_face(b, o, d, t_max)?;
     let mut rgb = [b.color[0], b.color[1], b.color[2]];
-    if b.color[3] >= 0.0 && tn != x0 {
+    if b.color[3] >= 0.0 && !matches!(face, BoxFace::X(_)) {
         let board = &s.boards[b.color[3] as usize];
-        let f = (lox + tn * ldx + hx) / (2.0 * hx);
         let first = board.range[0] as usize;
         let count = board.range[1] as usize;
         let mut k = count.saturating_sub(1);
@@ -172,7 +147,87 @@ pub fn hit_box(s: &Scene, b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> 
         };
         rgb = [col[0], col[1], col[2]];
     }
-    Some(Hit { t: tn, n, rgb })
+    Some(Hit {
+        t: tn,
+        n: face.normal(b),
+        rgb,
+    })
+}
+
+/// The face of a box a ray enters by: across its local x or y extent or its height, with the
+/// sign (+1 or -1) of the outward normal along that axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BoxFace {
+    /// A face across the box's local x.
+    X(f32),
+    /// A face across its local y.
+    Y(f32),
+    /// Its top (+1) or bottom (-1).
+    Z(f32),
+}
+
+impl BoxFace {
+    /// Every face, in the order of [`BoxFace::index`].
+    pub const ALL: [BoxFace; 6] = [
+        BoxFace::X(1.0),
+        BoxFace::X(-1.0),
+        BoxFace::Y(1.0),
+        BoxFace::Y(-1.0),
+        BoxFace::Z(1.0),
+        BoxFace::Z(-1.0),
+    ];
+
+    /// Its outward unit normal (world frame) on box `b`.
+    pub fn normal(self, b: &BoxPrim) -> V3 {
+        let [c, sn, _, _] = b.frame;
+        match self {
+            BoxFace::X(nx) => [c * nx, sn * nx, 0.0],
+            BoxFace::Y(ny) => [-sn * ny, c * ny, 0.0],
+            BoxFace::Z(nz) => [0.0, 0.0, nz],
+        }
+    }
+
+    /// A small index: 0-5 in the order of [`BoxFace::ALL`].
+    pub fn index(self) -> usize {
+        let (axis, sign) = match self {
+            BoxFace::X(s) => (0, s),
+            BoxFace::Y(s) => (2, s),
+            BoxFace::Z(s) => (4, s),
+        };
+        axis + usize::from(sign < 0.0)
+    }
+}
+
+/// [`hit_box`]'s distance, the face entered and the entry point's place across the box's local
+/// x as a fraction of its length (a board's stripe coordinate), without the colour.
+pub fn hit_box_face(b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<(f32, BoxFace, f32)> {
+    let [cx, cy, hx, hy] = b.geom;
+    let [c, sn, base, top] = b.frame;
+    let rx = o[0] - cx;
+    let ry = o[1] - cy;
+    let lox = c * rx + sn * ry;
+    let loy = -sn * rx + c * ry;
+    let ldx = c * d[0] + sn * d[1];
+    let ldy = -sn * d[0] + c * d[1];
+    let (x0, x1) = slab(lox, ldx, -hx, hx)?;
+    let (y0, y1) = slab(loy, ldy, -hy, hy)?;
+    let (z0, z1) = slab(o[2], d[2], base, top)?;
+    let tn = x0.max(y0).max(z0);
+    let tf = x1.min(y1).min(z1);
+    if tn > tf || tn <= T_EPS || tn >= t_max {
+        return None;
+    }
+    // The outward normal is against the ray: -sign(d) along the axis entered.
+    let against = |v: f32| if v.is_sign_negative() { 1.0 } else { -1.0 };
+    let face = if tn == x0 {
+        BoxFace::X(against(ldx))
+    } else if tn == y0 {
+        BoxFace::Y(against(ldy))
+    } else {
+        BoxFace::Z(against(d[2]))
+    };
+    let f = (lox + tn * ldx + hx) / (2.0 * hx);
+    Some((tn, face, f))
 }
 
 /// The sides of a quadrilateral prism, prepared once a scene: each side's outward unit normal
@@ -207,10 +262,70 @@ pub fn hit_quad(q: &QuadPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
 /// [`hit_quad`] with the prism's sides prepared ([`quad_sides`]): the same operations, so the
 /// same result to the bit.
 pub fn hit_quad_sides(q: &QuadPrim, sides: &QuadSides, o: V3, d: V3, t_max: f32) -> Option<Hit> {
+    let (t, face) = hit_quad_face(q, sides, o, d, t_max)?;
+    Some(Hit {
+        t,
+        n: face.normal(sides),
+        rgb: [q.color[0], q.color[1], q.color[2]],
+    })
+}
+
+/// The face of a quadrilateral prism a ray enters by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QuadFace {
+    /// Side `i` (from corner `i` to corner `i + 1`).
+    Side(usize),
+    /// The top, entered going down (normal +z).
+    Top,
+    /// The bottom, entered going up (normal -z).
+    Bottom,
+}
+
+impl QuadFace {
+    /// Every face, in the order of [`QuadFace::index`].
+    pub const ALL: [QuadFace; 6] = [
+        QuadFace::Side(0),
+        QuadFace::Side(1),
+        QuadFace::Side(2),
+        QuadFace::Side(3),
+        QuadFace::Top,
+        QuadFace::Bottom,
+    ];
+
+    /// Its outward unit normal.
+    pub fn normal(self, sides: &QuadSides) -> V3 {
+        match self {
+            QuadFace::Side(i) => sides.0[i].map_or([0.0; 3], |[nx, ny, _, _]| [nx, ny, 0.0]),
+            QuadFace::Top => [0.0, 0.0, 1.0],
+            QuadFace::Bottom => [0.0, 0.0, -1.0],
+        }
+    }
+
+    /// A small index: sides 0-3, top 4, bottom 5.
+    pub fn index(self) -> usize {
+        match self {
+            QuadFace::Side(i) => i,
+            QuadFace::Top => 4,
+            QuadFace::Bottom => 5,
+        }
+    }
+}
+
+/// [`hit_quad_sides`]'s distance and the face entered, without the colour.
+pub fn hit_quad_face(
+    q: &QuadPrim,
+    sides: &QuadSides,
+    o: V3,
+    d: V3,
+    t_max: f32,
+) -> Option<(f32, QuadFace)> {
     let mut tn = f32::NEG_INFINITY;
     let mut tf = f32::INFINITY;
-    let mut n = [0.0, 0.0, 0.0];
-    for [nx, ny, ax, ay] in sides.0.iter().flatten().copied() {
+    let mut face = QuadFace::Top;
+    for (i, side) in sides.0.iter().enumerate() {
+        let Some([nx, ny, ax, ay]) = *side else {
+            continue;
+        };
         let num = nx * (o[0] - ax) + ny * (o[1] - ay);
         let den = nx * d[0] + ny * d[1];
         if den.abs() < 1e-12 {
@@ -223,7 +338,7 @@ pub fn hit_quad_sides(q: &QuadPrim, sides: &QuadSides, o: V3, d: V3, t_max: f32)
         if den < 0.0 {
             if t > tn {
                 tn = t;
-                n = [nx, ny, 0.0];
+                face = QuadFace::Side(i);
             }
         } else if t < tf {
             tf = t;
@@ -232,17 +347,18 @@ pub fn hit_quad_sides(q: &QuadPrim, sides: &QuadSides, o: V3, d: V3, t_max: f32)
     let (z0, z1) = slab(o[2], d[2], 0.0, q.z[0])?;
     if z0 > tn {
         tn = z0;
-        n = [0.0, 0.0, -d[2].signum()];
+        // The normal -sign(d_z) z: -0 counts as going down, +0 as going up.
+        face = if d[2].is_sign_negative() {
+            QuadFace::Top
+        } else {
+            QuadFace::Bottom
+        };
     }
     tf = tf.min(z1);
     if tn > tf || tn <= T_EPS || tn >= t_max {
         return None;
     }
-    Some(Hit {
-        t: tn,
-        n,
-        rgb: [q.color[0], q.color[1], q.color[2]],
-    })
+    Some((tn, face))
 }
 
 /// Entry of the ray into an upright cylinder (side or top), if before `t_max`.
