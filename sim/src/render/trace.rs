@@ -230,15 +230,25 @@ pub fn hit_box_face(b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<(f32, BoxFa
     Some((tn, face, f))
 }
 
-/// The sides of a quadrilateral prism, prepared once a scene: each side's outward unit normal
-/// and its first corner (`nx, ny, ax, ay`), or `None` for a side too short to have one.
-#[derive(Debug, Clone, Copy)]
-pub struct QuadSides(pub [Option<[f32; 4]>; 4]);
+/// The sides of a quadrilateral prism, prepared once a frame: each side's outward unit normal
+/// and its first corner, as four lanes of each (a side too short to have a normal is all
+/// zeros, which every ray finds parallel and inside: as if it were not there).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct QuadSides {
+    /// Normals' x.
+    pub nx: [f32; 4],
+    /// Normals' y.
+    pub ny: [f32; 4],
+    /// First corners' x.
+    pub ax: [f32; 4],
+    /// First corners' y.
+    pub ay: [f32; 4],
+}
 
 /// The sides of `q` (counter-clockwise corners).
 pub fn quad_sides(q: &QuadPrim) -> QuadSides {
-    let mut sides = [None; 4];
-    for (i, side) in sides.iter_mut().enumerate() {
+    let mut sides = QuadSides::default();
+    for i in 0..4 {
         let a = q.corner(i);
         let b = q.corner((i + 1) % 4);
         let ex = b[0] - a[0];
@@ -248,9 +258,12 @@ pub fn quad_sides(q: &QuadPrim) -> QuadSides {
             continue;
         }
         // Outward normal of a counter-clockwise side.
-        *side = Some([ey / len, -ex / len, a[0], a[1]]);
+        sides.nx[i] = ey / len;
+        sides.ny[i] = -ex / len;
+        sides.ax[i] = a[0];
+        sides.ay[i] = a[1];
     }
-    QuadSides(sides)
+    sides
 }
 
 /// Entry of the ray into a quadrilateral prism (Cyrus-Beck over its sides, then the slab from
@@ -295,7 +308,7 @@ impl QuadFace {
     /// Its outward unit normal.
     pub fn normal(self, sides: &QuadSides) -> V3 {
         match self {
-            QuadFace::Side(i) => sides.0[i].map_or([0.0; 3], |[nx, ny, _, _]| [nx, ny, 0.0]),
+            QuadFace::Side(i) => [sides.nx[i], sides.ny[i], 0.0],
             QuadFace::Top => [0.0, 0.0, 1.0],
             QuadFace::Bottom => [0.0, 0.0, -1.0],
         }
@@ -312,6 +325,7 @@ impl QuadFace {
 }
 
 /// [`hit_quad_sides`]'s distance and the face entered, without the colour.
+#[inline]
 pub fn hit_quad_face(
     q: &QuadPrim,
     sides: &QuadSides,
@@ -319,31 +333,34 @@ pub fn hit_quad_face(
     d: V3,
     t_max: f32,
 ) -> Option<(f32, QuadFace)> {
+    // The four sides' numerators, denominators and crossings, lane by lane.
+    let (mut num, mut den, mut t) = ([0.0f32; 4], [0.0f32; 4], [0.0f32; 4]);
+    for i in 0..4 {
+        num[i] = sides.nx[i] * (o[0] - sides.ax[i]) + sides.ny[i] * (o[1] - sides.ay[i]);
+        den[i] = sides.nx[i] * d[0] + sides.ny[i] * d[1];
+        t[i] = -num[i] / den[i];
+    }
+    // Parallel to a side and outside it: a miss. Parallel and inside: that side does not bound.
+    if (0..4).any(|i| den[i].abs() < 1e-12 && num[i] > 0.0) {
+        return None;
+    }
+    // The latest entry and the earliest exit, taken in side order (selects, not branches).
     let mut tn = f32::NEG_INFINITY;
     let mut tf = f32::INFINITY;
-    let mut face = QuadFace::Top;
-    for (i, side) in sides.0.iter().enumerate() {
-        let Some([nx, ny, ax, ay]) = *side else {
-            continue;
-        };
-        let num = nx * (o[0] - ax) + ny * (o[1] - ay);
-        let den = nx * d[0] + ny * d[1];
-        if den.abs() < 1e-12 {
-            if num > 0.0 {
-                return None;
-            }
-            continue;
-        }
-        let t = -num / den;
-        if den < 0.0 {
-            if t > tn {
-                tn = t;
-                face = QuadFace::Side(i);
-            }
-        } else if t < tf {
-            tf = t;
-        }
+    let mut side = usize::MAX;
+    for i in 0..4 {
+        let bounds = den[i].abs() >= 1e-12;
+        let enters = bounds && den[i] < 0.0 && t[i] > tn;
+        let leaves = bounds && den[i] >= 0.0 && t[i] < tf;
+        tn = if enters { t[i] } else { tn };
+        side = if enters { i } else { side };
+        tf = if leaves { t[i] } else { tf };
     }
+    let mut face = if side < 4 {
+        QuadFace::Side(side)
+    } else {
+        QuadFace::Top
+    };
     let (z0, z1) = slab(o[2], d[2], 0.0, q.z[0])?;
     if z0 > tn {
         tn = z0;
