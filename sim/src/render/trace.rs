@@ -40,6 +40,7 @@ pub enum FloorPaint {
 
 /// What covers the floor at `(x, y)`: a mark painted on it (the last that covers the point),
 /// floor region, field lines or outside.
+#[inline]
 pub fn floor_paint(s: &Scene, x: f32, y: f32) -> FloorPaint {
     let g = &s.globals;
     let mut inside = g.flags[1] == 0;
@@ -49,15 +50,17 @@ pub fn floor_paint(s: &Scene, x: f32, y: f32) -> FloorPaint {
         let dy = y - r.geom[1];
         let lx = r.frame[0] * dx + r.frame[1] * dy;
         let ly = -r.frame[1] * dx + r.frame[0] * dy;
-        let in_rect = lx.abs() <= r.geom[2] && ly.abs() <= r.geom[3];
+        // `&`, not `&&`: both tests are cheap, and a branch on them would be a coin toss.
+        let in_rect = (lx.abs() <= r.geom[2]) & (ly.abs() <= r.geom[3]);
         if r.frame[2] == FLOOR_REGION {
             inside |= in_rect;
-        } else if r.frame[2] == SQUARE_MARK {
-            if in_rect {
-                mark = Some(i);
-            }
-        } else if lx * lx + ly * ly <= r.geom[2] * r.geom[2] {
-            mark = Some(i);
+        } else {
+            let covered = if r.frame[2] == SQUARE_MARK {
+                in_rect
+            } else {
+                lx * lx + ly * ly <= r.geom[2] * r.geom[2]
+            };
+            mark = if covered { Some(i) } else { mark };
         }
     }
     if let Some(m) = mark {
@@ -379,6 +382,7 @@ pub fn hit_quad_face(
 }
 
 /// Entry of the ray into an upright cylinder (side or top), if before `t_max`.
+#[inline]
 pub fn hit_cylinder(cy: &CylinderPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
     let [cx, cyy, r, top] = cy.geom;
     let mx = o[0] - cx;
