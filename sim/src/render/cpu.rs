@@ -6,6 +6,12 @@
 //! per frame into azimuth sectors around the sensor's axis and sorted by distance, so a ray
 //! that meets the floor near the robot tests only the few primitives nearer than that; the
 //! binning is conservative, so the image is the same as tracing every primitive.
+//!
+//! Further savings leave every value as it was: a primitive the ray passes over (above its top
+//! until past its footprint) is not tested, and a ray leaving above everything without going
+//! down is sky at once; the floor's colour is looked up only where nothing hides it; the shaded
+//! colours of the floor's paints, the sky and every face of a quad prism or plain box are
+//! computed once a frame; a quad's four sides are intersected as four lanes.
 
 use super::scene::Scene;
 use super::trace::{self, BLACK, FloorPaint, Hit, V3};
