@@ -14,7 +14,7 @@
 //! - The level: `clamp(floor(level + sigma * z + 0.5), 0, 255)`.
 
 use rayon::prelude::*;
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Bits of a table index.
 const TABLE_BITS: u32 = 16;
@@ -83,7 +83,13 @@ pub fn mix32(mut x: u32) -> u32 {
 
 /// The three table indices (red, green, blue) of pixel `i` under `key`.
 pub fn pixel_indices(i: u32, key: u32) -> [usize; 3] {
-    let m = mix32(i) ^ key;
+    mixed_indices(mix32(i), key)
+}
+
+/// [`pixel_indices`] from the pixel's hash `mix32(i)`, which does not change from frame to
+/// frame.
+fn mixed_indices(mixed: u32, key: u32) -> [usize; 3] {
+    let m = mixed ^ key;
     let h1 = mix32(m);
     let h2 = mix32(m ^ 0x9e37_79b9);
     [
@@ -109,23 +115,39 @@ pub fn apply(pixels: &[u32], noise: FrameNoise, rgba: &mut [u8]) {
         return;
     }
     let table = gauss_table();
+    let mixed = pixel_hashes(pixels.len());
     // Every draw is a function of its pixel's index: blocks of pixels in parallel give the
     // same image as one after the other.
     const BLOCK: usize = 4096;
     pixels
         .par_chunks(BLOCK)
         .zip(rgba.par_chunks_mut(4 * BLOCK))
-        .enumerate()
-        .for_each(|(b, (block, out))| {
-            for (j, (p, out)) in block.iter().zip(out.chunks_exact_mut(4)).enumerate() {
+        .zip(mixed.par_chunks(BLOCK))
+        .for_each(|((block, out), mixed)| {
+            for ((p, out), &m) in block.iter().zip(out.chunks_exact_mut(4)).zip(mixed) {
                 let bytes = p.to_le_bytes();
-                let k = pixel_indices((b * BLOCK + j) as u32, noise.key);
+                let k = mixed_indices(m, noise.key);
                 for c in 0..3 {
                     out[c] = noisy_level(bytes[c], noise.sigma, table[k[c]]);
                 }
                 out[3] = bytes[3];
             }
         });
+}
+
+/// `mix32(i)` of every pixel index of a frame of `len` pixels, hashed once for each frame size.
+fn pixel_hashes(len: usize) -> Arc<Vec<u32>> {
+    static HASHES: Mutex<Vec<Arc<Vec<u32>>>> = Mutex::new(Vec::new());
+    let mut cache = HASHES.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(h) = cache.iter().find(|h| h.len() == len) {
+        return h.clone();
+    }
+    let h = Arc::new((0..len as u32).map(mix32).collect::<Vec<_>>());
+    if cache.len() >= 8 {
+        cache.remove(0);
+    }
+    cache.push(h.clone());
+    h
 }
 
 /// The Gaussian table: standard normal quantiles at `(k + 0.5) / 65536`, scaled to unit
