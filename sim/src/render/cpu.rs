@@ -27,9 +27,16 @@ struct PixelRay {
     /// Azimuth of `d` in the robot frame, in turns as a 32-bit fraction (so that adding the
     /// robot's heading wraps by itself).
     azimuth: u32,
-    /// Horizontal length of `d`.
+    /// Horizontal length of `d`; negative for a pixel that sees no mirror (so that a ray is
+    /// 32 bytes, two to a cache line).
     d_xy: f32,
-    valid: bool,
+}
+
+impl PixelRay {
+    /// Whether the pixel sees the mirror.
+    fn valid(&self) -> bool {
+        self.d_xy >= 0.0
+    }
 }
 
 /// Per-sensor cache of pixel rays.
@@ -89,15 +96,13 @@ impl SensorRays {
                             d,
                             azimuth: turns(d[1].atan2(d[0]) as f64),
                             d_xy: (d[0] * d[0] + d[1] * d[1]).sqrt(),
-                            valid: true,
                         }
                     }
                     None => PixelRay {
                         o: [0.0; 3],
                         d: [0.0; 3],
                         azimuth: 0,
-                        d_xy: 0.0,
-                        valid: false,
+                        d_xy: -1.0,
                     },
                 });
             }
@@ -122,7 +127,7 @@ impl SensorRays {
             let flags = self
                 .rays
                 .iter()
-                .map(|ray| ray.valid && may_meet_cylinder(ray.o, ray.d, r, z_top))
+                .map(|ray| ray.valid() && may_meet_cylinder(ray.o, ray.d, r, z_top))
                 .collect();
             self.body = Some((key, flags));
         }
@@ -450,7 +455,7 @@ impl CpuRenderer {
             .enumerate()
             .for_each(|(v, (row, row_rays))| {
                 for (u, (out, r)) in row.iter_mut().zip(row_rays).enumerate() {
-                    if !r.valid {
+                    if !r.valid() {
                         *out = BLACK;
                         continue;
                     }
@@ -570,7 +575,7 @@ pub fn render_reference(scene: &Scene, rays: &SensorRays, pose: &Isometry2<f64>)
     rays.rays
         .iter()
         .map(|r| {
-            if !r.valid {
+            if !r.valid() {
                 return BLACK;
             }
             let o = [
