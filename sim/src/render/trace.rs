@@ -203,6 +203,7 @@ impl BoxFace {
 
 /// [`hit_box`]'s distance, the face entered and the entry point's place across the box's local
 /// x as a fraction of its length (a board's stripe coordinate), without the colour.
+#[inline]
 pub fn hit_box_face(b: &BoxPrim, o: V3, d: V3, t_max: f32) -> Option<(f32, BoxFace, f32)> {
     let [cx, cy, hx, hy] = b.geom;
     let [c, sn, base, top] = b.frame;
