@@ -262,47 +262,46 @@ fn polygon_distance(corners: &[[f32; 2]]) -> (f32, bool) {
 }
 
 impl Sectors {
-    /// Bins the scene's primitives for a sensor axis at `axis` whose rays start up to `rho` mm
-    /// from it.
-    fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32) {
+    /// Prepares, for this frame's scene, each quad prism's sides and the shaded colours that do
+    /// not depend on the ray: every face of the quads and boxes, the floor's paints, the sky;
+    /// and the highest top.
+    fn prepare_faces(&mut self, scene: &Scene) {
+        let shaded = |n: V3, rgb: V3| trace::pack(trace::shade(scene, &Hit { t: 0.0, n, rgb }));
         self.quad_sides.clear();
         self.quad_sides
             .extend(scene.quads.iter().map(trace::quad_sides));
         self.box_faces.clear();
         self.box_faces.extend(scene.boxes.iter().map(|b| {
             let rgb = [b.color[0], b.color[1], b.color[2]];
-            trace::BoxFace::ALL.map(|f| {
-                let n = f.normal(b);
-                trace::pack(trace::shade(scene, &Hit { t: 0.0, n, rgb }))
-            })
+            trace::BoxFace::ALL.map(|f| shaded(f.normal(b), rgb))
         }));
         self.quad_faces.clear();
         self.quad_faces
             .extend(scene.quads.iter().zip(&self.quad_sides).map(|(q, sides)| {
                 let rgb = [q.color[0], q.color[1], q.color[2]];
-                trace::QuadFace::ALL.map(|f| {
-                    let n = f.normal(sides);
-                    trace::pack(trace::shade(scene, &Hit { t: 0.0, n, rgb }))
-                })
+                trace::QuadFace::ALL.map(|f| shaded(f.normal(sides), rgb))
             }));
-        let floor = |paint| {
-            let rgb = trace::paint_color(scene, paint);
-            let n = trace::FLOOR_NORMAL;
-            trace::pack(trace::shade(scene, &Hit { t: 0.0, n, rgb }))
-        };
         let paints = (0..scene.floor_rects.len()).map(FloorPaint::Mark).chain([
             FloorPaint::Outside,
             FloorPaint::Line,
             FloorPaint::Floor,
         ]);
         self.palette.clear();
-        self.palette.extend(paints.map(floor));
+        self.palette.extend(
+            paints.map(|paint| shaded(trace::FLOOR_NORMAL, trace::paint_color(scene, paint))),
+        );
         let g = &scene.globals;
         self.sky = trace::pack([g.sky_rgb[0], g.sky_rgb[1], g.sky_rgb[2]]);
         let tops = (scene.boxes.iter().map(|b| b.frame[3]))
             .chain(scene.quads.iter().map(|q| q.z[0]))
             .chain(scene.cylinders.iter().map(|c| c.geom[3]));
         self.top_mm = tops.fold(f32::NEG_INFINITY, f32::max) + CULL_MARGIN_MM;
+    }
+
+    /// Bins the scene's primitives for a sensor axis at `axis` whose rays start up to `rho` mm
+    /// from it.
+    fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32) {
+        self.prepare_faces(scene);
         let pairs = &mut self.pairs;
         pairs.clear();
         let mut add = |prim: Prim, d_min: f32, d_max: f32, top: f32, (centre, half): (f32, f32)| {
