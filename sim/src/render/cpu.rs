@@ -4,8 +4,10 @@
 //! once per sensor in `f64` and kept; every frame then transforms the cached rays to the world
 //! and traces the scene in `f32` with the functions of [`super::trace`]. Primitives are binned
 //! per frame into azimuth sectors around the sensor's axis and sorted by distance, so a ray
-//! that meets the floor near the robot tests only the few primitives nearer than that; the
-//! binning is conservative, so the image is the same as tracing every primitive.
+//! that meets the floor near the robot tests only the few primitives nearer than that. A box's
+//! or quad's distance is that of its part inside the sector's wedge (a long wall is far in the
+//! sectors that look along it). The binning is conservative, and equal distances go to the
+//! primitive first in the scene's order, so the image is the same as tracing every primitive.
 //!
 //! Further savings leave every value as it was: a primitive the ray passes over (above its top
 //! until past its footprint) is not tested, and a ray leaving above everything without going
@@ -201,6 +203,8 @@ struct Sectors {
     /// The highest top of any primitive plus [`CULL_MARGIN_MM`]: a ray from above it that does
     /// not go down meets nothing.
     top_mm: f32,
+    /// The number of boxes and of quads, for [`Sectors::rank`].
+    counts: [u32; 2],
 }
 
 /// An angle (rad) as a fraction of a turn in 32 bits (wrapping).
@@ -261,6 +265,80 @@ fn polygon_distance(corners: &[[f32; 2]]) -> (f32, bool) {
     (best, inside)
 }
 
+/// The nearest and farthest distance (mm) from the axis of the part of a convex polygon
+/// (`corners` relative to the axis) inside the wedge of `sector` widened by half a sector and
+/// by `spread` (rad) on either side, or `None` where the wedge misses it. The wedge holds every
+/// point that a ray of the sector, starting within the rays' offset of the axis, can reach on
+/// the polygon (`spread` = asin(offset / distance of the polygon)); the half sector covers the
+/// rounding of the rays' sectors. In `f64`, whose rounding the culling margins cover.
+fn wedge_extent(corners: &[[f32; 2]; 4], sector: u16, spread: f64) -> Option<(f32, f32)> {
+    let width = std::f64::consts::TAU / SECTORS as f64;
+    let a0 = (sector as f64 - 0.5) * width - spread;
+    let a1 = (sector as f64 + 1.5) * width + spread;
+    // Left of the direction a0 and right of a1 (the wedge is narrower than a half turn).
+    let mut poly = Polygon::default();
+    for c in corners {
+        poly.push([c[0] as f64, c[1] as f64]);
+    }
+    let poly = poly.clip([-a0.sin(), a0.cos()]).clip([a1.sin(), -a1.cos()]);
+    if poly.n == 0 {
+        return None;
+    }
+    let pts = &poly.pts[..poly.n];
+    let far = pts.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max);
+    let near = (0..pts.len())
+        .map(|i| segment_distance(pts[i], pts[(i + 1) % pts.len()]))
+        .fold(f64::INFINITY, f64::min);
+    Some((near as f32, far as f32))
+}
+
+/// Distance from the origin to the segment `a b`.
+fn segment_distance(a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
+    let len2 = ex * ex + ey * ey;
+    let u = if len2 > 0.0 {
+        ((-a[0] * ex - a[1] * ey) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a[0] + u * ex).hypot(a[1] + u * ey)
+}
+
+/// A small convex polygon (a quadrilateral clipped by up to two half-planes).
+#[derive(Debug, Default, Clone, Copy)]
+struct Polygon {
+    pts: [[f64; 2]; 6],
+    n: usize,
+}
+
+impl Polygon {
+    fn push(&mut self, p: [f64; 2]) {
+        if self.n < self.pts.len() {
+            self.pts[self.n] = p;
+            self.n += 1;
+        }
+    }
+
+    /// The part where `normal . p >= 0` (Sutherland and Hodgman's step, for a half-plane
+    /// through the origin).
+    fn clip(&self, normal: [f64; 2]) -> Polygon {
+        let mut out = Polygon::default();
+        let side = |p: [f64; 2]| normal[0] * p[0] + normal[1] * p[1];
+        for i in 0..self.n {
+            let (p, q) = (self.pts[i], self.pts[(i + 1) % self.n]);
+            let (fp, fq) = (side(p), side(q));
+            if fp >= 0.0 {
+                out.push(p);
+            }
+            if (fp >= 0.0) != (fq >= 0.0) {
+                let u = fp / (fp - fq);
+                out.push([p[0] + u * (q[0] - p[0]), p[1] + u * (q[1] - p[1])]);
+            }
+        }
+        out
+    }
+}
+
 impl Sectors {
     /// Prepares, for this frame's scene, each quad prism's sides and the shaded colours that do
     /// not depend on the ray: every face of the quads and boxes, the floor's paints, the sky;
@@ -296,6 +374,17 @@ impl Sectors {
             .chain(scene.quads.iter().map(|q| q.z[0]))
             .chain(scene.cylinders.iter().map(|c| c.geom[3]));
         self.top_mm = tops.fold(f32::NEG_INFINITY, f32::max) + CULL_MARGIN_MM;
+        self.counts = [scene.boxes.len() as u32, scene.quads.len() as u32];
+    }
+
+    /// A primitive's place in the scene's order, from 1 (0 is the floor's).
+    fn rank(&self, prim: Prim) -> u32 {
+        let [boxes, quads] = self.counts;
+        match prim {
+            Prim::Box(i) => 1 + i,
+            Prim::Quad(i) => 1 + boxes + i,
+            Prim::Cylinder(i) => 1 + boxes + quads + i,
+        }
     }
 
     /// Bins the scene's primitives for a sensor axis at `axis` whose rays start up to `rho` mm
@@ -304,7 +393,12 @@ impl Sectors {
         self.prepare_faces(scene);
         let pairs = &mut self.pairs;
         pairs.clear();
-        let mut add = |prim: Prim, d_min: f32, d_max: f32, top: f32, (centre, half): (f32, f32)| {
+        let mut add = |prim: Prim,
+                       d_min: f32,
+                       d_max: f32,
+                       top: f32,
+                       (centre, half): (f32, f32),
+                       corners: Option<&[[f32; 2]; 4]>| {
             let item = Item {
                 d_min,
                 reach: d_max + rho + CULL_MARGIN_MM,
@@ -315,13 +409,28 @@ impl Sectors {
                 pairs.extend((0..SECTORS).map(|k| (k as u16, item)));
                 return;
             }
-            let half = half + (rho / d_min).min(1.0).asin();
+            let spread = (rho / d_min).min(1.0).asin();
+            let half = half + spread;
             let width = std::f32::consts::TAU / SECTORS as f32;
             // One sector to spare on either side: rays find their sector from 32-bit turns.
             let start = ((wrap(centre - half)) / width).floor() as i64 - 1;
             let n = ((2.0 * half) / width).ceil() as i64 + 1;
             for k in start..=start + n + 1 {
-                pairs.push((k.rem_euclid(SECTORS as i64) as u16, item));
+                let sector = k.rem_euclid(SECTORS as i64) as u16;
+                let Some(corners) = corners else {
+                    pairs.push((sector, item));
+                    continue;
+                };
+                // A polygon's part that the sector's rays can reach: nearer and farther than
+                // the whole footprint, or none at all.
+                if let Some((near, far)) = wedge_extent(corners, sector, spread as f64) {
+                    let item = Item {
+                        d_min: near.max(d_min),
+                        reach: far.min(d_max) + rho + CULL_MARGIN_MM,
+                        ..item
+                    };
+                    pairs.push((sector, item));
+                }
             }
         };
         for (i, b) in scene.boxes.iter().enumerate() {
@@ -340,12 +449,19 @@ impl Sectors {
             });
             let d_max = farthest(&corners);
             if lx <= 0.0 && ly <= 0.0 {
-                add(Prim::Box(i as u32), 0.0, d_max, top, AROUND);
+                add(Prim::Box(i as u32), 0.0, d_max, top, AROUND, None);
                 continue;
             }
             let centre = (cy - axis[1]).atan2(cx - axis[0]);
             let half = half_angle(&corners, centre);
-            add(Prim::Box(i as u32), d_min, d_max, top, (centre, half));
+            add(
+                Prim::Box(i as u32),
+                d_min,
+                d_max,
+                top,
+                (centre, half),
+                Some(&corners),
+            );
         }
         for (i, q) in scene.quads.iter().enumerate() {
             let corners = [0, 1, 2, 3].map(|k| {
@@ -355,7 +471,7 @@ impl Sectors {
             let (d_min, inside) = polygon_distance(&corners);
             let (d_max, top) = (farthest(&corners), q.z[0]);
             if inside {
-                add(Prim::Quad(i as u32), 0.0, d_max, top, AROUND);
+                add(Prim::Quad(i as u32), 0.0, d_max, top, AROUND, None);
                 continue;
             }
             let (sx, sy) = corners
@@ -363,7 +479,14 @@ impl Sectors {
                 .fold((0.0, 0.0), |(x, y), c| (x + c[0], y + c[1]));
             let centre = sy.atan2(sx);
             let half = half_angle(&corners, centre);
-            add(Prim::Quad(i as u32), d_min, d_max, top, (centre, half));
+            add(
+                Prim::Quad(i as u32),
+                d_min,
+                d_max,
+                top,
+                (centre, half),
+                Some(&corners),
+            );
         }
         for (i, cyl) in scene.cylinders.iter().enumerate() {
             let [cx, cy, r, top] = cyl.geom;
@@ -371,7 +494,7 @@ impl Sectors {
             let dy = cy - axis[1];
             let dc = (dx * dx + dy * dy).sqrt();
             if dc <= r {
-                add(Prim::Cylinder(i as u32), 0.0, dc + r, top, AROUND);
+                add(Prim::Cylinder(i as u32), 0.0, dc + r, top, AROUND, None);
                 continue;
             }
             add(
@@ -380,6 +503,7 @@ impl Sectors {
                 dc + r,
                 top,
                 (dy.atan2(dx), (r / dc).asin()),
+                None,
             );
         }
         // A stable sort keeps the scene's order among equal distances, so that exact ties
@@ -496,6 +620,9 @@ fn trace_culled(
     let t_floor = trace::floor_t(o, d);
     let mut best = Best::Nothing;
     let mut t_max = t_floor.unwrap_or(f32::INFINITY);
+    // Equal distances go to the primitive first in the scene's order (the floor, then boxes,
+    // quads and cylinders), as when every primitive is traced, whatever order they are tested in.
+    let mut best_rank = 0;
     let range = sectors.offsets[sector] as usize..sectors.offsets[sector + 1] as usize;
     for item in &sectors.items[range] {
         if item.d_min >= t_max * d_xy + rho + 1.0 {
@@ -504,17 +631,23 @@ fn trace_culled(
         if item.passes_over(o[2], d[2], d_xy) {
             continue;
         }
+        let rank = sectors.rank(item.prim);
+        let limit = if rank < best_rank {
+            t_max.next_up()
+        } else {
+            t_max
+        };
         let (t, found) = match item.prim {
             Prim::Box(i) => {
                 let i = i as usize;
                 let b = &scene.boxes[i];
                 if b.color[3] >= 0.0 {
-                    match trace::hit_box(scene, b, o, d, t_max) {
+                    match trace::hit_box(scene, b, o, d, limit) {
                         Some(h) => (h.t, Best::Hit(h)),
                         None => continue,
                     }
                 } else {
-                    match trace::hit_box_face(b, o, d, t_max) {
+                    match trace::hit_box_face(b, o, d, limit) {
                         Some((t, face, _)) => (t, Best::Packed(sectors.box_faces[i][face.index()])),
                         None => continue,
                     }
@@ -523,14 +656,14 @@ fn trace_culled(
             Prim::Quad(i) => {
                 let i = i as usize;
                 let q = &scene.quads[i];
-                match trace::hit_quad_face(q, &sectors.quad_sides[i], o, d, t_max) {
+                match trace::hit_quad_face(q, &sectors.quad_sides[i], o, d, limit) {
                     Some((t, face)) => (t, Best::Packed(sectors.quad_faces[i][face.index()])),
                     None => continue,
                 }
             }
             Prim::Cylinder(i) if i == skip_cylinder => continue,
             Prim::Cylinder(i) => {
-                match trace::hit_cylinder(&scene.cylinders[i as usize], o, d, t_max) {
+                match trace::hit_cylinder(&scene.cylinders[i as usize], o, d, limit) {
                     Some(h) => (h.t, Best::Hit(h)),
                     None => continue,
                 }
@@ -538,6 +671,7 @@ fn trace_culled(
         };
         t_max = t;
         best = found;
+        best_rank = rank;
     }
     match (best, t_floor) {
         (Best::Hit(h), _) => trace::pack(trace::shade(scene, &h)),
@@ -629,6 +763,55 @@ mod tests {
         assert!(
             hits > 1000 && culled > 10_000,
             "hits {hits}, culled {culled}"
+        );
+    }
+
+    #[test]
+    fn a_sectors_rays_meet_a_polygon_only_within_its_wedge_extent() {
+        // A wall 600 mm from the axis, 2 m long, turned a little; rays start within rho.
+        let rho = 20.0f64;
+        let (c, s) = (0.3f64.cos(), 0.3f64.sin());
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
+            let (lx, ly) = (sx * 1000.0, sy * 25.0);
+            [(c * lx - s * ly) as f32, (600.0 + s * lx + c * ly) as f32]
+        });
+        let d_min = 540.0f64;
+        let spread = (rho / d_min).asin();
+        let width = std::f64::consts::TAU / SECTORS as f64;
+        let inside = |x: f64, y: f64| {
+            let (dx, dy) = (x, y - 600.0);
+            let (lx, ly) = (c * dx + s * dy, -s * dx + c * dy);
+            lx.abs() <= 1000.0 && ly.abs() <= 25.0
+        };
+        let (mut met, mut narrowed) = (0, 0);
+        for sector in 0..SECTORS as u16 {
+            let extent = wedge_extent(&corners, sector, spread);
+            if let Some((near, _)) = extent {
+                narrowed += (near > 600.0) as u32;
+            }
+            for k in 0..200 {
+                let a = (sector as f64 + k as f64 / 200.0) * width;
+                let (oa, or) = (k as f64 * 2.4, rho * (k % 7) as f64 / 6.0);
+                let (ox, oy) = (or * oa.cos(), or * oa.sin());
+                for step in 0..400 {
+                    let r = 500.0 + 5.0 * step as f64;
+                    let (x, y) = (ox + r * a.cos(), oy + r * a.sin());
+                    if !inside(x, y) {
+                        continue;
+                    }
+                    met += 1;
+                    let (near, far) = extent.expect("the sector's rays meet the wall");
+                    let dist = x.hypot(y);
+                    assert!(
+                        dist >= near as f64 - 1e-3 && dist <= far as f64 + 1e-3,
+                        "sector {sector}: {dist} outside {near}..{far}"
+                    );
+                }
+            }
+        }
+        assert!(
+            met > 10_000 && narrowed > 10,
+            "met {met}, narrowed {narrowed}"
         );
     }
 
