@@ -20,6 +20,7 @@ use super::trace::{self, BLACK, FloorPaint, Hit, V3};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// The cached mirror half of one pixel, in the robot frame.
 #[derive(Debug, Clone, Copy)]
@@ -270,26 +271,46 @@ fn polygon_distance(corners: &[[f32; 2]]) -> (f32, bool) {
 /// by `spread` (rad) on either side, or `None` where the wedge misses it. The wedge holds every
 /// point that a ray of the sector, starting within the rays' offset of the axis, can reach on
 /// the polygon (`spread` = asin(offset / distance of the polygon)); the half sector covers the
-/// rounding of the rays' sectors. In `f64`, whose rounding the culling margins cover.
-fn wedge_extent(corners: &[[f32; 2]; 4], sector: u16, spread: f64) -> Option<(f32, f32)> {
-    let width = std::f64::consts::TAU / SECTORS as f64;
-    let a0 = (sector as f64 - 0.5) * width - spread;
-    let a1 = (sector as f64 + 1.5) * width + spread;
-    // Left of the direction a0 and right of a1 (the wedge is narrower than a half turn).
+/// rounding of the rays' sectors. `spread` is given by its cosine and sine. In `f64`, whose
+/// rounding the culling margins cover.
+fn wedge_extent(corners: &[[f32; 2]; 4], sector: u16, spread: (f64, f64)) -> Option<(f32, f32)> {
+    let [c0, s0, c1, s1] = sector_edges()[sector as usize];
+    let (cs, ss) = spread;
+    // The wedge's edges, turned outwards by the spread.
+    let (c0, s0) = (c0 * cs + s0 * ss, s0 * cs - c0 * ss);
+    let (c1, s1) = (c1 * cs - s1 * ss, s1 * cs + c1 * ss);
+    // Left of the first edge and right of the second (the wedge is narrower than a half turn).
     let mut poly = Polygon::default();
     for c in corners {
         poly.push([c[0] as f64, c[1] as f64]);
     }
-    let poly = poly.clip([-a0.sin(), a0.cos()]).clip([a1.sin(), -a1.cos()]);
+    let poly = poly.clip([-s0, c0]).clip([s1, -c1]);
     if poly.n == 0 {
         return None;
     }
     let pts = &poly.pts[..poly.n];
-    let far = pts.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max);
+    let far = pts
+        .iter()
+        .map(|p| p[0] * p[0] + p[1] * p[1])
+        .fold(0.0, f64::max)
+        .sqrt();
     let near = (0..pts.len())
         .map(|i| segment_distance(pts[i], pts[(i + 1) % pts.len()]))
         .fold(f64::INFINITY, f64::min);
     Some((near as f32, far as f32))
+}
+
+/// The cosine and sine of each sector's wedge edges, widened by half a sector on either side:
+/// `[cos a0, sin a0, cos a1, sin a1]`.
+fn sector_edges() -> &'static [[f64; 4]; SECTORS] {
+    static EDGES: OnceLock<[[f64; 4]; SECTORS]> = OnceLock::new();
+    EDGES.get_or_init(|| {
+        let width = std::f64::consts::TAU / SECTORS as f64;
+        std::array::from_fn(|k| {
+            let (a0, a1) = ((k as f64 - 0.5) * width, (k as f64 + 1.5) * width);
+            [a0.cos(), a0.sin(), a1.cos(), a1.sin()]
+        })
+    })
 }
 
 /// Distance from the origin to the segment `a b`.
@@ -301,7 +322,8 @@ fn segment_distance(a: [f64; 2], b: [f64; 2]) -> f64 {
     } else {
         0.0
     };
-    (a[0] + u * ex).hypot(a[1] + u * ey)
+    let (x, y) = (a[0] + u * ex, a[1] + u * ey);
+    (x * x + y * y).sqrt()
 }
 
 /// A small convex polygon (a quadrilateral clipped by up to two half-planes).
@@ -410,6 +432,7 @@ impl Sectors {
                 return;
             }
             let spread = (rho / d_min).min(1.0).asin();
+            let spread_cs = ((spread as f64).cos(), (spread as f64).sin());
             let half = half + spread;
             let width = std::f32::consts::TAU / SECTORS as f32;
             // One sector to spare on either side: rays find their sector from 32-bit turns.
@@ -423,7 +446,7 @@ impl Sectors {
                 };
                 // A polygon's part that the sector's rays can reach: nearer and farther than
                 // the whole footprint, or none at all.
-                if let Some((near, far)) = wedge_extent(corners, sector, spread as f64) {
+                if let Some((near, far)) = wedge_extent(corners, sector, spread_cs) {
                     let item = Item {
                         d_min: near.max(d_min),
                         reach: far.min(d_max) + rho + CULL_MARGIN_MM,
@@ -785,7 +808,7 @@ mod tests {
         };
         let (mut met, mut narrowed) = (0, 0);
         for sector in 0..SECTORS as u16 {
-            let extent = wedge_extent(&corners, sector, spread);
+            let extent = wedge_extent(&corners, sector, (spread.cos(), spread.sin()));
             if let Some((near, _)) = extent {
                 narrowed += (near > 600.0) as u32;
             }
