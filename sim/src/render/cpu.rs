@@ -410,8 +410,9 @@ impl Sectors {
     }
 
     /// Bins the scene's primitives for a sensor axis at `axis` whose rays start up to `rho` mm
-    /// from it.
-    fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32) {
+    /// from it, leaving out cylinder `body` (the robot's own, which the rays that may meet it
+    /// test first).
+    fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32, body: Option<usize>) {
         self.prepare_faces(scene);
         let pairs = &mut self.pairs;
         pairs.clear();
@@ -512,6 +513,9 @@ impl Sectors {
             );
         }
         for (i, cyl) in scene.cylinders.iter().enumerate() {
+            if Some(i) == body {
+                continue;
+            }
             let [cx, cy, r, top] = cyl.geom;
             let dx = cx - axis[0];
             let dy = cy - axis[1];
@@ -579,13 +583,13 @@ impl CpuRenderer {
             py + s * rays.axis[0] + c * rays.axis[1],
         ];
         let rho = rays.max_offset_mm;
-        self.sectors.rebuild(scene, axis, rho);
         // The robot's own body: the cylinder standing at its centre. The pixels whose rays
-        // surely miss it (the same for every pose) leave it untested.
+        // may meet it (the same for every pose) test it; the others leave it out.
         let body = scene
             .cylinders
             .iter()
             .position(|cy| cy.geom[0] == px && cy.geom[1] == py);
+        self.sectors.rebuild(scene, axis, rho, body);
         if let Some(i) = body {
             let [_, _, r, top] = scene.cylinders[i].geom;
             rays.prepare_body(r, top);
@@ -612,18 +616,15 @@ impl CpuRenderer {
                     ];
                     let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
                     let sector = (r.azimuth.wrapping_add(heading) >> SECTOR_SHIFT) as usize;
-                    let skip = match body {
-                        Some(i) if !flags[v * width + u] => i as u32,
-                        _ => u32::MAX,
-                    };
-                    *out = trace_culled(scene, sectors, sector, o, d, r.d_xy, rho, skip);
+                    let body = body.filter(|_| flags[v * width + u]);
+                    *out = trace_culled(scene, sectors, sector, o, d, r.d_xy, rho, body);
                 }
             });
     }
 }
 
 /// Traces one world ray against the floor and the primitives of its sector (nearest first,
-/// stopping where none can be nearer), leaving out cylinder `skip_cylinder`.
+/// stopping where none can be nearer), and against cylinder `body` (binned in no sector).
 #[allow(clippy::too_many_arguments)]
 fn trace_culled(
     scene: &Scene,
@@ -633,7 +634,7 @@ fn trace_culled(
     d: V3,
     d_xy: f32,
     rho: f32,
-    skip_cylinder: u32,
+    body: Option<usize>,
 ) -> u32 {
     // A ray that leaves above everything and does not come down passes over every item.
     if d[2] >= 0.0 && o[2] > sectors.top_mm {
@@ -646,6 +647,13 @@ fn trace_culled(
     // Equal distances go to the primitive first in the scene's order (the floor, then boxes,
     // quads and cylinders), as when every primitive is traced, whatever order they are tested in.
     let mut best_rank = 0;
+    if let Some(i) = body {
+        if let Some(h) = trace::hit_cylinder(&scene.cylinders[i], o, d, t_max) {
+            t_max = h.t;
+            best = Best::Hit(h);
+            best_rank = sectors.rank(Prim::Cylinder(i as u32));
+        }
+    }
     let range = sectors.offsets[sector] as usize..sectors.offsets[sector + 1] as usize;
     for item in &sectors.items[range] {
         if item.d_min >= t_max * d_xy + rho + 1.0 {
@@ -684,7 +692,6 @@ fn trace_culled(
                     None => continue,
                 }
             }
-            Prim::Cylinder(i) if i == skip_cylinder => continue,
             Prim::Cylinder(i) => {
                 match trace::hit_cylinder(&scene.cylinders[i as usize], o, d, limit) {
                     Some(h) => (h.t, Best::Hit(h)),
