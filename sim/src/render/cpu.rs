@@ -647,12 +647,12 @@ fn trace_culled(
     // Equal distances go to the primitive first in the scene's order (the floor, then boxes,
     // quads and cylinders), as when every primitive is traced, whatever order they are tested in.
     let mut best_rank = 0;
-    if let Some(i) = body {
-        if let Some(h) = trace::hit_cylinder(&scene.cylinders[i], o, d, t_max) {
-            t_max = h.t;
-            best = Best::Hit(h);
-            best_rank = sectors.rank(Prim::Cylinder(i as u32));
-        }
+    if let Some(i) = body
+        && let Some(h) = trace::hit_cylinder(&scene.cylinders[i], o, d, t_max)
+    {
+        t_max = h.t;
+        best = Best::Hit(h);
+        best_rank = sectors.rank(Prim::Cylinder(i as u32));
     }
     let range = sectors.offsets[sector] as usize..sectors.offsets[sector + 1] as usize;
     for item in &sectors.items[range] {
