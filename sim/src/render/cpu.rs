@@ -28,7 +28,9 @@ struct PixelRay {
     o: V3,
     d: V3,
     /// Azimuth of `d` in the robot frame, in turns as a 32-bit fraction (so that adding the
-    /// robot's heading wraps by itself).
+    /// robot's heading wraps by itself). Its lowest bit (2^-32 turn, far finer than the
+    /// sectors' slack) says whether the ray may meet the robot's body
+    /// ([`SensorRays::prepare_body`]).
     azimuth: u32,
     /// Horizontal length of `d`; negative for a pixel that sees no mirror (so that a ray is
     /// 32 bytes, two to a cache line).
@@ -40,6 +42,11 @@ impl PixelRay {
     fn valid(&self) -> bool {
         self.d_xy >= 0.0
     }
+
+    /// Whether the ray may meet the robot's body.
+    fn may_meet_body(&self) -> bool {
+        self.azimuth & 1 == 1
+    }
 }
 
 /// Per-sensor cache of pixel rays.
@@ -49,9 +56,9 @@ pub struct SensorRays {
     rays: Vec<PixelRay>,
     axis: [f32; 2],
     max_offset_mm: f32,
-    /// Which pixels' rays may meet the robot's own body, for the body's radius and height
-    /// (bits): the body is fixed to the sensor, so this holds for every pose.
-    body: Option<([u32; 2], Vec<bool>)>,
+    /// The robot body's radius and height (bits) for which each ray's body flag is set: the
+    /// body is fixed to the sensor, so the flags hold for every pose.
+    body: Option<[u32; 2]>,
 }
 
 /// Whether the ray `o + t d` (`t > 0`) comes within `r` of the vertical axis through the
@@ -124,21 +131,15 @@ impl SensorRays {
     /// robot-frame rays; the margin covers the rounding of the world-frame test it spares).
     fn prepare_body(&mut self, radius: f32, top: f32) {
         let key = [radius.to_bits(), top.to_bits()];
-        if self.body.as_ref().is_none_or(|(k, _)| *k != key) {
+        if self.body != Some(key) {
             let r = radius + BODY_MARGIN_MM;
             let z_top = top + BODY_MARGIN_MM;
-            let flags = self
-                .rays
-                .iter()
-                .map(|ray| ray.valid() && may_meet_cylinder(ray.o, ray.d, r, z_top))
-                .collect();
-            self.body = Some((key, flags));
+            for ray in &mut self.rays {
+                let meets = ray.valid() && may_meet_cylinder(ray.o, ray.d, r, z_top);
+                ray.azimuth = (ray.azimuth & !1) | meets as u32;
+            }
+            self.body = Some(key);
         }
-    }
-
-    /// The flags of the last [`SensorRays::prepare_body`].
-    fn body_flags(&self) -> &[bool] {
-        self.body.as_ref().map_or(&[], |(_, f)| f.as_slice())
     }
 }
 
@@ -595,16 +596,14 @@ impl CpuRenderer {
             rays.prepare_body(r, top);
         }
         let rays: &SensorRays = rays;
-        let flags = rays.body_flags();
         let sectors = &self.sectors;
         let heading = turns(theta);
         let width = rays.width as usize;
         pixels
             .par_chunks_mut(width)
             .zip(rays.rays.par_chunks(width))
-            .enumerate()
-            .for_each(|(v, (row, row_rays))| {
-                for (u, (out, r)) in row.iter_mut().zip(row_rays).enumerate() {
+            .for_each(|(row, row_rays)| {
+                for (out, r) in row.iter_mut().zip(row_rays) {
                     if !r.valid() {
                         *out = BLACK;
                         continue;
@@ -616,7 +615,7 @@ impl CpuRenderer {
                     ];
                     let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
                     let sector = (r.azimuth.wrapping_add(heading) >> SECTOR_SHIFT) as usize;
-                    let body = body.filter(|_| flags[v * width + u]);
+                    let body = body.filter(|_| r.may_meet_body());
                     *out = trace_culled(scene, sectors, sector, o, d, r.d_xy, rho, body);
                 }
             });
