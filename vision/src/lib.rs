@@ -4,6 +4,7 @@
 //! map, never a simulated world, so it works the same on a real camera's PNG.
 
 pub mod calibration;
+pub mod camera_model;
 pub mod floor_localization;
 pub mod forward;
 pub mod freespace;

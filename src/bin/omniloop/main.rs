@@ -9,9 +9,10 @@ use omniloop::experiments::{REPLAYS, ReplayContext, parse_scenario, replay, run_
 use omniloop::report::output::{default_out_dir, write_run};
 use omniloop::run::{RunOptions, render_snapshot};
 use omniloop::scenario::calibrate::calibrate_sensor;
+use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
 use omniloop::sweep::Seeds;
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
-use omniloop_sim::{Renderer, RendererChoice};
+use omniloop_sim::{Renderer, RendererChoice, SensorSpec};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -131,20 +132,71 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
-    /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate.
+    /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate;
+    /// with --format, fit a standard camera model to its rays and write that tool's file.
     Calibrate {
         /// Scenario file.
         scenario: PathBuf,
         /// Sensor name (default: the robot's first sensor).
         #[arg(long)]
         sensor: Option<String>,
-        /// Output file (default: runs/<scenario name>/calibration_<sensor>.json).
+        /// Camera model file to write instead: opencv-omnidir or kalibr-omni (Mei's unified
+        /// model; docs/camera-models.md).
+        #[arg(long, value_parser = camera_format)]
+        format: Option<CameraFormat>,
+        /// Output file (default: runs/<scenario name>/calibration_<sensor>.json, or
+        /// camera_<sensor>_<format>.yaml with --format; the model's pose as JSON beside it).
         #[arg(long)]
         out: Option<PathBuf>,
     },
 }
 
 mod sweep;
+
+/// A camera model format by its command-line name.
+fn camera_format(name: &str) -> Result<CameraFormat, String> {
+    CameraFormat::ALL
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, f)| *f)
+        .ok_or_else(|| {
+            let names: Vec<&str> = CameraFormat::ALL.iter().map(|(n, _)| *n).collect();
+            format!(
+                "unknown camera model format {name:?} (one of: {})",
+                names.join(", ")
+            )
+        })
+}
+
+/// Fits `format`'s model to `spec`'s rays, writes it to `out` and its pose as JSON beside it,
+/// and prints the fit's residual.
+fn write_camera_model(spec: &SensorSpec, format: CameraFormat, out: &Path) -> anyhow::Result<()> {
+    let e = export_camera_model(spec, format)?;
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("creating {}", parent.display()))?;
+    }
+    std::fs::write(out, &e.text).with_context(|| format!("writing {}", out.display()))?;
+    let json_path = out.with_extension("json");
+    let json = serde_json::to_string_pretty(&e.json)?;
+    std::fs::write(&json_path, json + "\n")
+        .with_context(|| format!("writing {}", json_path.display()))?;
+    println!(
+        "sensor {} as {} (xi {:.5}, f {:.3} / {:.3} px): reprojection RMS {:.4} px, worst {:.4} px \
+         over {} rays; rays within {:.3} mm of the viewpoint",
+        spec.name,
+        format.name(),
+        e.model.xi,
+        e.model.focal_px[0],
+        e.model.focal_px[1],
+        e.residual.rms_px,
+        e.residual.worst_px,
+        e.residual.count,
+        e.viewpoint_spread_mm
+    );
+    println!("wrote {} and {}", out.display(), json_path.display());
+    Ok(())
+}
 
 /// An error that makes the command exit with a given code.
 #[derive(Debug)]
@@ -384,6 +436,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate {
             scenario,
             sensor,
+            format,
             out,
         } => {
             let s = load(&scenario)?;
@@ -391,6 +444,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 Ok(spec) => spec,
                 Err(e) => bail!("scenario {:?}: {e}", s.name),
             };
+            if let Some(format) = format {
+                let out = out.unwrap_or_else(|| {
+                    default_out_dir(&s).join(format!("camera_{}_{}.yaml", spec.name, format.name()))
+                });
+                return write_camera_model(spec, format, &out);
+            }
             let cal = calibrate_sensor(spec)?;
             let out = out.unwrap_or_else(|| {
                 default_out_dir(&s).join(format!("calibration_{}.json", spec.name))

@@ -1,0 +1,236 @@
+//! Fitting a camera model to known rays: each ray's direction in the model's frame and the
+//! pixel that sees it, by least squares on the reprojection error in pixels.
+//!
+//! A small Levenberg-Marquardt of our own (Marquardt's diagonal damping, a central-difference
+//! Jacobian): the Rust crate for it is built on another major version of nalgebra than ours.
+
+use super::unified::UnifiedModel;
+use crate::VisionError;
+use nalgebra::{SMatrix, SVector, Vector3};
+
+/// A ray the model must image: its direction (model frame) and the pixel (pixel centres at
+/// integer coordinates) that sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Correspondence {
+    /// Direction of the ray from the model's viewpoint, in the model's frame.
+    pub direction: Vector3<f64>,
+    /// The pixel `[u, v]` that sees it.
+    pub pixel: [f64; 2],
+}
+
+/// How well a fitted model reprojects its rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitResidual {
+    /// Rays the fit used.
+    pub count: usize,
+    /// Root mean square reprojection error (px).
+    pub rms_px: f64,
+    /// Largest reprojection error (px).
+    pub worst_px: f64,
+}
+
+/// The reprojection errors of `model` on `rays` (a ray it cannot image counts as infinitely
+/// far).
+pub fn residual(model: &UnifiedModel, rays: &[Correspondence]) -> FitResidual {
+    let (mut sum, mut worst) = (0.0, 0.0f64);
+    for c in rays {
+        let e = match model.project(&c.direction) {
+            Some(p) => (p[0] - c.pixel[0]).hypot(p[1] - c.pixel[1]),
+            None => f64::INFINITY,
+        };
+        sum += e * e;
+        worst = worst.max(e);
+    }
+    FitResidual {
+        count: rays.len(),
+        rms_px: (sum / rays.len().max(1) as f64).sqrt(),
+        worst_px: worst,
+    }
+}
+
+/// Fits the unified model (`f_x, f_y, c_x, c_y, xi` and the four distortion terms; no skew) to
+/// `rays`. The start: for `xi` on a grid from 0 to 1.5, the focal lengths and principal point
+/// without distortion by linear least squares, keeping the `xi` that fits best.
+pub fn fit_unified(rays: &[Correspondence]) -> Result<(UnifiedModel, FitResidual), VisionError> {
+    if rays.len() < 20 {
+        return Err(VisionError::Calibration(format!(
+            "a camera model needs at least 20 rays to fit, got {}",
+            rays.len()
+        )));
+    }
+    let start = (0..=30)
+        .filter_map(|k| linear_start(rays, 0.05 * k as f64))
+        .map(|m| (residual(&m, rays).rms_px, m))
+        .filter(|(e, _)| e.is_finite())
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, m)| m)
+        .ok_or_else(|| {
+            VisionError::Calibration("no start for the unified model images every ray".into())
+        })?;
+    let model = levenberg_marquardt(start, rays);
+    Ok((model, residual(&model, rays)))
+}
+
+/// Focal lengths and principal point for a given `xi`, without distortion: `u = f_x x + c_x`
+/// and `v = f_y y + c_y` solved as two straight-line fits.
+fn linear_start(rays: &[Correspondence], xi: f64) -> Option<UnifiedModel> {
+    let mut sums = [[0.0f64; 5]; 2];
+    for c in rays {
+        let s = c.direction.normalize();
+        let denom = s.z + xi;
+        if denom <= 1e-6 {
+            return None;
+        }
+        for (axis, sum) in sums.iter_mut().enumerate() {
+            let (x, u) = (s[axis] / denom, c.pixel[axis]);
+            *sum = [
+                sum[0] + 1.0,
+                sum[1] + x,
+                sum[2] + u,
+                sum[3] + x * x,
+                sum[4] + x * u,
+            ];
+        }
+    }
+    let line = |[n, sx, su, sxx, sxu]: [f64; 5]| {
+        let det = n * sxx - sx * sx;
+        (det.abs() > 1e-12).then(|| ((n * sxu - sx * su) / det, (sxx * su - sx * sxu) / det))
+    };
+    let (fx, cx) = line(sums[0])?;
+    let (fy, cy) = line(sums[1])?;
+    Some(UnifiedModel {
+        focal_px: [fx, fy],
+        skew_px: 0.0,
+        principal_px: [cx, cy],
+        xi,
+        distortion: [0.0; 4],
+    })
+}
+
+/// Sum of squared reprojection errors; infinite where a ray cannot be imaged.
+fn cost(model: &UnifiedModel, rays: &[Correspondence]) -> f64 {
+    let r = residual(model, rays);
+    r.rms_px * r.rms_px * r.count as f64
+}
+
+fn levenberg_marquardt(start: UnifiedModel, rays: &[Correspondence]) -> UnifiedModel {
+    let mut model = start;
+    let mut current = cost(&model, rays);
+    let mut lambda = 1e-3;
+    for _ in 0..200 {
+        let (jtj, jtr) = normal_equations(&model, rays);
+        let mut improved = false;
+        while lambda < 1e12 {
+            let mut a = jtj;
+            for i in 0..9 {
+                a[(i, i)] += lambda * jtj[(i, i)].max(1e-12);
+            }
+            let Some(step) = a.cholesky().map(|c| c.solve(&-jtr)) else {
+                lambda *= 4.0;
+                continue;
+            };
+            let p = SVector::<f64, 9>::from(model.params()) + step;
+            let trial = model.with_params(&p.into());
+            let c = cost(&trial, rays);
+            if c < current {
+                let gain = (current - c) / current.max(1e-300);
+                model = trial;
+                current = c;
+                lambda = (lambda / 3.0).max(1e-12);
+                improved = gain > 1e-14;
+                break;
+            }
+            lambda *= 4.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    model
+}
+
+/// `J^T J` and `J^T r` of the reprojection residuals, with a central-difference Jacobian.
+fn normal_equations(
+    model: &UnifiedModel,
+    rays: &[Correspondence],
+) -> (SMatrix<f64, 9, 9>, SVector<f64, 9>) {
+    let p = model.params();
+    let steps: [f64; 9] = std::array::from_fn(|i| 1e-6 * p[i].abs().max(1e-2));
+    let shifted: Vec<[UnifiedModel; 2]> = (0..9)
+        .map(|i| {
+            [1.0, -1.0].map(|sign| {
+                let mut q = p;
+                q[i] += sign * steps[i];
+                model.with_params(&q)
+            })
+        })
+        .collect();
+    let mut jtj = SMatrix::<f64, 9, 9>::zeros();
+    let mut jtr = SVector::<f64, 9>::zeros();
+    for c in rays {
+        let Some(base) = model.project(&c.direction) else {
+            continue;
+        };
+        let mut rows = [SVector::<f64, 9>::zeros(); 2];
+        for (i, [plus, minus]) in shifted.iter().enumerate() {
+            let (Some(a), Some(b)) = (plus.project(&c.direction), minus.project(&c.direction))
+            else {
+                continue;
+            };
+            for k in 0..2 {
+                rows[k][i] = (a[k] - b[k]) / (2.0 * steps[i]);
+            }
+        }
+        for k in 0..2 {
+            jtj += rows[k] * rows[k].transpose();
+            jtr += rows[k] * (base[k] - c.pixel[k]);
+        }
+    }
+    (jtj, jtr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rays of a known model over a fisheye-like field of view.
+    fn rays_of(m: &UnifiedModel) -> Vec<Correspondence> {
+        let mut out = Vec::new();
+        for i in 0..40 {
+            for j in 0..60 {
+                let polar = 0.05 + 1.9 * i as f64 / 40.0;
+                let az = std::f64::consts::TAU * j as f64 / 60.0;
+                let d = Vector3::new(polar.sin() * az.cos(), polar.sin() * az.sin(), polar.cos());
+                if let Some(pixel) = m.project(&d) {
+                    out.push(Correspondence {
+                        direction: d,
+                        pixel,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_models_own_rays_give_it_back() {
+        let truth = UnifiedModel {
+            focal_px: [420.0, 415.0],
+            skew_px: 0.0,
+            principal_px: [127.3, 109.1],
+            xi: 0.97,
+            distortion: [0.02, -0.004, 0.0006, -0.0003],
+        };
+        let rays = rays_of(&truth);
+        let (m, r) = fit_unified(&rays).unwrap();
+        assert!(r.worst_px < 1e-4, "{r:?}");
+        assert!((m.xi - truth.xi).abs() < 1e-4, "{m:?}");
+        assert!((m.focal_px[0] - truth.focal_px[0]).abs() < 0.05, "{m:?}");
+    }
+
+    #[test]
+    fn too_few_rays_is_an_error() {
+        let e = fit_unified(&[]).unwrap_err();
+        assert!(e.to_string().contains("at least 20 rays"), "{e}");
+    }
+}
