@@ -13,8 +13,8 @@ use nalgebra::{Matrix3, Vector3};
 use omniloop_sim::SensorSpec;
 use omniloop_sim::optics::Optics;
 use omniloop_vision::camera_model::{
-    Correspondence, FitResidual, ModelPose, UnifiedModel, fit_unified, kalibr_omni_yaml,
-    opencv_omnidir_yaml,
+    Correspondence, DoubleSphereModel, FitResidual, ModelPose, OcamModel, UnifiedModel,
+    fit_unified, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml, refine, residual,
 };
 
 /// A camera model file format.
@@ -24,13 +24,79 @@ pub enum CameraFormat {
     OpencvOmnidir,
     /// Kalibr's camchain YAML with `camera_model: omni`, `distortion_model: radtan`.
     KalibrOmni,
+    /// Kalibr's camchain YAML with `camera_model: ds` (the double sphere model).
+    KalibrDs,
+    /// OCamCalib's `calib_results.txt` (Scaramuzza's polynomial).
+    Ocamcalib,
+}
+
+/// A fitted model: which, and its intrinsics.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FittedModel {
+    /// Mei's unified model (OpenCV `omnidir`, Kalibr `omni`).
+    Unified(UnifiedModel),
+    /// The double sphere model (Kalibr `ds`).
+    DoubleSphere(DoubleSphereModel),
+    /// Scaramuzza's polynomial (OCamCalib).
+    Ocam(OcamModel),
+}
+
+impl FittedModel {
+    /// Its intrinsics as JSON.
+    fn json(&self) -> serde_json::Value {
+        match self {
+            FittedModel::Unified(m) => serde_json::json!({
+                "model": "unified (Mei)",
+                "focal_px": m.focal_px,
+                "skew_px": m.skew_px,
+                "principal_point_px": m.principal_px,
+                "xi": m.xi,
+                "distortion_k1_k2_p1_p2": m.distortion,
+            }),
+            FittedModel::DoubleSphere(m) => serde_json::json!({
+                "model": "double sphere",
+                "focal_px": m.focal_px,
+                "principal_point_px": m.principal_px,
+                "xi": m.xi,
+                "alpha": m.alpha,
+            }),
+            FittedModel::Ocam(m) => serde_json::json!({
+                "model": "OCamCalib polynomial (Scaramuzza)",
+                "pol": m.pol,
+                "invpol": m.invpol,
+                "center_row_col_px": m.center_rc,
+                "affine_c_d_e": m.affine,
+            }),
+        }
+    }
+
+    /// A line of its main figures.
+    pub fn summary(&self) -> String {
+        match self {
+            FittedModel::Unified(m) => format!(
+                "xi {:.5}, f {:.3} / {:.3} px",
+                m.xi, m.focal_px[0], m.focal_px[1]
+            ),
+            FittedModel::DoubleSphere(m) => format!(
+                "xi {:.5}, alpha {:.5}, f {:.3} / {:.3} px",
+                m.xi, m.alpha, m.focal_px[0], m.focal_px[1]
+            ),
+            FittedModel::Ocam(m) => format!(
+                "f(rho) of degree {}, inverse of degree {}",
+                m.pol.len() - 1,
+                m.invpol.len() - 1
+            ),
+        }
+    }
 }
 
 impl CameraFormat {
     /// Every format, by the name the command line takes.
-    pub const ALL: [(&'static str, CameraFormat); 2] = [
+    pub const ALL: [(&'static str, CameraFormat); 4] = [
         ("opencv-omnidir", CameraFormat::OpencvOmnidir),
+        ("ocamcalib", CameraFormat::Ocamcalib),
         ("kalibr-omni", CameraFormat::KalibrOmni),
+        ("kalibr-ds", CameraFormat::KalibrDs),
     ];
 
     /// Its name on the command line.
@@ -49,20 +115,20 @@ pub enum ExportError {
     #[error("sensor {0:?} is a pinhole camera: the omnidirectional models are for mirror sensors")]
     NotAMirror(String),
     /// The fit failed.
-    #[error("sensor {sensor:?}: {source}")]
+    #[error("sensor {sensor:?}: {reason}")]
     Fit {
         /// The sensor.
         sensor: String,
         /// What failed.
-        source: omniloop_vision::VisionError,
+        reason: omniloop_vision::VisionError,
     },
 }
 
 /// A fitted model, its file's text and the figures of the fit.
 #[derive(Debug, Clone)]
 pub struct CameraExport {
-    /// The fitted intrinsics.
-    pub model: UnifiedModel,
+    /// The fitted model.
+    pub model: FittedModel,
     /// The model's frame on the robot.
     pub pose: ModelPose,
     /// Reprojection residual over every traced ray.
@@ -97,53 +163,94 @@ pub fn export_camera_model(
         .iter()
         .map(|(_, o, d)| distance_to_line(&viewpoint, o, d))
         .fold(0.0, f64::max);
-    let rotation = Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0);
+    let in_frame = |rotation: &Matrix3<f64>| -> Vec<Correspondence> {
+        rays.iter()
+            .map(|(pixel, _, d)| Correspondence {
+                direction: rotation.transpose() * d,
+                pixel: *pixel,
+            })
+            .collect()
+    };
+    let correspondences = in_frame(&UNIFIED_FRAME);
+    let mut rotation = UNIFIED_FRAME;
+    let fit_error = |reason| ExportError::Fit {
+        sensor: spec.name.clone(),
+        reason,
+    };
+    let (unified, unified_residual) = fit_unified(&correspondences).map_err(fit_error)?;
+    let (model, residual) = match format {
+        CameraFormat::OpencvOmnidir | CameraFormat::KalibrOmni => {
+            (FittedModel::Unified(unified), unified_residual)
+        }
+        CameraFormat::KalibrDs => {
+            // Starts from the unified fit with the second sphere's weight at a few values
+            // (xi grown until the model's field of view holds every ray); the best refined one.
+            let mut best: Option<(DoubleSphereModel, FitResidual)> = None;
+            for alpha in [0.0, 0.2, 0.4, 0.6] {
+                let mut start = DoubleSphereModel {
+                    alpha,
+                    ..DoubleSphereModel::from_unified(&unified)
+                };
+                while start.xi < 5.0 && !residual(&start, &correspondences).rms_px.is_finite() {
+                    start.xi += 0.1;
+                }
+                if let Ok((m, r)) = refine(start, &correspondences)
+                    && best.as_ref().is_none_or(|(_, b)| r.rms_px < b.rms_px)
+                {
+                    best = Some((m, r));
+                }
+            }
+            let (m, r) = best.ok_or_else(|| {
+                fit_error(omniloop_vision::VisionError::Calibration(
+                    "no start of the double sphere model images every ray".into(),
+                ))
+            })?;
+            (FittedModel::DoubleSphere(m), r)
+        }
+        CameraFormat::Ocamcalib => {
+            rotation = OCAM_FRAME;
+            let rays = in_frame(&OCAM_FRAME);
+            let [cx, cy] = unified.principal_px;
+            let size_hw = [sensor.height_px, sensor.width_px];
+            let m = OcamModel::fit(&rays, [cy, cx], size_hw, 4).map_err(fit_error)?;
+            let r = m.residual(&rays);
+            (FittedModel::Ocam(m), r)
+        }
+    };
     let pose = ModelPose {
         rotation,
         translation_mm: viewpoint,
     };
-    let correspondences: Vec<Correspondence> = rays
-        .iter()
-        .map(|(pixel, _, d)| Correspondence {
-            direction: rotation.transpose() * d,
-            pixel: *pixel,
-        })
-        .collect();
-    let (model, residual) = fit_unified(&correspondences).map_err(|source| ExportError::Fit {
-        sensor: spec.name.clone(),
-        source,
-    })?;
     let header = format!(
-        "omniloop: sensor {:?} ({} mirror) as Mei's unified model, fitted to {} traced rays:\n\
+        "omniloop: sensor {:?} ({} mirror) as the {} model, fitted to {} traced rays:\n\
          reprojection RMS {:.4} px, worst {:.4} px; rays within {:.3} mm of the viewpoint.",
         spec.name,
         spec.optics.kind(),
+        format.name(),
         residual.count,
         residual.rms_px,
         residual.worst_px,
         spread
     );
     let size = [sensor.width_px, sensor.height_px];
-    let text = match format {
-        CameraFormat::OpencvOmnidir => opencv_omnidir_yaml(&model, size, &pose, &header),
-        CameraFormat::KalibrOmni => kalibr_omni_yaml(
-            &model,
-            size,
-            &pose,
-            &format!("/camera/{}", spec.name),
-            &header,
-        ),
+    let topic = format!("/camera/{}", spec.name);
+    let text = match &model {
+        FittedModel::Unified(m) if format == CameraFormat::KalibrOmni => {
+            kalibr_omni_yaml(m, size, &pose, &topic, &header)
+        }
+        FittedModel::Unified(m) => opencv_omnidir_yaml(m, size, &pose, &header),
+        FittedModel::DoubleSphere(m) => kalibr_ds_yaml(m, size, &pose, &topic, &header),
+        // The toolbox reads its fields in a fixed order: the notes follow them.
+        FittedModel::Ocam(m) => {
+            let notes: String = header.lines().map(|l| format!("#{l}\n")).collect();
+            format!("{}{notes}{}", m.calib_results_txt(), pose.comment_lines())
+        }
     };
     let json = serde_json::json!({
         "sensor": spec.name,
         "format": format.name(),
-        "model": "unified (Mei)",
         "image_size_px": size,
-        "focal_px": model.focal_px,
-        "skew_px": model.skew_px,
-        "principal_point_px": model.principal_px,
-        "xi": model.xi,
-        "distortion_k1_k2_p1_p2": model.distortion,
+        "intrinsics": model.json(),
         "model_frame_in_body": {
             "rotation": [
                 [rotation[(0, 0)], rotation[(0, 1)], rotation[(0, 2)]],
@@ -164,6 +271,14 @@ pub fn export_camera_model(
         json,
     })
 }
+
+/// The unified and double sphere models' frame in the body frame (its columns): x forward, y
+/// right, z down.
+const UNIFIED_FRAME: Matrix3<f64> = Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0);
+
+/// OCamCalib's frame in the body frame: x along the image rows (the body's right), y along the
+/// columns (forward), z up.
+const OCAM_FRAME: Matrix3<f64> = Matrix3::new(0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
 
 /// The point nearest (least squares) to the lines through `o` along unit `d`.
 fn nearest_point(rays: &[([f64; 2], Vector3<f64>, Vector3<f64>)]) -> Vector3<f64> {
@@ -200,10 +315,21 @@ mod tests {
         // xi = 2e / (1 + e^2) with e = c / b (Geyer and Daniilidis).
         let m = omniloop_sim::optics::HyperbolicMirror::corner_paper();
         let ecc = m.focal_half_distance_mm() / m.b_mm;
+        let FittedModel::Unified(m) = e.model else {
+            panic!("{:?}", e.model)
+        };
+        assert!((m.xi - 2.0 * ecc / (1.0 + ecc * ecc)).abs() < 1e-4, "{m:?}");
+        // The double sphere model holds the unified one: exact too.
+        let ds = export_camera_model(&spec, CameraFormat::KalibrDs).unwrap();
+        assert!(ds.residual.worst_px < 0.05, "{:?}", ds.residual);
+        assert!(ds.text.contains("camera_model: ds"), "{}", ds.text);
+        // Scaramuzza's polynomial approximates it (degree 4, its inverse to 0.01 px).
+        let ocam = export_camera_model(&spec, CameraFormat::Ocamcalib).unwrap();
+        assert!(ocam.residual.worst_px < 0.05, "{:?}", ocam.residual);
         assert!(
-            (e.model.xi - 2.0 * ecc / (1.0 + ecc * ecc)).abs() < 1e-4,
-            "{:?}",
-            e.model
+            ocam.text.starts_with("#polynomial coefficients"),
+            "{}",
+            ocam.text
         );
     }
 

@@ -141,11 +141,13 @@ enum Command {
         #[arg(long)]
         sensor: Option<String>,
         /// Camera model file to write instead: opencv-omnidir or kalibr-omni (Mei's unified
-        /// model; docs/camera-models.md).
+        /// model), ocamcalib (Scaramuzza's polynomial) or kalibr-ds (double sphere);
+        /// docs/camera-models.md.
         #[arg(long, value_parser = camera_format)]
         format: Option<CameraFormat>,
         /// Output file (default: runs/<scenario name>/calibration_<sensor>.json, or
-        /// camera_<sensor>_<format>.yaml with --format; the model's pose as JSON beside it).
+        /// camera_<sensor>_<format>.yaml (.txt for ocamcalib) with --format; the model's pose
+        /// as JSON beside it).
         #[arg(long)]
         out: Option<PathBuf>,
     },
@@ -182,13 +184,11 @@ fn write_camera_model(spec: &SensorSpec, format: CameraFormat, out: &Path) -> an
     std::fs::write(&json_path, json + "\n")
         .with_context(|| format!("writing {}", json_path.display()))?;
     println!(
-        "sensor {} as {} (xi {:.5}, f {:.3} / {:.3} px): reprojection RMS {:.4} px, worst {:.4} px \
-         over {} rays; rays within {:.3} mm of the viewpoint",
+        "sensor {} as {} ({}): reprojection RMS {:.4} px, worst {:.4} px over {} rays; rays \
+         within {:.3} mm of the viewpoint",
         spec.name,
         format.name(),
-        e.model.xi,
-        e.model.focal_px[0],
-        e.model.focal_px[1],
+        e.model.summary(),
         e.residual.rms_px,
         e.residual.worst_px,
         e.residual.count,
@@ -446,7 +446,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             };
             if let Some(format) = format {
                 let out = out.unwrap_or_else(|| {
-                    default_out_dir(&s).join(format!("camera_{}_{}.yaml", spec.name, format.name()))
+                    let ext = if format == CameraFormat::Ocamcalib {
+                        "txt"
+                    } else {
+                        "yaml"
+                    };
+                    default_out_dir(&s).join(format!(
+                        "camera_{}_{}.{ext}",
+                        spec.name,
+                        format.name()
+                    ))
                 });
                 return write_camera_model(spec, format, &out);
             }

@@ -1,6 +1,7 @@
 //! Camera model files in their tools' own formats: OpenCV's `cv::FileStorage` YAML for the
 //! `omnidir` module and Kalibr's camchain YAML.
 
+use super::double_sphere::DoubleSphereModel;
 use super::unified::UnifiedModel;
 use nalgebra::{Matrix3, Vector3};
 
@@ -15,7 +16,7 @@ pub struct ModelPose {
 
 impl ModelPose {
     /// The pose as comment lines (`# ...`).
-    fn comment(&self) -> String {
+    pub fn comment_lines(&self) -> String {
         let r = &self.rotation;
         let t = &self.translation_mm;
         let mut s = String::from(
@@ -58,7 +59,7 @@ pub fn opencv_omnidir_yaml(
     for line in header.lines() {
         s += &format!("# {line}\n");
     }
-    s += &pose.comment();
+    s += &pose.comment_lines();
     s += &format!(
         "image_width: {}\nimage_height: {}\n",
         size_px[0], size_px[1]
@@ -81,6 +82,52 @@ pub fn kalibr_omni_yaml(
 ) -> String {
     let [fx, fy] = model.focal_px;
     let [cx, cy] = model.principal_px;
+    let camera = KalibrCamera {
+        model: "omni",
+        intrinsics: vec![model.xi, fx, fy, cx, cy],
+        distortion: ("radtan", model.distortion.to_vec()),
+    };
+    kalibr_yaml(&camera, size_px, pose, topic, header)
+}
+
+/// The model as a Kalibr camchain with `camera_model: ds` (`intrinsics: [xi, alpha, f_u, f_v,
+/// p_u, p_v]`, no distortion), as [`kalibr_omni_yaml`] otherwise.
+pub fn kalibr_ds_yaml(
+    model: &DoubleSphereModel,
+    size_px: [u32; 2],
+    pose: &ModelPose,
+    topic: &str,
+    header: &str,
+) -> String {
+    let [fx, fy] = model.focal_px;
+    let [cx, cy] = model.principal_px;
+    let camera = KalibrCamera {
+        model: "ds",
+        intrinsics: vec![model.xi, model.alpha, fx, fy, cx, cy],
+        distortion: ("none", Vec::new()),
+    };
+    kalibr_yaml(&camera, size_px, pose, topic, header)
+}
+
+/// One camera of a Kalibr camchain.
+struct KalibrCamera {
+    model: &'static str,
+    intrinsics: Vec<f64>,
+    distortion: (&'static str, Vec<f64>),
+}
+
+fn yaml_list(values: &[f64]) -> String {
+    let v: Vec<String> = values.iter().map(|v| format!("{v:?}")).collect();
+    format!("[{}]", v.join(", "))
+}
+
+fn kalibr_yaml(
+    camera: &KalibrCamera,
+    size_px: [u32; 2],
+    pose: &ModelPose,
+    topic: &str,
+    header: &str,
+) -> String {
     // p_model = R^T (p_body - t).
     let r = pose.rotation.transpose();
     let t = -(r * pose.translation_mm) / 1000.0;
@@ -88,25 +135,16 @@ pub fn kalibr_omni_yaml(
     for line in header.lines() {
         s += &format!("# {line}\n");
     }
-    s += &pose.comment();
-    s += "cam0:\n  camera_model: omni\n";
-    s += &format!(
-        "  intrinsics: [{:?}, {fx:?}, {fy:?}, {cx:?}, {cy:?}]\n",
-        model.xi
-    );
-    s += "  distortion_model: radtan\n";
-    let [k1, k2, p1, p2] = model.distortion;
-    s += &format!("  distortion_coeffs: [{k1:?}, {k2:?}, {p1:?}, {p2:?}]\n");
+    s += &pose.comment_lines();
+    s += &format!("cam0:\n  camera_model: {}\n", camera.model);
+    s += &format!("  intrinsics: {}\n", yaml_list(&camera.intrinsics));
+    s += &format!("  distortion_model: {}\n", camera.distortion.0);
+    s += &format!("  distortion_coeffs: {}\n", yaml_list(&camera.distortion.1));
     s += &format!("  resolution: [{}, {}]\n", size_px[0], size_px[1]);
     s += &format!("  rostopic: {topic}\n  T_cam_imu:\n");
     for i in 0..3 {
-        s += &format!(
-            "  - [{:?}, {:?}, {:?}, {:?}]\n",
-            r[(i, 0)],
-            r[(i, 1)],
-            r[(i, 2)],
-            t[i]
-        );
+        let row = [r[(i, 0)], r[(i, 1)], r[(i, 2)], t[i]];
+        s += &format!("  - {}\n", yaml_list(&row));
     }
     s + "  - [0.0, 0.0, 0.0, 1.0]\n"
 }

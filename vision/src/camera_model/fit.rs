@@ -6,7 +6,31 @@
 
 use super::unified::UnifiedModel;
 use crate::VisionError;
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// A camera model the fit can adjust: its free parameters as a vector, and its projection.
+pub trait Projection: Copy {
+    /// The free parameters, in a fixed order.
+    fn params(&self) -> Vec<f64>;
+    /// The model with other values of [`Projection::params`].
+    fn with_params(&self, p: &[f64]) -> Self;
+    /// The pixel where a point of the model's frame images, if it does.
+    fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]>;
+}
+
+impl Projection for UnifiedModel {
+    fn params(&self) -> Vec<f64> {
+        UnifiedModel::params(self).to_vec()
+    }
+    fn with_params(&self, p: &[f64]) -> Self {
+        let mut q = [0.0; 9];
+        q.copy_from_slice(&p[..9]);
+        UnifiedModel::with_params(self, &q)
+    }
+    fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
+        UnifiedModel::project(self, p)
+    }
+}
 
 /// A ray the model must image: its direction (model frame) and the pixel (pixel centres at
 /// integer coordinates) that sees it.
@@ -31,7 +55,7 @@ pub struct FitResidual {
 
 /// The reprojection errors of `model` on `rays` (a ray it cannot image counts as infinitely
 /// far).
-pub fn residual(model: &UnifiedModel, rays: &[Correspondence]) -> FitResidual {
+pub fn residual(model: &impl Projection, rays: &[Correspondence]) -> FitResidual {
     let (mut sum, mut worst) = (0.0, 0.0f64);
     for c in rays {
         let e = match model.project(&c.direction) {
@@ -52,12 +76,7 @@ pub fn residual(model: &UnifiedModel, rays: &[Correspondence]) -> FitResidual {
 /// `rays`. The start: for `xi` on a grid from 0 to 1.5, the focal lengths and principal point
 /// without distortion by linear least squares, keeping the `xi` that fits best.
 pub fn fit_unified(rays: &[Correspondence]) -> Result<(UnifiedModel, FitResidual), VisionError> {
-    if rays.len() < 20 {
-        return Err(VisionError::Calibration(format!(
-            "a camera model needs at least 20 rays to fit, got {}",
-            rays.len()
-        )));
-    }
+    enough(rays)?;
     let start = (0..=30)
         .filter_map(|k| linear_start(rays, 0.05 * k as f64))
         .map(|m| (residual(&m, rays).rms_px, m))
@@ -69,6 +88,31 @@ pub fn fit_unified(rays: &[Correspondence]) -> Result<(UnifiedModel, FitResidual
         })?;
     let model = levenberg_marquardt(start, rays);
     Ok((model, residual(&model, rays)))
+}
+
+/// Refines `start` on `rays` by least squares on the reprojection error.
+pub fn refine<M: Projection>(
+    start: M,
+    rays: &[Correspondence],
+) -> Result<(M, FitResidual), VisionError> {
+    enough(rays)?;
+    if !residual(&start, rays).rms_px.is_finite() {
+        return Err(VisionError::Calibration(
+            "the starting model does not image every ray".into(),
+        ));
+    }
+    let model = levenberg_marquardt(start, rays);
+    Ok((model, residual(&model, rays)))
+}
+
+fn enough(rays: &[Correspondence]) -> Result<(), VisionError> {
+    if rays.len() < 20 {
+        return Err(VisionError::Calibration(format!(
+            "a camera model needs at least 20 rays to fit, got {}",
+            rays.len()
+        )));
+    }
+    Ok(())
 }
 
 /// Focal lengths and principal point for a given `xi`, without distortion: `u = f_x x + c_x`
@@ -108,29 +152,30 @@ fn linear_start(rays: &[Correspondence], xi: f64) -> Option<UnifiedModel> {
 }
 
 /// Sum of squared reprojection errors; infinite where a ray cannot be imaged.
-fn cost(model: &UnifiedModel, rays: &[Correspondence]) -> f64 {
+fn cost(model: &impl Projection, rays: &[Correspondence]) -> f64 {
     let r = residual(model, rays);
     r.rms_px * r.rms_px * r.count as f64
 }
 
-fn levenberg_marquardt(start: UnifiedModel, rays: &[Correspondence]) -> UnifiedModel {
+fn levenberg_marquardt<M: Projection>(start: M, rays: &[Correspondence]) -> M {
     let mut model = start;
     let mut current = cost(&model, rays);
     let mut lambda = 1e-3;
+    let n = model.params().len();
     for _ in 0..200 {
         let (jtj, jtr) = normal_equations(&model, rays);
         let mut improved = false;
         while lambda < 1e12 {
-            let mut a = jtj;
-            for i in 0..9 {
+            let mut a = jtj.clone();
+            for i in 0..n {
                 a[(i, i)] += lambda * jtj[(i, i)].max(1e-12);
             }
-            let Some(step) = a.cholesky().map(|c| c.solve(&-jtr)) else {
+            let Some(step) = a.cholesky().map(|c| c.solve(&-&jtr)) else {
                 lambda *= 4.0;
                 continue;
             };
-            let p = SVector::<f64, 9>::from(model.params()) + step;
-            let trial = model.with_params(&p.into());
+            let p = DVector::from_vec(model.params()) + step;
+            let trial = model.with_params(p.as_slice());
             let c = cost(&trial, rays);
             if c < current {
                 let gain = (current - c) / current.max(1e-300);
@@ -150,42 +195,50 @@ fn levenberg_marquardt(start: UnifiedModel, rays: &[Correspondence]) -> UnifiedM
 }
 
 /// `J^T J` and `J^T r` of the reprojection residuals, with a central-difference Jacobian.
-fn normal_equations(
-    model: &UnifiedModel,
+fn normal_equations<M: Projection>(
+    model: &M,
     rays: &[Correspondence],
-) -> (SMatrix<f64, 9, 9>, SVector<f64, 9>) {
+) -> (DMatrix<f64>, DVector<f64>) {
     let p = model.params();
-    let steps: [f64; 9] = std::array::from_fn(|i| 1e-6 * p[i].abs().max(1e-2));
-    let shifted: Vec<[UnifiedModel; 2]> = (0..9)
+    let n = p.len();
+    let steps: Vec<f64> = p.iter().map(|v| 1e-6 * v.abs().max(1e-2)).collect();
+    let shifted: Vec<[M; 2]> = (0..n)
         .map(|i| {
             [1.0, -1.0].map(|sign| {
-                let mut q = p;
+                let mut q = p.clone();
                 q[i] += sign * steps[i];
                 model.with_params(&q)
             })
         })
         .collect();
-    let mut jtj = SMatrix::<f64, 9, 9>::zeros();
-    let mut jtr = SVector::<f64, 9>::zeros();
+    let mut jtj = DMatrix::<f64>::zeros(n, n);
+    let mut jtr = DVector::<f64>::zeros(n);
+    let mut rows = [DVector::<f64>::zeros(n), DVector::<f64>::zeros(n)];
     for c in rays {
         let Some(base) = model.project(&c.direction) else {
             continue;
         };
-        let mut rows = [SVector::<f64, 9>::zeros(); 2];
+        for row in rows.iter_mut() {
+            row.fill(0.0);
+        }
         for (i, [plus, minus]) in shifted.iter().enumerate() {
-            let (Some(a), Some(b)) = (plus.project(&c.direction), minus.project(&c.direction))
-            else {
-                continue;
+            // Central differences, one-sided at the edge of a parameter's range.
+            let (a, b, span) = match (plus.project(&c.direction), minus.project(&c.direction)) {
+                (Some(a), Some(b)) => (a, b, 2.0 * steps[i]),
+                (Some(a), None) => (a, base, steps[i]),
+                (None, Some(b)) => (base, b, steps[i]),
+                (None, None) => continue,
             };
             for k in 0..2 {
-                rows[k][i] = (a[k] - b[k]) / (2.0 * steps[i]);
+                rows[k][i] = (a[k] - b[k]) / span;
             }
         }
         for k in 0..2 {
-            jtj += rows[k] * rows[k].transpose();
-            jtr += rows[k] * (base[k] - c.pixel[k]);
+            jtj.syger(1.0, &rows[k], &rows[k], 1.0);
+            jtr.axpy(base[k] - c.pixel[k], &rows[k], 1.0);
         }
     }
+    jtj.fill_upper_triangle_with_lower_triangle();
     (jtj, jtr)
 }
 

@@ -1,11 +1,16 @@
 //! Standard camera models of omnidirectional cameras, fitted to known rays and written in the
 //! calibration tools' own files: Mei's unified model for OpenCV's `omnidir` module and Kalibr's
-//! `omni` camera.
+//! `omni` camera, the double sphere model for Kalibr's `ds` camera, Scaramuzza's polynomial
+//! for the OCamCalib toolbox.
 
+pub mod double_sphere;
 pub mod files;
 pub mod fit;
+pub mod ocamcalib;
 pub mod unified;
 
-pub use files::{ModelPose, kalibr_omni_yaml, opencv_omnidir_yaml};
-pub use fit::{Correspondence, FitResidual, fit_unified, residual};
+pub use double_sphere::DoubleSphereModel;
+pub use files::{ModelPose, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml};
+pub use fit::{Correspondence, FitResidual, Projection, fit_unified, refine, residual};
+pub use ocamcalib::OcamModel;
 pub use unified::UnifiedModel;

@@ -1,0 +1,107 @@
+//! The double sphere camera model (Usenko, Demmel and Cremers 2018, eq. (40)-(43)), Kalibr's
+//! `ds` camera: with `d1 = |P|` and `d2 = |(x, y, xi d1 + z)|`,
+//! `u = f_x x / (alpha d2 + (1 - alpha)(xi d1 + z)) + c_x`, `v = f_y y / (...) + c_y`, a point
+//! being imaged where `z > -w2 d1`, `w2 = (w1 + xi) / sqrt(2 w1 xi + xi^2 + 1)`,
+//! `w1 = alpha / (1 - alpha)` if `alpha <= 0.5`, else `(1 - alpha) / alpha` (eq. (43)). Pixel
+//! centres at integer coordinates. With `alpha = 0` it is Mei's unified model without
+//! distortion.
+
+use super::fit::Projection;
+use super::unified::UnifiedModel;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// The double sphere model's intrinsics.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DoubleSphereModel {
+    /// Focal lengths `f_x`, `f_y` (px).
+    pub focal_px: [f64; 2],
+    /// Principal point `c_x`, `c_y` (px).
+    pub principal_px: [f64; 2],
+    /// The shift `xi` between the two spheres.
+    pub xi: f64,
+    /// The weight `alpha` of the second sphere, in `[0, 1)`.
+    pub alpha: f64,
+}
+
+impl DoubleSphereModel {
+    /// The model equal to `m` where `m` has no distortion (`alpha = 0`).
+    pub fn from_unified(m: &UnifiedModel) -> Self {
+        Self {
+            focal_px: m.focal_px,
+            principal_px: m.principal_px,
+            xi: m.xi,
+            alpha: 0.0,
+        }
+    }
+}
+
+impl Projection for DoubleSphereModel {
+    fn params(&self) -> Vec<f64> {
+        let [fx, fy] = self.focal_px;
+        let [cx, cy] = self.principal_px;
+        vec![fx, fy, cx, cy, self.xi, self.alpha]
+    }
+
+    fn with_params(&self, p: &[f64]) -> Self {
+        Self {
+            focal_px: [p[0], p[1]],
+            principal_px: [p[2], p[3]],
+            xi: p[4],
+            alpha: p[5],
+        }
+    }
+
+    fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
+        let (xi, alpha) = (self.xi, self.alpha);
+        if !(0.0..1.0).contains(&alpha) {
+            return None;
+        }
+        let d1 = p.norm();
+        let w1 = if alpha <= 0.5 {
+            alpha / (1.0 - alpha)
+        } else {
+            (1.0 - alpha) / alpha
+        };
+        let w2 = (w1 + xi) / (2.0 * w1 * xi + xi * xi + 1.0).sqrt();
+        if d1 <= 0.0 || p.z <= -w2 * d1 {
+            return None;
+        }
+        let k = xi * d1 + p.z;
+        let d2 = (p.x * p.x + p.y * p.y + k * k).sqrt();
+        let denom = alpha * d2 + (1.0 - alpha) * k;
+        if denom <= 1e-12 {
+            return None;
+        }
+        let [fx, fy] = self.focal_px;
+        let [cx, cy] = self.principal_px;
+        Some([fx * p.x / denom + cx, fy * p.y / denom + cy])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn with_alpha_zero_it_is_the_unified_model() {
+        let u = UnifiedModel {
+            focal_px: [300.0, 300.0],
+            skew_px: 0.0,
+            principal_px: [128.0, 110.0],
+            xi: 0.9,
+            distortion: [0.0; 4],
+        };
+        let ds = DoubleSphereModel::from_unified(&u);
+        for p in [
+            Vector3::new(1.0, 2.0, 0.5),
+            Vector3::new(-3.0, 0.2, -0.4),
+            Vector3::new(0.1, -0.1, 2.0),
+        ] {
+            let (a, b) = (u.project(&p).unwrap(), ds.project(&p).unwrap());
+            assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9);
+        }
+        // Straight back, beyond the model's field of view.
+        assert!(ds.project(&Vector3::new(0.0, 0.0, -1.0)).is_none());
+    }
+}
