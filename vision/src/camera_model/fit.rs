@@ -56,9 +56,18 @@ pub struct FitResidual {
 /// The reprojection errors of `model` on `rays` (a ray it cannot image counts as infinitely
 /// far).
 pub fn residual(model: &impl Projection, rays: &[Correspondence]) -> FitResidual {
+    residual_of(rays, |c| model.project(&c.direction))
+}
+
+/// The reprojection errors of a projection given as a function of each ray: the pixel
+/// `[u, v]` where it images the ray, if it does.
+pub fn residual_of(
+    rays: &[Correspondence],
+    project: impl Fn(&Correspondence) -> Option<[f64; 2]>,
+) -> FitResidual {
     let (mut sum, mut worst) = (0.0, 0.0f64);
     for c in rays {
-        let e = match model.project(&c.direction) {
+        let e = match project(c) {
             Some(p) => (p[0] - c.pixel[0]).hypot(p[1] - c.pixel[1]),
             None => f64::INFINITY,
         };

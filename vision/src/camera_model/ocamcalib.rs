@@ -11,7 +11,7 @@
 //! Pixel coordinates here are 0-based with pixel centres at integers (as OpenCV's); the
 //! toolbox's MATLAB side counts from 1, so its centre is ours plus one.
 
-use super::fit::{Correspondence, FitResidual};
+use super::fit::{Correspondence, FitResidual, residual_of};
 use crate::VisionError;
 use nalgebra::{DMatrix, DVector, Vector3};
 
@@ -137,18 +137,10 @@ impl OcamModel {
 
     /// The reprojection errors of `world2cam` on `rays` (pixels `[column, row]`).
     pub fn residual(&self, rays: &[Correspondence]) -> FitResidual {
-        let (mut sum, mut worst) = (0.0, 0.0f64);
-        for c in rays {
-            let p = self.world2cam(&c.direction);
-            let e = (p[0] - c.pixel[1]).hypot(p[1] - c.pixel[0]);
-            sum += e * e;
-            worst = worst.max(e);
-        }
-        FitResidual {
-            count: rays.len(),
-            rms_px: (sum / rays.len().max(1) as f64).sqrt(),
-            worst_px: worst,
-        }
+        residual_of(rays, |c| {
+            let [row, col] = self.world2cam(&c.direction);
+            Some([col, row])
+        })
     }
 
     /// The model as the toolbox's `calib_results.txt`.
