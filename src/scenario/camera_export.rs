@@ -13,8 +13,9 @@ use nalgebra::{Matrix3, Vector3};
 use omniloop_sim::SensorSpec;
 use omniloop_sim::optics::Optics;
 use omniloop_vision::camera_model::{
-    Correspondence, DoubleSphereModel, FitResidual, ModelPose, OcamModel, UnifiedModel,
-    fit_unified, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml, refine, residual,
+    CameraFile, Correspondence, DoubleSphereModel, FitResidual, ModelPose, OcamModel, UnifiedModel,
+    fit_unified, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml, parse_camera_file, refine,
+    residual as reprojection,
 };
 
 /// A camera model file format.
@@ -191,7 +192,7 @@ pub fn export_camera_model(
                     alpha,
                     ..DoubleSphereModel::from_unified(&unified)
                 };
-                while start.xi < 5.0 && !residual(&start, &correspondences).rms_px.is_finite() {
+                while start.xi < 5.0 && !reprojection(&start, &correspondences).rms_px.is_finite() {
                     start.xi += 0.1;
                 }
                 if let Ok((m, r)) = refine(start, &correspondences)
@@ -246,6 +247,28 @@ pub fn export_camera_model(
             format!("{}{notes}{}", m.calib_results_txt(), pose.comment_lines())
         }
     };
+    // The file must read back to the model that was fitted.
+    let back = parse_camera_file(&text, format.name()).map_err(|e| {
+        fit_error(omniloop_vision::VisionError::Calibration(format!(
+            "the written {} file does not read back: {e}",
+            format.name()
+        )))
+    })?;
+    let back_residual = match &back {
+        CameraFile::Unified(m, _) => reprojection(m, &correspondences),
+        CameraFile::DoubleSphere(m, _) => reprojection(m, &correspondences),
+        CameraFile::Ocam(m) => m.residual(&in_frame(&OCAM_FRAME)),
+    };
+    if (back_residual.rms_px - residual.rms_px).abs() > 1e-6 {
+        return Err(fit_error(omniloop_vision::VisionError::Calibration(
+            format!(
+                "the written {} file reads back to a model with RMS {} px, not {} px",
+                format.name(),
+                back_residual.rms_px,
+                residual.rms_px
+            ),
+        )));
+    }
     let json = serde_json::json!({
         "sensor": spec.name,
         "format": format.name(),

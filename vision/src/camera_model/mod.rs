@@ -7,10 +7,12 @@ pub mod double_sphere;
 pub mod files;
 pub mod fit;
 pub mod ocamcalib;
+pub mod read;
 pub mod unified;
 
 pub use double_sphere::DoubleSphereModel;
 pub use files::{ModelPose, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml};
 pub use fit::{Correspondence, FitResidual, Projection, fit_unified, refine, residual};
 pub use ocamcalib::OcamModel;
+pub use read::{CameraFile, parse_camera_file, read_camera_file};
 pub use unified::UnifiedModel;

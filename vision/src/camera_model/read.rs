@@ -1,0 +1,405 @@
+//! Reading camera model files in their tools' formats (the files [`super::files`] and
+//! [`super::OcamModel::calib_results_txt`] write, and the tools' own): every problem is an
+//! error naming the file, the line and the field.
+
+use super::double_sphere::DoubleSphereModel;
+use super::ocamcalib::OcamModel;
+use super::unified::UnifiedModel;
+use crate::VisionError;
+use std::path::Path;
+use yaml_rust2::{Yaml, YamlLoader};
+
+/// A camera model read from a file, with its image size (width, height in px).
+#[derive(Debug, Clone, PartialEq)]
+pub enum CameraFile {
+    /// Mei's unified model (OpenCV `omnidir`, Kalibr `omni`).
+    Unified(UnifiedModel, [u32; 2]),
+    /// The double sphere model (Kalibr `ds`).
+    DoubleSphere(DoubleSphereModel, [u32; 2]),
+    /// Scaramuzza's polynomial (OCamCalib; the size is in the model).
+    Ocam(OcamModel),
+}
+
+/// The formats [`read_camera_file`] takes, by name.
+pub const FORMATS: [&str; 4] = ["opencv-omnidir", "ocamcalib", "kalibr-omni", "kalibr-ds"];
+
+/// Reads `path` as a camera model file of `format` (one of [`FORMATS`]).
+pub fn read_camera_file(path: &Path, format: &str) -> Result<CameraFile, VisionError> {
+    let text = std::fs::read_to_string(path).map_err(|e| VisionError::CalibrationFile {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    parse_camera_file(&text, format).map_err(|message| VisionError::CalibrationFile {
+        path: path.display().to_string(),
+        message,
+    })
+}
+
+/// Parses the text of a camera model file of `format`; the error says the line and field.
+pub fn parse_camera_file(text: &str, format: &str) -> Result<CameraFile, String> {
+    match format {
+        "opencv-omnidir" => parse_opencv(text),
+        "ocamcalib" => parse_ocamcalib(text),
+        "kalibr-omni" | "kalibr-ds" => parse_kalibr(text, format),
+        other => Err(format!(
+            "unknown camera model format {other:?} (one of: {})",
+            FORMATS.join(", ")
+        )),
+    }
+}
+
+/// The 1-based line where `key:` first appears in `text` (1 when it does not).
+fn line_of(text: &str, key: &str) -> usize {
+    text.lines()
+        .position(|l| {
+            let l = l.trim_start().trim_start_matches("- ");
+            l.strip_prefix(key)
+                .is_some_and(|rest| rest.trim_start().starts_with(':'))
+        })
+        .map_or(1, |i| i + 1)
+}
+
+/// A YAML document; OpenCV's `%YAML:1.0` first line is read as a comment (it is not standard
+/// YAML), so that line numbers stay the file's.
+fn load_yaml(text: &str) -> Result<Yaml, String> {
+    let text = match text.strip_prefix("%YAML:1.0") {
+        Some(rest) => format!("#{rest}"),
+        None => text.to_string(),
+    };
+    let docs = YamlLoader::load_from_str(&text)
+        .map_err(|e| format!("line {}: not YAML: {e}", e.marker().line()))?;
+    docs.into_iter()
+        .next()
+        .ok_or_else(|| "line 1: the file is empty".to_string())
+}
+
+/// A number of a YAML value.
+fn number(y: &Yaml) -> Option<f64> {
+    match y {
+        Yaml::Real(_) => y.as_f64(),
+        Yaml::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+/// `n` numbers of a YAML list at `key` (its line for errors).
+fn numbers(y: &Yaml, text: &str, key: &str, n: usize) -> Result<Vec<f64>, String> {
+    let line = line_of(text, key);
+    let list = y
+        .as_vec()
+        .ok_or_else(|| format!("line {line}, field `{key}`: expected a list of {n} numbers"))?;
+    let values: Option<Vec<f64>> = list.iter().map(number).collect();
+    match values {
+        Some(v) if v.len() == n && v.iter().all(|x| x.is_finite()) => Ok(v),
+        Some(v) if v.len() != n => Err(format!(
+            "line {line}, field `{key}`: expected {n} numbers, found {}",
+            v.len()
+        )),
+        _ => Err(format!(
+            "line {line}, field `{key}`: expected {n} finite numbers"
+        )),
+    }
+}
+
+/// The field `key` of a mapping, or an error naming it.
+fn field<'a>(map: &'a Yaml, text: &str, key: &str, within: &str) -> Result<&'a Yaml, String> {
+    let v = &map[key];
+    if v.is_badvalue() {
+        return Err(format!(
+            "line {}, field `{key}`: missing{within}",
+            line_of(text, key)
+        ));
+    }
+    Ok(v)
+}
+
+/// An OpenCV matrix (`!!opencv-matrix` with `rows`, `cols`, `data`) of `n` values, or a plain
+/// number for a 1x1 matrix.
+fn opencv_matrix(doc: &Yaml, text: &str, key: &str, n: usize) -> Result<Vec<f64>, String> {
+    let m = field(doc, text, key, "")?;
+    if n == 1
+        && let Some(v) = number(m)
+    {
+        return Ok(vec![v]);
+    }
+    let data = field(m, text, "data", &format!(" in `{key}`"))?;
+    let values = numbers(data, text, key, n)?;
+    let (rows, cols) = (m["rows"].as_i64(), m["cols"].as_i64());
+    if let (Some(r), Some(c)) = (rows, cols)
+        && (r * c) as usize != n
+    {
+        return Err(format!(
+            "line {}, field `{key}`: a {r}x{c} matrix where {n} values are needed",
+            line_of(text, key)
+        ));
+    }
+    Ok(values)
+}
+
+fn size_field(doc: &Yaml, text: &str, key: &str) -> Result<u32, String> {
+    let v = field(doc, text, key, "")?;
+    v.as_i64()
+        .filter(|&n| n > 0 && n <= 1 << 16)
+        .map(|n| n as u32)
+        .ok_or_else(|| {
+            format!(
+                "line {}, field `{key}`: expected a size in pixels",
+                line_of(text, key)
+            )
+        })
+}
+
+fn parse_opencv(text: &str) -> Result<CameraFile, String> {
+    let doc = load_yaml(text)?;
+    if doc["cam0"].as_hash().is_some() {
+        return Err("line 1: this is a Kalibr camchain, not an OpenCV omnidir file".into());
+    }
+    let k = opencv_matrix(&doc, text, "K", 9)?;
+    let xi = opencv_matrix(&doc, text, "xi", 1)?[0];
+    let d = opencv_matrix(&doc, text, "D", 4)?;
+    let size = [
+        size_field(&doc, text, "image_width")?,
+        size_field(&doc, text, "image_height")?,
+    ];
+    if k[0] <= 0.0 || k[4] <= 0.0 {
+        return Err(format!(
+            "line {}, field `K`: the focal lengths must be positive",
+            line_of(text, "K")
+        ));
+    }
+    let model = UnifiedModel {
+        focal_px: [k[0], k[4]],
+        skew_px: k[1],
+        principal_px: [k[2], k[5]],
+        xi,
+        distortion: [d[0], d[1], d[2], d[3]],
+    };
+    Ok(CameraFile::Unified(model, size))
+}
+
+fn parse_kalibr(text: &str, format: &str) -> Result<CameraFile, String> {
+    let doc = load_yaml(text)?;
+    let cam = field(
+        &doc,
+        text,
+        "cam0",
+        " (a Kalibr camchain names its cameras cam0, cam1, ...)",
+    )?;
+    let model_name = field(cam, text, "camera_model", " in `cam0`")?
+        .as_str()
+        .unwrap_or_default();
+    let want = if format == "kalibr-ds" { "ds" } else { "omni" };
+    if model_name != want {
+        return Err(format!(
+            "line {}, field `camera_model`: {model_name:?} where format {format} needs {want:?}",
+            line_of(text, "camera_model")
+        ));
+    }
+    let res = numbers(
+        field(cam, text, "resolution", " in `cam0`")?,
+        text,
+        "resolution",
+        2,
+    )?;
+    let size = [res[0] as u32, res[1] as u32];
+    let (n, n_dist) = if want == "ds" { (6, 0) } else { (5, 4) };
+    let p = numbers(
+        field(cam, text, "intrinsics", " in `cam0`")?,
+        text,
+        "intrinsics",
+        n,
+    )?;
+    let dist = match &cam["distortion_coeffs"] {
+        Yaml::BadValue if n_dist == 0 => Vec::new(),
+        y => numbers(y, text, "distortion_coeffs", n_dist)?,
+    };
+    Ok(if want == "ds" {
+        CameraFile::DoubleSphere(
+            DoubleSphereModel {
+                focal_px: [p[2], p[3]],
+                principal_px: [p[4], p[5]],
+                xi: p[0],
+                alpha: p[1],
+            },
+            size,
+        )
+    } else {
+        CameraFile::Unified(
+            UnifiedModel {
+                focal_px: [p[1], p[2]],
+                skew_px: 0.0,
+                principal_px: [p[3], p[4]],
+                xi: p[0],
+                distortion: [dist[0], dist[1], dist[2], dist[3]],
+            },
+            size,
+        )
+    })
+}
+
+/// OCamCalib's `calib_results.txt`: its fields in order, each on the first line with numbers
+/// after its comment line.
+fn parse_ocamcalib(text: &str) -> Result<CameraFile, String> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let mut next = |field: &str| -> Result<(usize, Vec<f64>), String> {
+        let (i, l) = lines
+            .next()
+            .ok_or_else(|| format!("line {}, field `{field}`: missing", text.lines().count()))?;
+        let values: Result<Vec<f64>, _> = l.split_whitespace().map(str::parse::<f64>).collect();
+        match values {
+            Ok(v) if v.iter().all(|x| x.is_finite()) => Ok((i + 1, v)),
+            _ => Err(format!(
+                "line {}, field `{field}`: expected numbers, found {l:?}",
+                i + 1
+            )),
+        }
+    };
+    let counted = |(line, v): (usize, Vec<f64>), field: &str| -> Result<Vec<f64>, String> {
+        let n = v.first().copied().unwrap_or(0.0);
+        if n < 1.0 || n.fract() != 0.0 || v.len() != n as usize + 1 {
+            return Err(format!(
+                "line {line}, field `{field}`: a count and that many coefficients"
+            ));
+        }
+        Ok(v[1..].to_vec())
+    };
+    let pol = counted(next("pol")?, "pol")?;
+    let invpol = counted(next("invpol")?, "invpol")?;
+    let exact = |(line, v): (usize, Vec<f64>), field: &str, n: usize| {
+        if v.len() == n {
+            Ok(v)
+        } else {
+            Err(format!(
+                "line {line}, field `{field}`: expected {n} numbers, found {}",
+                v.len()
+            ))
+        }
+    };
+    let center = exact(next("center")?, "center", 2)?;
+    let affine = exact(next("affine")?, "affine", 3)?;
+    let (size_line, size) = next("size")?;
+    let size = exact((size_line, size), "size", 2)?;
+    if size.iter().any(|s| *s < 1.0 || s.fract() != 0.0) {
+        return Err(format!(
+            "line {size_line}, field `size`: height and width in pixels"
+        ));
+    }
+    let [c, d, e] = [affine[0], affine[1], affine[2]];
+    if (c - d * e).abs() < 1e-12 {
+        return Err("field `affine`: c - d e is 0, the affine map has no inverse".into());
+    }
+    Ok(CameraFile::Ocam(OcamModel {
+        pol,
+        invpol,
+        center_rc: [center[0], center[1]],
+        affine: [c, d, e],
+        size_hw: [size[0] as u32, size[1] as u32],
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera_model::files::{
+        ModelPose, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml,
+    };
+    use nalgebra::{Matrix3, Vector3};
+
+    fn unified() -> UnifiedModel {
+        UnifiedModel {
+            focal_px: [110.7, 110.8],
+            skew_px: 0.0,
+            principal_px: [127.5, 109.5],
+            xi: 0.973,
+            distortion: [0.01, -0.002, 0.0003, -0.0004],
+        }
+    }
+
+    fn pose() -> ModelPose {
+        ModelPose {
+            rotation: Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, -1.0),
+            translation_mm: Vector3::new(0.0, 0.0, 205.08),
+        }
+    }
+
+    #[test]
+    fn every_written_file_reads_back_the_same() {
+        let m = unified();
+        let cv = opencv_omnidir_yaml(&m, [256, 220], &pose(), "a test");
+        assert_eq!(
+            parse_camera_file(&cv, "opencv-omnidir").unwrap(),
+            CameraFile::Unified(m, [256, 220])
+        );
+        let k = kalibr_omni_yaml(&m, [256, 220], &pose(), "/camera/omni", "");
+        assert_eq!(
+            parse_camera_file(&k, "kalibr-omni").unwrap(),
+            CameraFile::Unified(m, [256, 220])
+        );
+        let ds = DoubleSphereModel {
+            focal_px: [100.0, 101.0],
+            principal_px: [127.5, 109.5],
+            xi: -0.2,
+            alpha: 0.6,
+        };
+        let k = kalibr_ds_yaml(&ds, [256, 220], &pose(), "/camera/omni", "");
+        assert_eq!(
+            parse_camera_file(&k, "kalibr-ds").unwrap(),
+            CameraFile::DoubleSphere(ds, [256, 220])
+        );
+        let ocam = OcamModel {
+            pol: vec![-56.1, 0.0, 4.4e-3, -1.3e-7, -3.9e-9],
+            invpol: vec![113.8, 116.9, 63.2],
+            center_rc: [109.5, 127.5],
+            affine: [1.0, 0.0, 0.0],
+            size_hw: [220, 256],
+        };
+        let CameraFile::Ocam(back) =
+            parse_camera_file(&ocam.calib_results_txt(), "ocamcalib").unwrap()
+        else {
+            panic!("not an OCamCalib model")
+        };
+        for (a, b) in back.pol.iter().zip(&ocam.pol) {
+            assert!((a - b).abs() <= 1e-11 * b.abs());
+        }
+        assert_eq!(
+            (back.center_rc, back.size_hw),
+            (ocam.center_rc, ocam.size_hw)
+        );
+    }
+
+    #[test]
+    fn a_bad_file_names_the_line_and_the_field() {
+        let cv = opencv_omnidir_yaml(&unified(), [256, 220], &pose(), "");
+        // A missing field: named, with the line where it would be looked for.
+        let no_xi = cv.replace("xi: !!opencv-matrix", "chi: !!opencv-matrix");
+        let e = parse_camera_file(&no_xi, "opencv-omnidir").unwrap_err();
+        assert!(e.contains("field `xi`: missing"), "{e}");
+        // A short matrix: its line.
+        let short = cv.replace("data: [ 0.01, -0.002, 0.0003, -0.0004 ]", "data: [ 0.01 ]");
+        let e = parse_camera_file(&short, "opencv-omnidir").unwrap_err();
+        let line = cv.lines().position(|l| l.starts_with("D:")).unwrap() + 1;
+        assert!(e.starts_with(&format!("line {line}, field `D`")), "{e}");
+        // The wrong format.
+        let k = kalibr_omni_yaml(&unified(), [256, 220], &pose(), "/c", "");
+        let e = parse_camera_file(&k, "opencv-omnidir").unwrap_err();
+        assert!(e.contains("Kalibr camchain"), "{e}");
+        let e = parse_camera_file(&k, "kalibr-ds").unwrap_err();
+        assert!(
+            e.contains("field `camera_model`") && e.contains("\"omni\""),
+            "{e}"
+        );
+        // Not YAML at all.
+        let e = parse_camera_file("K: [1, 2\n", "opencv-omnidir").unwrap_err();
+        assert!(e.starts_with("line 2: not YAML"), "{e}");
+        // OCamCalib: a count that does not match its coefficients, a missing field.
+        let e = parse_camera_file("#pol\n5 1 2 3\n", "ocamcalib").unwrap_err();
+        assert_eq!(e, "line 2, field `pol`: a count and that many coefficients");
+        let e = parse_camera_file("#pol\n2 1 2\n#inv\n1 5\n", "ocamcalib").unwrap_err();
+        assert!(e.ends_with("field `center`: missing"), "{e}");
+        let e = parse_camera_file("", "kalibr-dss").unwrap_err();
+        assert!(e.contains("unknown camera model format"), "{e}");
+    }
+}
