@@ -173,7 +173,11 @@ pub fn export_camera_model(
             .collect()
     };
     let correspondences = in_frame(&UNIFIED_FRAME);
-    let mut rotation = UNIFIED_FRAME;
+    // OCamCalib's frame is its own; its rays are turned into it once.
+    let (rotation, ocam_rays) = match format {
+        CameraFormat::Ocamcalib => (OCAM_FRAME, in_frame(&OCAM_FRAME)),
+        _ => (UNIFIED_FRAME, Vec::new()),
+    };
     let fit_error = |reason| ExportError::Fit {
         sensor: spec.name.clone(),
         reason,
@@ -184,37 +188,14 @@ pub fn export_camera_model(
             (FittedModel::Unified(unified), unified_residual)
         }
         CameraFormat::KalibrDs => {
-            // Starts from the unified fit with the second sphere's weight at a few values
-            // (xi grown until the model's field of view holds every ray); the best refined one.
-            let mut best: Option<(DoubleSphereModel, FitResidual)> = None;
-            for alpha in [0.0, 0.2, 0.4, 0.6] {
-                let mut start = DoubleSphereModel {
-                    alpha,
-                    ..DoubleSphereModel::from_unified(&unified)
-                };
-                while start.xi < 5.0 && !reprojection(&start, &correspondences).rms_px.is_finite() {
-                    start.xi += 0.1;
-                }
-                if let Ok((m, r)) = refine(start, &correspondences)
-                    && best.as_ref().is_none_or(|(_, b)| r.rms_px < b.rms_px)
-                {
-                    best = Some((m, r));
-                }
-            }
-            let (m, r) = best.ok_or_else(|| {
-                fit_error(omniloop_vision::VisionError::Calibration(
-                    "no start of the double sphere model images every ray".into(),
-                ))
-            })?;
+            let (m, r) = fit_double_sphere(&unified, &correspondences).map_err(fit_error)?;
             (FittedModel::DoubleSphere(m), r)
         }
         CameraFormat::Ocamcalib => {
-            rotation = OCAM_FRAME;
-            let rays = in_frame(&OCAM_FRAME);
             let [cx, cy] = unified.principal_px;
             let size_hw = [sensor.height_px, sensor.width_px];
-            let m = OcamModel::fit(&rays, [cy, cx], size_hw, 4).map_err(fit_error)?;
-            let r = m.residual(&rays);
+            let m = OcamModel::fit(&ocam_rays, [cy, cx], size_hw, 4).map_err(fit_error)?;
+            let r = m.residual(&ocam_rays);
             (FittedModel::Ocam(m), r)
         }
     };
@@ -257,7 +238,7 @@ pub fn export_camera_model(
     let back_residual = match &back {
         CameraFile::Unified(m, _) => reprojection(m, &correspondences),
         CameraFile::DoubleSphere(m, _) => reprojection(m, &correspondences),
-        CameraFile::Ocam(m) => m.residual(&in_frame(&OCAM_FRAME)),
+        CameraFile::Ocam(m) => m.residual(&ocam_rays),
     };
     if (back_residual.rms_px - residual.rms_px).abs() > 1e-6 {
         return Err(fit_error(omniloop_vision::VisionError::Calibration(
@@ -292,6 +273,35 @@ pub fn export_camera_model(
         viewpoint_spread_mm: spread,
         text,
         json,
+    })
+}
+
+/// The double sphere model fitted to `rays`: from the unified fit with the second sphere's
+/// weight at a few values (xi grown until the model's field of view holds every ray), the best
+/// refined one.
+fn fit_double_sphere(
+    unified: &UnifiedModel,
+    rays: &[Correspondence],
+) -> Result<(DoubleSphereModel, FitResidual), omniloop_vision::VisionError> {
+    let mut best: Option<(DoubleSphereModel, FitResidual)> = None;
+    for alpha in [0.0, 0.2, 0.4, 0.6] {
+        let mut start = DoubleSphereModel {
+            alpha,
+            ..DoubleSphereModel::from_unified(unified)
+        };
+        while start.xi < 5.0 && !reprojection(&start, rays).rms_px.is_finite() {
+            start.xi += 0.1;
+        }
+        if let Ok((m, r)) = refine(start, rays)
+            && best.as_ref().is_none_or(|(_, b)| r.rms_px < b.rms_px)
+        {
+            best = Some((m, r));
+        }
+    }
+    best.ok_or_else(|| {
+        omniloop_vision::VisionError::Calibration(
+            "no start of the double sphere model images every ray".into(),
+        )
     })
 }
 
