@@ -79,6 +79,35 @@ impl Projection for DoubleSphereModel {
     }
 }
 
+impl DoubleSphereModel {
+    /// The unit ray (model frame) of pixel `[u, v]`, or `None` outside the model's image: with
+    /// `m = ((u - c_x) / f_x, (v - c_y) / f_y)`, `r^2 = |m|^2`,
+    /// `m_z = (1 - alpha^2 r^2) / (alpha sqrt(1 - (2 alpha - 1) r^2) + 1 - alpha)` and
+    /// `P = (m_z xi + sqrt(m_z^2 + (1 - xi^2) r^2)) / (m_z^2 + r^2) (m_x, m_y, m_z) - (0, 0, xi)`
+    /// (Usenko, Demmel and Cremers 2018, eq. (46)-(51)); valid where `alpha <= 0.5` or
+    /// `r^2 <= 1 / (2 alpha - 1)`, and the square roots are real.
+    pub fn unproject(&self, pixel: [f64; 2]) -> Option<Vector3<f64>> {
+        let (xi, alpha) = (self.xi, self.alpha);
+        let [fx, fy] = self.focal_px;
+        let [cx, cy] = self.principal_px;
+        let (mx, my) = ((pixel[0] - cx) / fx, (pixel[1] - cy) / fy);
+        let r2 = mx * mx + my * my;
+        let inner = 1.0 - (2.0 * alpha - 1.0) * r2;
+        if inner < 0.0 {
+            return None;
+        }
+        let mz = (1.0 - alpha * alpha * r2) / (alpha * inner.sqrt() + 1.0 - alpha);
+        let disc = mz * mz + (1.0 - xi * xi) * r2;
+        if disc < 0.0 {
+            return None;
+        }
+        let k = (mz * xi + disc.sqrt()) / (mz * mz + r2);
+        let p = Vector3::new(k * mx, k * my, k * mz - xi);
+        let n = p.norm();
+        (n.is_finite() && n > 0.0).then(|| p / n)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -103,5 +132,29 @@ mod tests {
         }
         // Straight back, beyond the model's field of view.
         assert!(ds.project(&Vector3::new(0.0, 0.0, -1.0)).is_none());
+    }
+
+    #[test]
+    fn unproject_inverts_project_across_the_image() {
+        let m = DoubleSphereModel {
+            focal_px: [160.0, 158.0],
+            principal_px: [127.5, 109.5],
+            xi: -0.2,
+            alpha: 0.6,
+        };
+        let mut checked = 0;
+        for v in (0..220).step_by(7) {
+            for u in (0..256).step_by(7) {
+                let px = [u as f64, v as f64];
+                let Some(d) = m.unproject(px) else { continue };
+                let back = m.project(&d).unwrap();
+                let e = (back[0] - px[0]).hypot(back[1] - px[1]);
+                assert!(e < 1e-6, "{e} px at {px:?}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 1000, "{checked}");
+        // alpha > 0.5: beyond r^2 = 1 / (2 alpha - 1) there is no ray.
+        assert!(m.unproject([127.5 + 160.0 * 2.3, 109.5]).is_none());
     }
 }

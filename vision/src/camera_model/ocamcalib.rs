@@ -135,6 +135,54 @@ impl OcamModel {
         })
     }
 
+    /// Whether `f(rho)` gives every pixel of the image one ray and every ray of the image one
+    /// pixel: `a0 != 0` (else the centre pixel has no ray), and the ray's elevation
+    /// `theta(rho) = atan(f(rho) / rho)` strictly monotonic from the centre pixel's rim
+    /// (`rho = 1`) to the farthest corner, so that `world2cam`'s equation `f(rho) = rho tan(theta)` (Scaramuzza et al. 2006,
+    /// eq. (6) solved for `rho`) has exactly one real root in the image for each `theta` in its
+    /// field of view. The error says what fails, and where.
+    pub fn check_polynomial(&self) -> Result<(), String> {
+        if self.pol.first().is_none_or(|a0| *a0 == 0.0) {
+            return Err("a0 is 0: the image centre has no ray".into());
+        }
+        let [h, w] = self.size_hw.map(f64::from);
+        let rho_max = [(0.0, 0.0), (h, 0.0), (0.0, w), (h, w)]
+            .iter()
+            .map(|&(r, c)| self.rho(r - 0.5, c - 0.5))
+            .fold(0.0, f64::max);
+        let theta = |rho: f64| horner(&self.pol, rho).atan2(rho);
+        const STEPS: usize = 1000;
+        let mut sign = 0.0;
+        let mut last = theta(1.0);
+        for k in 1..=STEPS {
+            let rho = 1.0 + (rho_max - 1.0) * k as f64 / STEPS as f64;
+            let t = theta(rho);
+            let step = t - last;
+            if !t.is_finite() {
+                return Err(format!("f({rho:.1} px) is not a number"));
+            }
+            if step == 0.0 || (sign != 0.0 && step.signum() != sign) {
+                return Err(format!(
+                    "f(rho) - rho tan(theta) has no real root in the image for elevations \
+                     beyond {:.2} deg: the ray's elevation turns back at rho = {rho:.1} px \
+                     (the image reaches {rho_max:.1} px)",
+                    last.to_degrees()
+                ));
+            }
+            sign = step.signum();
+            last = t;
+        }
+        Ok(())
+    }
+
+    /// `rho` of the pixel at `(row, col)`: its distance from the centre after the affine map.
+    fn rho(&self, row: f64, col: f64) -> f64 {
+        let [c, d, e] = self.affine;
+        let (dr, dc) = (row - self.center_rc[0], col - self.center_rc[1]);
+        let inv = 1.0 / (c - d * e);
+        (inv * (dr - d * dc)).hypot(inv * (-e * dr + c * dc))
+    }
+
     /// The reprojection errors of `world2cam` on `rays` (pixels `[column, row]`).
     pub fn residual(&self, rays: &[Correspondence]) -> FitResidual {
         residual_of(rays, |c| {

@@ -20,6 +20,36 @@ pub enum CameraFile {
     Ocam(OcamModel),
 }
 
+impl CameraFile {
+    /// The unit ray, in the model's frame, of the pixel at `[u, v]` (pixel centres at
+    /// integers), or `None` where the model has no ray: each model's own unprojection.
+    pub fn unproject(&self, pixel: [f64; 2]) -> Option<nalgebra::Vector3<f64>> {
+        match self {
+            CameraFile::Unified(m, _) => m.unproject(pixel),
+            CameraFile::DoubleSphere(m, _) => m.unproject(pixel),
+            CameraFile::Ocam(m) => Some(m.cam2world(pixel[1], pixel[0])),
+        }
+    }
+
+    /// The principal point `[u, v]` (px, pixel centres at integers): where the optical axis
+    /// images.
+    pub fn principal_px(&self) -> [f64; 2] {
+        match self {
+            CameraFile::Unified(m, _) => m.principal_px,
+            CameraFile::DoubleSphere(m, _) => m.principal_px,
+            CameraFile::Ocam(m) => [m.center_rc[1], m.center_rc[0]],
+        }
+    }
+
+    /// The image size the model was calibrated for: width, height (px).
+    pub fn size_px(&self) -> [u32; 2] {
+        match self {
+            CameraFile::Unified(_, size) | CameraFile::DoubleSphere(_, size) => *size,
+            CameraFile::Ocam(m) => [m.size_hw[1], m.size_hw[0]],
+        }
+    }
+}
+
 /// The formats [`read_camera_file`] takes, by name.
 pub const FORMATS: [&str; 4] = ["opencv-omnidir", "ocamcalib", "kalibr-omni", "kalibr-ds"];
 
@@ -266,7 +296,9 @@ fn parse_ocamcalib(text: &str) -> Result<CameraFile, String> {
         }
         Ok(v[1..].to_vec())
     };
-    let pol = counted(next("pol")?, "pol")?;
+    let pol_at = next("pol")?;
+    let pol_line = pol_at.0;
+    let pol = counted(pol_at, "pol")?;
     let invpol = counted(next("invpol")?, "invpol")?;
     let exact = |(line, v): (usize, Vec<f64>), field: &str, n: usize| {
         if v.len() == n {
@@ -289,15 +321,31 @@ fn parse_ocamcalib(text: &str) -> Result<CameraFile, String> {
     }
     let [c, d, e] = [affine[0], affine[1], affine[2]];
     if (c - d * e).abs() < 1e-12 {
-        return Err("field `affine`: c - d e is 0, the affine map has no inverse".into());
+        return Err(format!(
+            "line {}, field `affine`: c - d e is 0, the affine map has no inverse",
+            line_of_values(text, 4)
+        ));
     }
-    Ok(CameraFile::Ocam(OcamModel {
+    let model = OcamModel {
         pol,
         invpol,
         center_rc: [center[0], center[1]],
         affine: [c, d, e],
         size_hw: [size[0] as u32, size[1] as u32],
-    }))
+    };
+    model
+        .check_polynomial()
+        .map_err(|why| format!("line {pol_line}, field `pol`: {why}"))?;
+    Ok(CameraFile::Ocam(model))
+}
+
+/// The 1-based line of the `k`-th (1-based) line of numbers of a `calib_results.txt`.
+fn line_of_values(text: &str, k: usize) -> usize {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .nth(k - 1)
+        .map_or(1, |(i, _)| i + 1)
 }
 
 #[cfg(test)]
@@ -399,6 +447,28 @@ mod tests {
         assert_eq!(e, "line 2, field `pol`: a count and that many coefficients");
         let e = parse_camera_file("#pol\n2 1 2\n#inv\n1 5\n", "ocamcalib").unwrap_err();
         assert!(e.ends_with("field `center`: missing"), "{e}");
+        // OCamCalib: a polynomial whose rays turn back inside the image.
+        let mut bent = OcamModel {
+            pol: vec![-56.1, 0.0, 4.4e-3, -1.3e-7, -3.9e-9],
+            invpol: vec![113.8, 116.9, 63.2],
+            center_rc: [109.5, 127.5],
+            affine: [1.0, 0.0, 0.0],
+            size_hw: [220, 256],
+        };
+        assert!(bent.check_polynomial().is_ok());
+        bent.pol[4] = -3.0e-7;
+        let text = bent.calib_results_txt();
+        let e = parse_camera_file(&text, "ocamcalib").unwrap_err();
+        let line = text.lines().position(|l| l.starts_with("5 ")).unwrap() + 1;
+        assert!(
+            e.starts_with(&format!(
+                "line {line}, field `pol`: f(rho) - rho tan(theta) has no real root"
+            )),
+            "{e}"
+        );
+        bent.pol[0] = 0.0;
+        let e = parse_camera_file(&bent.calib_results_txt(), "ocamcalib").unwrap_err();
+        assert!(e.ends_with("a0 is 0: the image centre has no ray"), "{e}");
         let e = parse_camera_file("", "kalibr-dss").unwrap_err();
         assert!(e.contains("unknown camera model format"), "{e}");
     }

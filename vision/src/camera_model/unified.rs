@@ -70,7 +70,55 @@ impl UnifiedModel {
         let [cx, cy] = self.principal_px;
         Some([fx * xd + self.skew_px * yd + cx, fy * yd + cy])
     }
+
+    /// The unit ray (model frame) of pixel `[u, v]`, or `None` where the model has no ray: the
+    /// inverse of [`UnifiedModel::project`]. The distortion is undone by fixed-point iteration
+    /// `m = (m_d - t(m)) / (1 + k1 r^2 + k2 r^4)` (as OpenCV's `undistortPoints`), and `None` is
+    /// returned where it does not converge; then `m` is lifted to the sphere,
+    /// `P_s = (l x, l y, l - xi)` with `l = (xi + sqrt(1 + (1 - xi^2) r^2)) / (1 + r^2)`
+    /// (Mei and Rives 2007, eq. (6)), which has no real value where `1 + (1 - xi^2) r^2 < 0`.
+    pub fn unproject(&self, pixel: [f64; 2]) -> Option<Vector3<f64>> {
+        let [fx, fy] = self.focal_px;
+        let [cx, cy] = self.principal_px;
+        let yd = (pixel[1] - cy) / fy;
+        let xd = (pixel[0] - cx - self.skew_px * yd) / fx;
+        let [k1, k2, p1, p2] = self.distortion;
+        let distort = |x: f64, y: f64| {
+            let r2 = x * x + y * y;
+            let radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+            let tx = 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+            let ty = p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+            (radial, tx, ty)
+        };
+        let (mut x, mut y) = (xd, yd);
+        for _ in 0..UNDISTORT_ITERATIONS {
+            let (radial, tx, ty) = distort(x, y);
+            if radial.abs() < 1e-12 {
+                return None;
+            }
+            (x, y) = ((xd - tx) / radial, (yd - ty) / radial);
+        }
+        let (radial, tx, ty) = distort(x, y);
+        let miss = (x * radial + tx - xd).hypot(y * radial + ty - yd);
+        if !miss.is_finite() || miss > 1e-9 * (1.0 + xd.hypot(yd)) {
+            return None;
+        }
+        let r2 = x * x + y * y;
+        let disc = 1.0 + (1.0 - self.xi * self.xi) * r2;
+        if disc < 0.0 {
+            return None;
+        }
+        let l = (self.xi + disc.sqrt()) / (1.0 + r2);
+        if l <= 0.0 {
+            return None;
+        }
+        Some(Vector3::new(l * x, l * y, l - self.xi).normalize())
+    }
 }
+
+/// Fixed-point steps that undo the radial-tangential distortion (OpenCV's `undistortPoints`
+/// takes 20 by default; the tracers take as many).
+pub const UNDISTORT_ITERATIONS: usize = 20;
 
 #[cfg(test)]
 mod tests {
@@ -93,6 +141,38 @@ mod tests {
         // Beyond what the model images: straight back from a mirror with xi < 1.
         assert!(m.project(&Vector3::new(0.0, 0.0, -1.0)).is_none());
         assert!(m.project(&Vector3::zeros()).is_none());
+    }
+
+    #[test]
+    fn unproject_inverts_project_across_the_image() {
+        let m = UnifiedModel {
+            focal_px: [120.0, 118.0],
+            skew_px: 0.3,
+            principal_px: [127.5, 109.5],
+            xi: 0.97,
+            distortion: [0.01, -0.002, 0.001, 0.0005],
+        };
+        let mut checked = 0;
+        for v in (0..220).step_by(7) {
+            for u in (0..256).step_by(7) {
+                let px = [u as f64, v as f64];
+                let Some(d) = m.unproject(px) else { continue };
+                assert!((d.norm() - 1.0).abs() < 1e-12);
+                let back = m.project(&d).unwrap();
+                let e = (back[0] - px[0]).hypot(back[1] - px[1]);
+                assert!(e < 1e-6, "{e} px at {px:?}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 1000, "{checked}");
+        // xi > 1 leaves the image's outer part without rays.
+        let wide = UnifiedModel {
+            xi: 1.5,
+            distortion: [0.0; 4],
+            ..m
+        };
+        assert!(wide.unproject([127.5, 109.5]).is_some());
+        assert!(wide.unproject([127.5 + 400.0, 109.5]).is_none());
     }
 
     #[test]
