@@ -155,13 +155,13 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
                  camera_distance_mm = 200.0\nfocal_px = 400.0\nlens_height_mm = 300.0\n"
             ),
             ":10:1: field `robot.sensors[0]`: sensor \"omni\": a sensor needs exactly one of the \
-             tables hyperbolic, conical, spherical, pinhole (found spherical, pinhole)",
+             tables hyperbolic, conical, spherical, pinhole, calibrated (found spherical, pinhole)",
         ),
         (
             "no_optics",
             format!("{BASE}\n[[robot.sensors]]\nname = \"omni\"\n"),
             ":10:1: field `robot.sensors[0]`: sensor \"omni\": a sensor needs exactly one of the \
-             tables hyperbolic, conical, spherical, pinhole (found none)",
+             tables hyperbolic, conical, spherical, pinhole, calibrated (found none)",
         ),
         (
             "hyperbola_c",

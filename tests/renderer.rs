@@ -14,7 +14,7 @@ use omniloop_sim::{
 };
 mod common;
 
-use common::{omniloop, scenario_path as scenario};
+use common::{gpu_or_skip, omniloop, scenario_path as scenario};
 use std::path::Path;
 
 /// The paper's f(R) and its inverse.
@@ -278,19 +278,6 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
                 .filter(|(a, b)| a != b)
                 .count();
             assert_eq!(diff, 0, "{name}/{}", spec.name);
-        }
-    }
-}
-
-fn gpu_or_skip() -> Option<Renderer> {
-    match Renderer::new(RendererChoice::Gpu, |_| {}) {
-        Ok(r) => Some(r),
-        Err(e) => {
-            if std::env::var_os("OMNILOOP_REQUIRE_GPU").is_some() {
-                panic!("OMNILOOP_REQUIRE_GPU is set but no adapter opened: {e}");
-            }
-            eprintln!("skipping the GPU comparison: {e}");
-            None
         }
     }
 }

@@ -13,6 +13,8 @@ import cv2
 import numpy as np
 import pytest
 
+import omniloop
+
 from conftest import ROOT, SCENARIOS
 
 
@@ -68,3 +70,23 @@ def test_opencv_projects_floor_marks_where_the_renderer_images_them(tmp_path):
         errors.append(float(np.hypot(cu - u, cv - v)))
     assert len(errors) == 18
     assert max(errors) < 0.3, errors
+
+
+def test_a_camera_known_by_its_opencv_file_drives_e1_as_the_cli_does(tmp_path):
+    """`[robot.sensors.calibrated]` from Python: the scenario loads with its camera file, runs
+    to the goal, and a broken file is a ScenarioError naming the file, line and field."""
+    scenario = omniloop.Scenario.load(SCENARIOS / "corner55_calibrated.toml")
+    assert scenario.robot["sensors"][0]["kind"] == "calibrated"
+    s = omniloop.run(scenario).summary
+    assert s["reached_goal"] is True and s["wall_contacts"] == 0
+    (tmp_path / "cameras").mkdir()
+    good = (SCENARIOS / "cameras" / "corner_omni.opencv.yaml").read_text()
+    (tmp_path / "cameras" / "corner_omni.opencv.yaml").write_text(good.replace("\nD:", "\nE:"))
+    bad = tmp_path / "calibrated.toml"
+    bad.write_text((SCENARIOS / "corner55_calibrated.toml").read_text())
+    with pytest.raises(omniloop.ScenarioError) as e:
+        omniloop.Scenario.load(bad)
+    assert f"{bad}:" in str(e.value)
+    assert "field `robot.sensors[0].calibrated.file`" in str(e.value)
+    assert "corner_omni.opencv.yaml: line " in str(e.value)
+    assert "field `D`: missing" in str(e.value)

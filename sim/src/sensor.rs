@@ -1,10 +1,13 @@
 //! Sensors mounted on a robot: image size, principal point, noise and optics.
 
-use crate::optics::{ConicalMirror, HyperbolicMirror, Optics, PinholeCamera, SphericalMirror};
+use crate::optics::{
+    CalibratedCamera, ConicalMirror, HyperbolicMirror, Optics, PinholeCamera, SphericalMirror,
+};
 use serde::{Deserialize, Serialize};
 
 /// A sensor as written in a scenario (`[[robot.sensors]]`), with its optics as one typed value:
-/// in the file, exactly one of the tables `hyperbolic`, `conical`, `spherical`, `pinhole`.
+/// in the file, exactly one of the tables `hyperbolic`, `conical`, `spherical`, `pinhole`,
+/// `calibrated`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "RawSensorSpec", into = "RawSensorSpec")]
 pub struct SensorSpec {
@@ -14,7 +17,7 @@ pub struct SensorSpec {
     pub width_px: u32,
     /// Image height.
     pub height_px: u32,
-    /// Principal point (default: the image centre).
+    /// Principal point (default: the image centre; a calibrated camera's: its model's).
     pub principal_point_px: Option<[f64; 2]>,
     /// Standard deviation of the Gaussian noise added to each channel of each pixel, in levels
     /// of 255.
@@ -55,6 +58,8 @@ struct RawSensorSpec {
     spherical: Option<SphericalMirror>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pinhole: Option<PinholeCamera>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    calibrated: Option<CalibratedCamera>,
 }
 
 impl TryFrom<RawSensorSpec> for SensorSpec {
@@ -66,6 +71,7 @@ impl TryFrom<RawSensorSpec> for SensorSpec {
         given.extend(r.conical.map(Optics::Conical));
         given.extend(r.spherical.map(Optics::Spherical));
         given.extend(r.pinhole.map(Optics::Pinhole));
+        given.extend(r.calibrated.map(Optics::Calibrated));
         let optics = match given.len() {
             1 => given.remove(0),
             _ => {
@@ -77,7 +83,7 @@ impl TryFrom<RawSensorSpec> for SensorSpec {
                 };
                 return Err(format!(
                     "sensor {:?}: a sensor needs exactly one of the tables hyperbolic, conical, \
-                     spherical, pinhole (found {found})",
+                     spherical, pinhole, calibrated (found {found})",
                     r.name
                 ));
             }
@@ -109,12 +115,14 @@ impl From<SensorSpec> for RawSensorSpec {
             conical: None,
             spherical: None,
             pinhole: None,
+            calibrated: None,
         };
         match s.optics {
             Optics::Hyperbolic(m) => r.hyperbolic = Some(m),
             Optics::Conical(m) => r.conical = Some(m),
             Optics::Spherical(m) => r.spherical = Some(m),
             Optics::Pinhole(c) => r.pinhole = Some(c),
+            Optics::Calibrated(c) => r.calibrated = Some(c),
         }
         r
     }
@@ -149,6 +157,7 @@ impl SensorSpec {
     pub fn build(&self) -> Sensor {
         let [cx, cy] = self
             .principal_point_px
+            .or_else(|| self.optics.calibrated()?.principal_point_px())
             .unwrap_or([self.width_px as f64 / 2.0, self.height_px as f64 / 2.0]);
         Sensor {
             name: self.name.clone(),

@@ -136,6 +136,9 @@ pub struct CameraExport {
     pub residual: FitResidual,
     /// Largest distance (mm) of a ray from the model's viewpoint (0 for a central mirror).
     pub viewpoint_spread_mm: f64,
+    /// Radius about the principal point beyond which the mirror is not seen (`None`: it
+    /// fills the image to its corners); `image_circle_px` of a `calibrated` sensor.
+    pub image_circle_px: Option<f64>,
     /// The file, in the format asked for.
     pub text: String,
     /// The same as JSON: model, pose and residual (written beside the file).
@@ -152,13 +155,19 @@ pub fn export_camera_model(
     }
     let sensor = spec.build();
     let mut rays = Vec::new();
+    let mut dark_radii = Vec::new();
     for v in 0..sensor.height_px {
         for u in 0..sensor.width_px {
-            if let Some(r) = sensor.pixel_ray(u, v) {
-                rays.push(([u as f64, v as f64], r.origin.coords, r.dir.normalize()));
+            match sensor.pixel_ray(u, v) {
+                Some(r) => rays.push(([u as f64, v as f64], r.origin.coords, r.dir.normalize())),
+                None => {
+                    let (x, y) = sensor.image_coords(u, v);
+                    dark_radii.push(x.hypot(y));
+                }
             }
         }
     }
+    let image_circle_px = image_circle(&sensor, &rays, &dark_radii);
     let viewpoint = nearest_point(&rays);
     let spread = rays
         .iter()
@@ -205,14 +214,18 @@ pub fn export_camera_model(
     };
     let header = format!(
         "omniloop: sensor {:?} ({} mirror) as the {} model, fitted to {} traced rays:\n\
-         reprojection RMS {:.4} px, worst {:.4} px; rays within {:.3} mm of the viewpoint.",
+         reprojection RMS {:.4} px, worst {:.4} px; rays within {:.3} mm of the viewpoint.\n\
+         The mirror's image: {}.",
         spec.name,
         spec.optics.kind(),
         format.name(),
         residual.count,
         residual.rms_px,
         residual.worst_px,
-        spread
+        spread,
+        image_circle_px.map_or("the whole image".to_string(), |r| format!(
+            "a circle of radius {r:.4} px about the principal point"
+        ))
     );
     let size = [sensor.width_px, sensor.height_px];
     let topic = format!("/camera/{}", spec.name);
@@ -265,15 +278,39 @@ pub fn export_camera_model(
         },
         "residual_px": { "rays": residual.count, "rms": residual.rms_px, "worst": residual.worst_px },
         "viewpoint_spread_mm": spread,
+        "image_circle_px": image_circle_px,
     });
     Ok(CameraExport {
         model,
         pose,
         residual,
         viewpoint_spread_mm: spread,
+        image_circle_px,
         text,
         json,
     })
+}
+
+/// The radius about the principal point halfway between the farthest pixel that sees the
+/// mirror and the nearest dark one beyond it, or `None` when none is dark beyond it.
+fn image_circle(
+    sensor: &omniloop_sim::Sensor,
+    rays: &[([f64; 2], Vector3<f64>, Vector3<f64>)],
+    dark_radii: &[f64],
+) -> Option<f64> {
+    let lit = rays
+        .iter()
+        .map(|(p, _, _)| {
+            let (x, y) = sensor.image_coords(p[0] as u32, p[1] as u32);
+            x.hypot(y)
+        })
+        .fold(0.0, f64::max);
+    let dark = dark_radii
+        .iter()
+        .copied()
+        .filter(|r| *r > lit)
+        .fold(f64::INFINITY, f64::min);
+    dark.is_finite().then_some(0.5 * (lit + dark))
 }
 
 /// The double sphere model fitted to `rays`: from the unified fit with the second sphere's

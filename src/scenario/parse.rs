@@ -5,6 +5,7 @@
 use super::check::{Checker, FieldPath, PathSeg};
 use super::rules::validate;
 use super::schema::Scenario;
+use omniloop_sim::optics::Optics;
 use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -122,6 +123,13 @@ pub fn parse_scenario_with(
     {
         let dir = file.parent().unwrap_or(Path::new(""));
         scenario.vision.calibration_file = Some(dir.join(f));
+    }
+    // Calibrated cameras read their files now; what fails is reported with the rules.
+    let dir = file.parent().unwrap_or(Path::new(""));
+    for sensor in &mut scenario.robot.sensors {
+        if let Optics::Calibrated(cam) = &mut sensor.optics {
+            cam.load(dir).ok();
+        }
     }
     let mut violations = validate(&scenario);
     let mut c = Checker::new();

@@ -396,6 +396,10 @@ fn software_config(
         );
         return None;
     }
+    // Optics at fault are reported with the sensor; its calibration would only repeat them.
+    if !sensors[index].optics.problems().is_empty() {
+        return None;
+    }
     let cal = match &s.vision.calibration_file {
         Some(path) => match omniloop_vision::RadialCalibration::load(path) {
             Ok(cal) => cal,
@@ -510,5 +514,47 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
     }
     for (key, why) in s.optics.problems() {
         c.fail(format!("{p}.{key}"), why);
+    }
+    if let Some(model) = s.optics.calibrated().and_then(|cam| cam.model()) {
+        check_calibrated_size(c, p, s, model);
+    }
+}
+
+/// A calibrated camera's image is the one its model was calibrated for.
+fn check_calibrated_size(
+    c: &mut Checker,
+    p: &str,
+    s: &SensorSpec,
+    model: &omniloop_vision::camera_model::CameraFile,
+) {
+    let [w, h] = model.size_px();
+    if [s.width_px, s.height_px] != [w, h] {
+        let key = if s.width_px != w {
+            "width_px"
+        } else {
+            "height_px"
+        };
+        c.fail(
+            format!("{p}.{key}"),
+            format!(
+                "the calibration file describes a {w}x{h} image; the sensor is {}x{}",
+                s.width_px, s.height_px
+            ),
+        );
+    }
+    let [u, v] = model.principal_px();
+    if let Some([x, y]) = s
+        .principal_point_px
+        .filter(|&[x, y]| (x - u - 0.5).abs() > 1e-9 || (y - v - 0.5).abs() > 1e-9)
+    {
+        c.fail(
+            format!("{p}.principal_point_px"),
+            format!(
+                "({x}, {y}) is not the calibration's ({}, {}) (pixel edges at integers); \
+                 leave it out",
+                u + 0.5,
+                v + 0.5
+            ),
+        );
     }
 }

@@ -30,6 +30,21 @@ pub fn cpu() -> RunOptions {
     }
 }
 
+/// The GPU renderer, or `None` (the comparison skipped, and said so) where no adapter opens;
+/// with `OMNILOOP_REQUIRE_GPU` set, no adapter fails the test instead.
+pub fn gpu_or_skip() -> Option<omniloop_sim::Renderer> {
+    match omniloop_sim::Renderer::new(RendererChoice::Gpu, |_| {}) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            if std::env::var_os("OMNILOOP_REQUIRE_GPU").is_some() {
+                panic!("OMNILOOP_REQUIRE_GPU is set but no adapter opened: {e}");
+            }
+            eprintln!("skipping the GPU comparison: {e}");
+            None
+        }
+    }
+}
+
 /// A fresh, empty folder for one test.
 pub fn tmp(name: &str) -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);

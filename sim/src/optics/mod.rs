@@ -10,6 +10,7 @@
 //! `r = d - 2 (d . n) n`. Rays that miss the mirror give `None` (black pixels). The same math
 //! runs in the WGSL tracer (`render/trace.wgsl`).
 
+pub mod calibrated;
 pub mod conical;
 pub mod hyperbolic;
 pub mod pinhole;
@@ -17,6 +18,7 @@ pub mod problems;
 pub mod ray;
 pub mod spherical;
 
+pub use calibrated::CalibratedCamera;
 pub use conical::ConicalMirror;
 pub use hyperbolic::HyperbolicMirror;
 pub use pinhole::PinholeCamera;
@@ -34,6 +36,8 @@ pub enum Optics {
     Spherical(SphericalMirror),
     /// Plain pinhole camera with pan and tilt.
     Pinhole(PinholeCamera),
+    /// A camera known by its calibration file (a standard camera model and its pose).
+    Calibrated(CalibratedCamera),
 }
 
 impl Optics {
@@ -45,6 +49,7 @@ impl Optics {
             Optics::Conical(m) => m.scene_ray(x_px, y_px),
             Optics::Spherical(m) => m.scene_ray(x_px, y_px),
             Optics::Pinhole(c) => c.scene_ray(x_px, y_px),
+            Optics::Calibrated(c) => c.scene_ray(x_px, y_px),
         }
     }
 
@@ -56,6 +61,7 @@ impl Optics {
             Optics::Conical(m) => m.radius_mm,
             Optics::Spherical(m) => m.radius_mm,
             Optics::Pinhole(_) => 0.0,
+            Optics::Calibrated(c) => c.max_origin_offset_mm(),
         }
     }
 
@@ -67,6 +73,7 @@ impl Optics {
             Optics::Conical(m) => m.problems(),
             Optics::Spherical(m) => m.problems(),
             Optics::Pinhole(c) => c.problems(),
+            Optics::Calibrated(c) => c.problems(),
         };
         let table = self.kind();
         list.into_iter()
@@ -90,6 +97,14 @@ impl Optics {
         }
     }
 
+    /// The calibrated camera, when the optics are one.
+    pub fn calibrated(&self) -> Option<&CalibratedCamera> {
+        match self {
+            Optics::Calibrated(c) => Some(c),
+            _ => None,
+        }
+    }
+
     /// Short name of the kind of optics: the name of its table in a scenario.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -97,6 +112,7 @@ impl Optics {
             Optics::Conical(_) => "conical",
             Optics::Spherical(_) => "spherical",
             Optics::Pinhole(_) => "pinhole",
+            Optics::Calibrated(_) => "calibrated",
         }
     }
 }

@@ -13,9 +13,11 @@ use super::scene::{
     BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals,
 };
 use crate::optics::Optics;
+use crate::optics::calibrated::{CalibratedCamera, MAX_POLYNOMIAL};
 use crate::sensor::Sensor;
 use bytemuck::{Pod, Zeroable};
 use nalgebra::Isometry2;
+use omniloop_vision::camera_model::CameraFile;
 
 /// The sensor and pose of one frame, as the shader reads them.
 #[repr(C)]
@@ -26,6 +28,10 @@ struct SensorParams {
     p0: [f32; 4],
     p1: [f32; 4],
     p2: [f32; 4],
+    /// A calibrated camera's image circle, principal point and polynomial length.
+    p3: [f32; 4],
+    /// A calibrated camera's intrinsics.
+    model: [[f32; 4]; 3],
     mount: [f32; 4],
     pose: [f32; 4],
 }
@@ -34,6 +40,8 @@ impl SensorParams {
     fn new(s: &Sensor, pose: &Isometry2<f64>, sigma: f32) -> Self {
         let mut p1 = [0.0f32; 4];
         let mut p2 = [0.0f32; 4];
+        let mut p3 = [0.0f32; 4];
+        let mut model = [[0.0f32; 4]; 3];
         let p0;
         let (kind, focal) = match &s.optics {
             Optics::Hyperbolic(m) => {
@@ -72,6 +80,23 @@ impl SensorParams {
                 p2 = [u.x as f32, u.y as f32, u.z as f32, 0.0];
                 (3, c.focal_px)
             }
+            Optics::Calibrated(c) => {
+                let r = c.rotation_matrix();
+                let t = c.translation_mm;
+                let row = |i: usize| [r[(i, 0)], r[(i, 1)], r[(i, 2)], t[i]].map(|v| v as f32);
+                (p0, p1, p2) = (row(0), row(1), row(2));
+                let (kind, values, principal) = calibrated_params(c);
+                let [cu, cv] = principal;
+                let circle = c.image_circle_px.unwrap_or(-1.0);
+                p3 = [circle as f32, cu as f32, cv as f32, 0.0];
+                if let Some(CameraFile::Ocam(m)) = c.model() {
+                    p3[3] = m.pol.len() as f32;
+                }
+                for (k, v) in values.iter().enumerate() {
+                    model[k / 4][k % 4] = *v as f32;
+                }
+                (kind, 0.0)
+            }
         };
         let theta = pose.rotation.angle();
         Self {
@@ -80,6 +105,8 @@ impl SensorParams {
             p0,
             p1,
             p2,
+            p3,
+            model,
             mount: [s.mount_mm[0] as f32, s.mount_mm[1] as f32, 0.0, 0.0],
             pose: [
                 pose.translation.x as f32,
@@ -88,6 +115,38 @@ impl SensorParams {
                 theta.sin() as f32,
             ],
         }
+    }
+}
+
+/// A calibrated camera's kind in the shader (4 unified, 5 double sphere, 6 OCamCalib), its
+/// intrinsics in the order `trace.wgsl` reads them, and its principal point; a camera whose
+/// file was not read is kind 7, which traces black.
+fn calibrated_params(c: &CalibratedCamera) -> (u32, Vec<f64>, [f64; 2]) {
+    match c.model() {
+        Some(CameraFile::Unified(m, _)) => {
+            let [k1, k2, p1, p2] = m.distortion;
+            let v = vec![
+                m.focal_px[0],
+                m.focal_px[1],
+                m.skew_px,
+                m.xi,
+                k1,
+                k2,
+                p1,
+                p2,
+            ];
+            (4, v, m.principal_px)
+        }
+        Some(CameraFile::DoubleSphere(m, _)) => {
+            let v = vec![m.focal_px[0], m.focal_px[1], m.xi, m.alpha];
+            (5, v, m.principal_px)
+        }
+        Some(CameraFile::Ocam(m)) => {
+            let mut v = m.affine.to_vec();
+            v.extend(m.pol.iter().take(MAX_POLYNOMIAL));
+            (6, v, [m.center_rc[1], m.center_rc[0]])
+        }
+        None => (7, Vec::new(), [0.0; 2]),
     }
 }
 

@@ -21,6 +21,10 @@ struct SensorParams {
     p0: vec4<f32>,
     p1: vec4<f32>,
     p2: vec4<f32>,
+    p3: vec4<f32>,          // calibrated: image circle (< 0: none), principal u, v, coefficients
+    p4: vec4<f32>,          // calibrated: the model's intrinsics (gpu.rs: SensorParams::new)
+    p5: vec4<f32>,
+    p6: vec4<f32>,
     mount: vec4<f32>,       // axis offset on the robot x, y
     pose: vec4<f32>,        // robot x, y, cos(theta), sin(theta)
 };
@@ -88,9 +92,104 @@ fn quadratic(a: f32, b: f32, c: f32) -> vec3<f32> {
     return vec3<f32>(min(t0, t1), max(t0, t1), 1.0);
 }
 
+// Mei's unified model's ray of normalised distorted coordinates (xd, yd) in its frame
+// (sim/src/optics/calibrated.rs, vision's UnifiedModel::unproject): the radial-tangential
+// distortion undone by 20 fixed-point steps, then the lift to the sphere (Mei and Rives eq. (6)).
+fn unified_ray(xd: f32, yd: f32) -> vec4<f32> {
+    let k1 = sensor.p5.x;
+    let k2 = sensor.p5.y;
+    let q1 = sensor.p5.z;
+    let q2 = sensor.p5.w;
+    var x = xd;
+    var y = yd;
+    for (var i = 0; i < 20; i = i + 1) {
+        let r2 = x * x + y * y;
+        let radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+        if (abs(radial) < 1e-12) { return vec4<f32>(0.0); }
+        let tx = 2.0 * q1 * x * y + q2 * (r2 + 2.0 * x * x);
+        let ty = q1 * (r2 + 2.0 * y * y) + 2.0 * q2 * x * y;
+        x = (xd - tx) / radial;
+        y = (yd - ty) / radial;
+    }
+    let r2 = x * x + y * y;
+    let radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+    let mx = x * radial + 2.0 * q1 * x * y + q2 * (r2 + 2.0 * x * x) - xd;
+    let my = y * radial + q1 * (r2 + 2.0 * y * y) + 2.0 * q2 * x * y - yd;
+    if (!(length(vec2<f32>(mx, my)) <= 1e-5 * (1.0 + length(vec2<f32>(xd, yd))))) {
+        return vec4<f32>(0.0);
+    }
+    let xi = sensor.p4.w;
+    let disc = 1.0 + (1.0 - xi * xi) * r2;
+    if (disc < 0.0) { return vec4<f32>(0.0); }
+    let l = (xi + sqrt(disc)) / (1.0 + r2);
+    if (l <= 0.0) { return vec4<f32>(0.0); }
+    return vec4<f32>(l * x, l * y, l - xi, 1.0);
+}
+
+// The double sphere model's ray of pixel (u, v) (Usenko et al. eq. (46)-(51)).
+fn double_sphere_ray(u: f32, v: f32) -> vec4<f32> {
+    let xi = sensor.p4.z;
+    let alpha = sensor.p4.w;
+    let mx = (u - sensor.p3.y) / sensor.p4.x;
+    let my = (v - sensor.p3.z) / sensor.p4.y;
+    let r2 = mx * mx + my * my;
+    let inner = 1.0 - (2.0 * alpha - 1.0) * r2;
+    if (inner < 0.0) { return vec4<f32>(0.0); }
+    let mz = (1.0 - alpha * alpha * r2) / (alpha * sqrt(inner) + 1.0 - alpha);
+    let disc = mz * mz + (1.0 - xi * xi) * r2;
+    if (disc < 0.0) { return vec4<f32>(0.0); }
+    let k = (mz * xi + sqrt(disc)) / (mz * mz + r2);
+    return vec4<f32>(k * mx, k * my, k * mz - xi, 1.0);
+}
+
+// OCamCalib's cam2world of pixel (u, v): (x', y') = A^-1 (row - x_c, col - y_c), ray
+// (x', y', f(rho)) (Scaramuzza et al. eq. (6)).
+fn ocam_ray(u: f32, v: f32) -> vec4<f32> {
+    let c = sensor.p4.x;
+    let dd = sensor.p4.y;
+    let e = sensor.p4.z;
+    let dr = v - sensor.p3.z;
+    let dc = u - sensor.p3.y;
+    let inv = 1.0 / (c - dd * e);
+    let xp = inv * (dr - dd * dc);
+    let yp = inv * (-e * dr + c * dc);
+    let rho = sqrt(xp * xp + yp * yp);
+    let coef = array<f32, 9>(sensor.p4.w, sensor.p5.x, sensor.p5.y, sensor.p5.z, sensor.p5.w,
+        sensor.p6.x, sensor.p6.y, sensor.p6.z, sensor.p6.w);
+    var f = 0.0;
+    for (var i = i32(sensor.p3.w) - 1; i >= 0; i = i - 1) {
+        f = f * rho + coef[i];
+    }
+    return vec4<f32>(xp, yp, f, 1.0);
+}
+
+// A calibrated camera's scene ray (sim/src/optics/calibrated.rs): the model's unprojection,
+// turned by the model frame's rotation (rows in p0..p2 xyz), from its viewpoint (their w).
+fn calibrated_ray(kind: u32, x: f32, y: f32) -> Ray {
+    var fail = Ray(vec3<f32>(0.0), vec3<f32>(0.0), false);
+    if (kind > 6u) { return fail; }
+    if (sensor.p3.x >= 0.0 && x * x + y * y > sensor.p3.x * sensor.p3.x) { return fail; }
+    let u = sensor.p3.y + x;
+    let v = sensor.p3.z - y;
+    var m = vec4<f32>(0.0);
+    if (kind == 4u) {
+        let yd = (v - sensor.p3.z) / sensor.p4.y;
+        m = unified_ray((u - sensor.p3.y - sensor.p4.z * yd) / sensor.p4.x, yd);
+    } else if (kind == 5u) {
+        m = double_sphere_ray(u, v);
+    } else {
+        m = ocam_ray(u, v);
+    }
+    if (m.w == 0.0) { return fail; }
+    let dm = normalize(m.xyz);
+    let dir = vec3<f32>(dot(sensor.p0.xyz, dm), dot(sensor.p1.xyz, dm), dot(sensor.p2.xyz, dm));
+    return Ray(vec3<f32>(sensor.p0.w, sensor.p1.w, sensor.p2.w), dir, true);
+}
+
 // The scene ray of image coordinates (x, y) in the robot frame (see sim/src/optics).
 fn scene_ray(x: f32, y: f32) -> Ray {
     let kind = sensor.size.z;
+    if (kind >= 4u) { return calibrated_ray(kind, x, y); }
     let f = sensor.intr.z;
     var fail = Ray(vec3<f32>(0.0), vec3<f32>(0.0), false);
     if (kind == 3u) {

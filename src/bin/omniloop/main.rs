@@ -195,6 +195,20 @@ fn write_camera_model(spec: &SensorSpec, format: CameraFormat, out: &Path) -> an
         e.viewpoint_spread_mm
     );
     println!("wrote {} and {}", out.display(), json_path.display());
+    let t = e.pose.translation_mm.map(|v| (v * 1e6).round() / 1e6 + 0.0);
+    let circle = e
+        .image_circle_px
+        .map_or(String::new(), |r| format!("\nimage_circle_px = {r:.4}"));
+    println!(
+        "as a sensor of a scenario (file relative to the scenario):\n\
+         [robot.sensors.calibrated]\nfile = {:?}\nformat = \"{}\"\n\
+         translation_mm = [{:?}, {:?}, {:?}]{circle}",
+        out.display().to_string(),
+        format.name(),
+        t.x,
+        t.y,
+        t.z
+    );
     Ok(())
 }
 

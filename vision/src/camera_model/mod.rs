@@ -14,5 +14,5 @@ pub use double_sphere::DoubleSphereModel;
 pub use files::{ModelPose, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml};
 pub use fit::{Correspondence, FitResidual, Projection, fit_unified, refine, residual};
 pub use ocamcalib::OcamModel;
-pub use read::{CameraFile, parse_camera_file, read_camera_file};
+pub use read::{CameraFile, FORMATS, parse_camera_file, read_camera_file};
 pub use unified::UnifiedModel;
