@@ -20,7 +20,8 @@ pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use floor_rect::FloorRect;
 pub use layout::{Board, Cube, FieldSpec, Layout, Pillar, Wall};
 pub use render::{
-    FrameNoise, FrameRequest, RenderError, Renderer, RendererChoice, Scene, SensorNoise,
+    CameraEffects, FrameNoise, FrameRequest, RenderError, Renderer, RendererChoice, Scene,
+    SensorNoise,
 };
 pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};

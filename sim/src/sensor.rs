@@ -3,6 +3,7 @@
 use crate::optics::{
     CalibratedCamera, ConicalMirror, HyperbolicMirror, Optics, PinholeCamera, SphericalMirror,
 };
+use crate::render::effects::CameraEffects;
 use serde::{Deserialize, Serialize};
 
 /// A sensor as written in a scenario (`[[robot.sensors]]`), with its optics as one typed value:
@@ -30,6 +31,8 @@ pub struct SensorSpec {
     pub mount_mm: [f64; 2],
     /// Its optics: a mirror under which the camera looks up, or a pinhole camera.
     pub optics: Optics,
+    /// What the real camera does to the image (`[robot.sensors.effects]`; default: nothing).
+    pub effects: CameraEffects,
 }
 
 /// A sensor as the file writes it: the optics as four optional tables, of which exactly one
@@ -50,6 +53,8 @@ struct RawSensorSpec {
     grey_levels: Option<u32>,
     #[serde(default)]
     mount_mm: [f64; 2],
+    #[serde(default, skip_serializing_if = "CameraEffects::is_off")]
+    effects: CameraEffects,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     hyperbolic: Option<HyperbolicMirror>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -97,6 +102,7 @@ impl TryFrom<RawSensorSpec> for SensorSpec {
             grey_levels: r.grey_levels,
             mount_mm: r.mount_mm,
             optics,
+            effects: r.effects,
         })
     }
 }
@@ -111,6 +117,7 @@ impl From<SensorSpec> for RawSensorSpec {
             noise_sigma: s.noise_sigma,
             grey_levels: s.grey_levels,
             mount_mm: s.mount_mm,
+            effects: s.effects,
             hyperbolic: None,
             conical: None,
             spherical: None,
@@ -150,6 +157,7 @@ impl SensorSpec {
             grey_levels: None,
             mount_mm: [0.0, 0.0],
             optics: Optics::Hyperbolic(HyperbolicMirror::corner_paper()),
+            effects: CameraEffects::default(),
         }
     }
 
@@ -169,6 +177,7 @@ impl SensorSpec {
             grey_levels: self.grey_levels,
             mount_mm: self.mount_mm,
             optics: self.optics.clone(),
+            effects: self.effects.clone(),
         }
     }
 }
@@ -194,6 +203,8 @@ pub struct Sensor {
     pub mount_mm: [f64; 2],
     /// Optics.
     pub optics: Optics,
+    /// Camera effects applied to each traced frame.
+    pub effects: CameraEffects,
 }
 
 impl Sensor {

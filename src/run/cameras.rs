@@ -7,6 +7,7 @@ use image::RgbaImage;
 use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
 use omniloop_sim::optics::Optics;
 use omniloop_sim::render::BatchHandle;
+use omniloop_sim::render::effects::exposure_poses;
 use omniloop_sim::{Renderer, RendererChoice, Scene, Sensor, SensorNoise, World};
 use std::f64::consts::PI;
 
@@ -138,15 +139,21 @@ impl Cameras {
         world: &World,
         wanted: Option<&[String]>,
     ) -> Result<(), RunError> {
-        let pose = world.robot_state(0).pose;
+        let state = world.robot_state(0);
         let scene = Scene::of_world(world);
         self.images.clear();
         for c in &mut self.cameras {
             let take = c.live && wanted.is_none_or(|w| w.contains(&c.sensor.name));
             let img = if take {
+                let poses = exposure_poses(
+                    &state.pose,
+                    state.velocity_mm_s,
+                    state.omega_rad_s,
+                    &c.sensor.effects,
+                );
                 Some(
                     self.renderer
-                        .render(&scene, &c.sensor, &pose, Some(&mut c.noise))?,
+                        .render_exposed(&scene, &c.sensor, &poses, Some(&mut c.noise))?,
                 )
             } else {
                 None

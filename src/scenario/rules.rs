@@ -515,6 +515,9 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
     for (key, why) in s.optics.problems() {
         c.fail(format!("{p}.{key}"), why);
     }
+    for (key, why) in s.effects.problems() {
+        c.fail(format!("{p}.effects.{key}"), why);
+    }
     if let Some(model) = s.optics.calibrated().and_then(|cam| cam.model()) {
         check_calibrated_size(c, p, s, model);
     }

@@ -12,4 +12,7 @@ pub enum RenderError {
     /// The device failed.
     #[error("GPU device error: {0}")]
     Device(String),
+    /// The frame asked for cannot be made.
+    #[error("cannot render: {0}")]
+    Invalid(String),
 }

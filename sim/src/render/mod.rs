@@ -3,6 +3,7 @@
 
 pub mod batch;
 pub mod cpu;
+pub mod effects;
 pub mod error;
 pub mod gpu;
 pub mod noise;
@@ -11,6 +12,7 @@ pub mod trace;
 
 pub use batch::{BatchClient, BatchHandle, BatchServer};
 pub use cpu::{CpuRenderer, SensorRays};
+pub use effects::CameraEffects;
 pub use error::RenderError;
 pub use gpu::{FrameRequest, GpuRenderer};
 pub use noise::{FrameNoise, SensorNoise};
@@ -218,8 +220,46 @@ impl Renderer {
         pose: &Isometry2<f64>,
         noise: Option<&mut SensorNoise>,
     ) -> Result<RgbaImage, RenderError> {
-        let mut img = RgbaImage::new(sensor.width_px, sensor.height_px);
+        self.render_exposed(scene, sensor, std::slice::from_ref(pose), noise)
+    }
+
+    /// Renders a frame as [`Renderer::render`] does, through the sensor's camera effects:
+    /// `poses` are where the robot was during the exposure (the first alone without motion
+    /// blur; [`effects::exposure_poses`] gives them).
+    pub fn render_exposed(
+        &mut self,
+        scene: &Scene,
+        sensor: &Sensor,
+        poses: &[Isometry2<f64>],
+        noise: Option<&mut SensorNoise>,
+    ) -> Result<RgbaImage, RenderError> {
+        let Some(pose) = poses.first() else {
+            return Err(RenderError::Invalid("a frame needs a pose".into()));
+        };
         let frame_noise = noise.map(|n| n.next_frame(sensor.noise_sigma as f32));
+        if !sensor.effects.is_off() {
+            let used = &poses[..poses.len().min(sensor.effects.sub_frames())];
+            let mut sub_frames = Vec::with_capacity(used.len());
+            for p in used {
+                self.trace(scene, sensor, p, None)?;
+                sub_frames.push(self.pixels.clone());
+            }
+            let size = [sensor.width_px, sensor.height_px];
+            let rgba = effects::develop(
+                &sensor.effects,
+                &sub_frames,
+                size,
+                [sensor.cx_px, sensor.cy_px],
+                frame_noise,
+            );
+            let mut img = RgbaImage::from_raw(size[0], size[1], rgba)
+                .ok_or_else(|| RenderError::Invalid("frame size".into()))?;
+            if let Some(levels) = sensor.grey_levels {
+                quantise_grey(&mut img, levels);
+            }
+            return effects::compress(img, sensor.effects.jpeg_quality);
+        }
+        let mut img = RgbaImage::new(sensor.width_px, sensor.height_px);
         let drawn = self.trace(scene, sensor, pose, frame_noise)?;
         match frame_noise {
             Some(fnz) if !drawn => noise::apply(&self.pixels, fnz, &mut img),
