@@ -21,6 +21,7 @@ fn on_biased_odometry_the_robot_turns_where_its_estimate_says_the_waypoint_is() 
         omega_noise_rad_s: 0.0,
         scale_bias_frac: SCALE_BIAS,
         omega_bias_rad_s: 0.0,
+        slip_s: 0.0,
     };
     s.run.duration_s = 8.0;
     let goal = s.goal.clone().unwrap();

@@ -130,6 +130,24 @@ impl RobotSoftware for Robot {
         };
         let mut percepts = Percepts::default();
         for stage in &mut self.stages {
+            // A frame lost on its way: the stage finds nothing this cycle, unless it carries
+            // on without one.
+            let lost = (stage.wants_frames() && !stage.runs_without_frames())
+                .then(|| {
+                    stage
+                        .cameras()
+                        .iter()
+                        .find(|c| !obs.frames.iter().any(|f| f.sensor == **c))
+                        .map(|c| c.to_string())
+                })
+                .flatten();
+            if let Some(camera) = lost {
+                percepts.not_found.push(crate::estimates::NotFound {
+                    source: stage.name(),
+                    reason: format!("no frame of camera {camera:?} this cycle"),
+                });
+                continue;
+            }
             stage.run(obs, &belief, &mut percepts)?;
         }
         let fixes: Vec<Fix> = percepts

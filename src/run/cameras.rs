@@ -3,12 +3,17 @@
 
 use super::error::RunError;
 use crate::scenario::Scenario;
+use crate::scenario::TimingSpec;
 use image::RgbaImage;
+use nalgebra::Isometry2;
 use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
 use omniloop_sim::optics::Optics;
 use omniloop_sim::render::BatchHandle;
 use omniloop_sim::render::effects::exposure_poses;
 use omniloop_sim::{Renderer, RendererChoice, Scene, Sensor, SensorNoise, World};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
+use std::collections::VecDeque;
 use std::f64::consts::PI;
 
 /// The seed of sensor `index`'s noise, derived from the run's seed.
@@ -80,8 +85,54 @@ struct Camera {
 pub struct Cameras {
     renderer: Renderer,
     cameras: Vec<Camera>,
-    /// The last capture, one entry a camera (`None`: not rendered).
+    /// The capture the software gets now, one entry a camera (`None`: not rendered, lost or
+    /// not yet arrived).
     images: Vec<Option<RgbaImage>>,
+    /// When that capture was taken.
+    images_t_s: f64,
+    /// When frames arrive and how many are lost.
+    delivery: Delivery,
+    /// Captures on their way to the software.
+    queue: VecDeque<Capture>,
+}
+
+/// A capture on its way: when it was taken, the cycle it arrives, its frames.
+struct Capture {
+    t_s: f64,
+    arrives_s: f64,
+    images: Vec<Option<RgbaImage>>,
+}
+
+/// `[robot.timing]`'s frame latency as whole control periods `periods` plus the capture's
+/// place in its period, and the seeded loss of frames.
+struct Delivery {
+    /// Periods between the cycle that renders a frame and the one that gets it.
+    periods: u32,
+    /// How far into its cycle a frame is taken (s): `periods * dt - latency`.
+    offset_s: f64,
+    period_s: f64,
+    drop_rate: f64,
+    rng: StdRng,
+}
+
+impl Delivery {
+    fn new(timing: &TimingSpec, control_period_s: f64, seed: u64) -> Self {
+        let periods = (timing.frame_latency_s / control_period_s - 1e-9)
+            .ceil()
+            .max(0.0);
+        Self {
+            periods: periods as u32,
+            offset_s: (periods * control_period_s - timing.frame_latency_s).max(0.0),
+            period_s: control_period_s,
+            drop_rate: timing.frame_drop_rate,
+            rng: StdRng::seed_from_u64(seed ^ 0xD50F_F2A3_E000_0001),
+        }
+    }
+
+    /// Whether the next frame is lost (no draw when none is).
+    fn lost(&mut self) -> bool {
+        self.drop_rate > 0.0 && self.rng.random::<f64>() < self.drop_rate
+    }
 }
 
 impl Cameras {
@@ -119,6 +170,13 @@ impl Cameras {
             },
             cameras,
             images: Vec::new(),
+            images_t_s: 0.0,
+            delivery: Delivery::new(
+                &scenario.robot.timing,
+                scenario.run.control_period_s,
+                scenario.seed,
+            ),
+            queue: VecDeque::new(),
         }))
     }
 
@@ -133,18 +191,28 @@ impl Cameras {
     }
 
     /// Renders the live cameras named in `wanted` (all live ones with `None`) at robot 0's
-    /// true pose, with their noise; the others give no frame this cycle.
+    /// true pose, with their noise; the others give no frame this cycle. With a frame
+    /// latency, the frames rendered now arrive that much later (taken `offset_s` into this
+    /// cycle, the robot moved on along its velocity; the rest of the world as at the cycle's
+    /// start), and the capture that arrives now is the one the software gets; a lost frame
+    /// never arrives.
     pub fn capture_some(
         &mut self,
         world: &World,
         wanted: Option<&[String]>,
     ) -> Result<(), RunError> {
-        let state = world.robot_state(0);
+        let mut state = world.robot_state(0);
+        let offset = self.delivery.offset_s;
+        state.pose = Isometry2::new(
+            state.pose.translation.vector + state.velocity_mm_s * offset,
+            state.pose.rotation.angle() + state.omega_rad_s * offset,
+        );
         let scene = Scene::of_world(world);
-        self.images.clear();
+        let now = world.time_s();
+        let mut images = Vec::with_capacity(self.cameras.len());
         for c in &mut self.cameras {
             let take = c.live && wanted.is_none_or(|w| w.contains(&c.sensor.name));
-            let img = if take {
+            let img = if take && !self.delivery.lost() {
                 let poses = exposure_poses(
                     &state.pose,
                     state.velocity_mm_s,
@@ -158,13 +226,31 @@ impl Cameras {
             } else {
                 None
             };
-            self.images.push(img);
+            images.push(img);
+        }
+        self.queue.push_back(Capture {
+            t_s: now + offset,
+            arrives_s: now + f64::from(self.delivery.periods) * self.delivery.period_s,
+            images,
+        });
+        self.images = vec![None; self.cameras.len()];
+        while let Some(first) = self.queue.front() {
+            if first.arrives_s > now + 1e-9 {
+                break;
+            }
+            let Some(arrived) = self.queue.pop_front() else {
+                break;
+            };
+            self.images = arrived.images;
+            self.images_t_s = arrived.t_s;
         }
         Ok(())
     }
 
-    /// The frames of the last capture, by camera name, taken at `t_s`.
-    pub fn frames(&self, t_s: f64) -> Vec<Frame<'_>> {
+    /// The frames the software gets now, by camera name, stamped with the time they were
+    /// taken.
+    pub fn frames(&self) -> Vec<Frame<'_>> {
+        let t_s = self.images_t_s;
         self.cameras
             .iter()
             .zip(&self.images)

@@ -14,6 +14,8 @@ use rand_distr::StandardNormal;
 pub struct WheelOdometry {
     spec: OdometrySpec,
     rng: StdRng,
+    /// The true body-frame velocity of the last reading (for the slip).
+    last_v_body: Option<Vector2<f64>>,
 }
 
 impl WheelOdometry {
@@ -22,16 +24,23 @@ impl WheelOdometry {
         Self {
             spec: spec.clone(),
             rng: StdRng::seed_from_u64(seed ^ 0x0D0_3E7E_u64),
+            last_v_body: None,
         }
     }
 
     /// The reading after `dt_s` that ended in `state` (true velocity in the world frame):
     /// measured in the body frame, scaled by `1 + scale_bias_frac`, each component with
-    /// relative noise `speed_noise_frac`, the rotation rate with bias and noise.
+    /// relative noise `speed_noise_frac`, the rotation rate with bias and noise; with slip,
+    /// the wheels read `slip_s` times the body's acceleration over the period more.
     pub fn read(&mut self, state: &RobotState, dt_s: f64) -> OdometryReading {
         let s = &self.spec;
         let heading = state.pose.rotation.angle();
-        let v_body = Rotation2::new(-heading) * state.velocity_mm_s * (1.0 + s.scale_bias_frac);
+        let true_body = Rotation2::new(-heading) * state.velocity_mm_s;
+        let accel = match self.last_v_body.replace(true_body) {
+            Some(before) if dt_s > 0.0 => (true_body - before) / dt_s,
+            _ => Vector2::zeros(),
+        };
+        let v_body = (true_body + accel * s.slip_s) * (1.0 + s.scale_bias_frac);
         let mut n = || self.rng.sample::<f64, _>(StandardNormal);
         let noisy = Vector2::new(
             v_body.x * (1.0 + s.speed_noise_frac * n()),
@@ -58,6 +67,7 @@ mod tests {
             omega_noise_rad_s: 0.0,
             scale_bias_frac: 0.1,
             omega_bias_rad_s: 0.02,
+            slip_s: 0.0,
         };
         let state = RobotState {
             pose: Isometry2::new(Vector2::zeros(), std::f64::consts::FRAC_PI_2),
@@ -77,5 +87,26 @@ mod tests {
         let c = WheelOdometry::new(&noisy, 6).read(&state, 0.04);
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn slip_reads_more_while_the_robot_accelerates() {
+        let spec = OdometrySpec {
+            speed_noise_frac: 0.0,
+            slip_s: 0.1,
+            ..OdometrySpec::default()
+        };
+        let mut wheels = WheelOdometry::new(&spec, 1);
+        let at = |v: f64| RobotState {
+            pose: Isometry2::new(Vector2::zeros(), 0.0),
+            velocity_mm_s: Vector2::new(v, 0.0),
+            omega_rad_s: 0.0,
+        };
+        assert_eq!(wheels.read(&at(0.0), 0.04).v_body_mm_s.x, 0.0);
+        // 300 mm/s^2 over the period: 30 mm/s more than the body's 12 mm/s.
+        let r = wheels.read(&at(12.0), 0.04);
+        assert!((r.v_body_mm_s.x - 42.0).abs() < 1e-9, "{r:?}");
+        // At constant speed, none.
+        assert!((wheels.read(&at(12.0), 0.04).v_body_mm_s.x - 12.0).abs() < 1e-9);
     }
 }

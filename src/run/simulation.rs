@@ -115,6 +115,8 @@ pub struct Simulation {
     other_paths: Vec<Vec<Point2<f64>>>,
     options: RunOptions,
     last_odometry: Option<OdometryReading>,
+    /// Commands on their way to the drive: when each is due, and the command.
+    commands: std::collections::VecDeque<(f64, VelocityCommand)>,
 }
 
 impl Simulation {
@@ -191,6 +193,7 @@ impl Simulation {
             estimates: Vec::new(),
             options: options.clone(),
             last_odometry: None,
+            commands: std::collections::VecDeque::new(),
         })
     }
 
@@ -292,13 +295,12 @@ impl Simulation {
         Ok(())
     }
 
-    /// The frames of the last [`Simulation::sense`], stamped with the time now (none without
-    /// cameras).
+    /// The frames the software gets after the last [`Simulation::sense`], stamped with the
+    /// time they were taken (none without cameras).
     pub fn frames(&self) -> Vec<Frame<'_>> {
-        let t = self.world.time_s();
         self.cameras
             .as_ref()
-            .map(|c| c.frames(t))
+            .map(|c| c.frames())
             .unwrap_or_default()
     }
 
@@ -322,7 +324,7 @@ impl Simulation {
     pub fn act(&mut self) -> Result<(), RunError> {
         let t = self.world.time_s();
         let cameras = self.cameras.as_ref();
-        let frames = cameras.map(|c| c.frames(t)).unwrap_or_default();
+        let frames = cameras.map(|c| c.frames()).unwrap_or_default();
         let actuators = cameras.map(|c| c.actuator_state()).unwrap_or_default();
         let out = self.robot.cycle(&Observation {
             t_s: t,
@@ -344,7 +346,8 @@ impl Simulation {
                 out.estimates.target,
             ),
         };
-        self.world.set_command(0, command);
+        let latency = self.scenario.robot.timing.command_latency_s;
+        self.commands.push_back((t + latency, command));
         if let Some(c) = &mut self.cameras {
             c.command(&out.actuators)?;
         }
@@ -356,7 +359,7 @@ impl Simulation {
         self.record(t, command, out.estimates);
 
         let dt = self.scenario.run.control_period_s;
-        self.world.advance(dt);
+        self.advance_applying_commands(t + dt);
         if let Some(c) = &mut self.cameras {
             c.advance(dt);
         }
@@ -368,6 +371,29 @@ impl Simulation {
         let p = Point2::from(after.pose.translation.vector);
         self.truth.targets(p, heading_for, self.world.time_s());
         Ok(())
+    }
+
+    /// Moves the world on to `end_s`, each queued command reaching the drive when it is due
+    /// (`[robot.timing] command_latency_s` after the software gave it; at once without one).
+    fn advance_applying_commands(&mut self, end_s: f64) {
+        let half_step = 0.5 * self.scenario.run.physics_step_s;
+        loop {
+            let now = self.world.time_s();
+            while let Some(&(due, command)) = self.commands.front() {
+                if due > now + half_step {
+                    break;
+                }
+                self.world.set_command(0, command);
+                self.commands.pop_front();
+            }
+            match self.commands.front() {
+                Some(&(due, _)) if due < end_s - half_step => self.world.advance(due - now),
+                _ => {
+                    self.world.advance(end_s - now);
+                    return;
+                }
+            }
+        }
     }
 
     /// Where the axis of the camera vision uses sits on the robot.

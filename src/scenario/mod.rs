@@ -15,5 +15,5 @@ pub use parse::{LoadError, Problem, load_scenario_with, parse_scenario_with};
 pub use rules::validate;
 pub use schema::{
     DifferentialSpec, OdometrySpec, OtherRobotSpec, PilotChoice, PoseSpec, RobotSpec, RunSpec,
-    Scenario,
+    Scenario, TimingSpec,
 };

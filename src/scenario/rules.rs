@@ -2,7 +2,7 @@
 //! of the field it concerns (each experiment adds its own through its registry entry).
 
 use super::check::{Checker, Violation};
-use super::schema::{PilotChoice, Scenario};
+use super::schema::{PilotChoice, Scenario, TimingSpec};
 use nalgebra::Point2;
 use omniloop_robot::controllers::{self, CONTROLLERS};
 use omniloop_robot::perception::{self, CameraNeed, STAGES};
@@ -197,6 +197,38 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
     c.out
 }
 
+/// `[robot.timing]`: latencies >= 0 (a command's in whole physics steps), a drop rate below 1.
+fn check_timing(c: &mut Checker, t: &TimingSpec, physics_step_s: f64) {
+    for (key, v) in [
+        ("frame_latency_s", t.frame_latency_s),
+        ("command_latency_s", t.command_latency_s),
+    ] {
+        if !(v.is_finite() && (0.0..=10.0).contains(&v)) {
+            c.fail(
+                format!("robot.timing.{key}"),
+                format!("must lie in [0, 10] (got {v})"),
+            );
+        }
+    }
+    let steps = t.command_latency_s / physics_step_s;
+    if steps.is_finite() && (steps - steps.round()).abs() > 1e-6 {
+        c.fail(
+            "robot.timing.command_latency_s",
+            format!(
+                "must be a whole number of physics steps of {physics_step_s} s (got {})",
+                t.command_latency_s
+            ),
+        );
+    }
+    let r = t.frame_drop_rate;
+    if !(r.is_finite() && (0.0..1.0).contains(&r)) {
+        c.fail(
+            "robot.timing.frame_drop_rate",
+            format!("must lie in [0, 1) (got {r})"),
+        );
+    }
+}
+
 /// The robot's software: its controller and pose source by their registered names, their
 /// tables, the stages they run and what those need of the robot (checked by their own code),
 /// the odometry's errors, and vision's camera.
@@ -217,6 +249,13 @@ fn check_software(c: &mut Checker, s: &Scenario) {
         );
     }
     c.finite("odometry.omega_bias_rad_s", o.omega_bias_rad_s);
+    if !(o.slip_s.is_finite() && o.slip_s >= 0.0) {
+        c.fail(
+            "odometry.slip_s",
+            format!("must be >= 0 (got {})", o.slip_s),
+        );
+    }
+    check_timing(c, &s.robot.timing, s.run.physics_step_s);
     check_boards(c, s);
     let g = s.control.localization_gain;
     if g.is_nan() || !(0.0..=1.0).contains(&g) {

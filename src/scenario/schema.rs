@@ -165,6 +165,31 @@ pub struct RobotSpec {
     /// turns on the spot; without it the robot is omnidirectional.
     #[serde(default)]
     pub differential: Option<DifferentialSpec>,
+    /// When frames and commands arrive (`[robot.timing]`; default: at once, none lost).
+    #[serde(default, skip_serializing_if = "TimingSpec::is_ideal")]
+    pub timing: TimingSpec,
+}
+
+/// Latency and loss between the robot's software and its cameras and drive
+/// (`[robot.timing]`), drawn from the run's seed.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TimingSpec {
+    /// A frame reaches the robot's software this long after it was captured (its `t_s` is the
+    /// capture time).
+    pub frame_latency_s: f64,
+    /// Probability that a frame is lost (the software gets no frame of that camera that
+    /// cycle).
+    pub frame_drop_rate: f64,
+    /// A command reaches the drive this long after the software gave it.
+    pub command_latency_s: f64,
+}
+
+impl TimingSpec {
+    /// Whether frames and commands arrive at once and none is lost.
+    pub fn is_ideal(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 /// A two-wheeled differential drive (`[robot.differential]`). Its top wheel speed is
@@ -255,6 +280,14 @@ pub struct OdometrySpec {
     pub scale_bias_frac: f64,
     /// Systematic rotation-rate error (gyro bias, wheel slip), rad/s.
     pub omega_bias_rad_s: f64,
+    /// Wheel slip that grows with acceleration, s: the wheels read the body's velocity plus
+    /// `slip_s` times its acceleration (body frame) over the last period.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub slip_s: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Default for OdometrySpec {
@@ -264,6 +297,7 @@ impl Default for OdometrySpec {
             omega_noise_rad_s: 0.0,
             scale_bias_frac: 0.0,
             omega_bias_rad_s: 0.0,
+            slip_s: 0.0,
         }
     }
 }

@@ -20,7 +20,7 @@ use crate::VisionError;
 use crate::calibration::RadialCalibration;
 use crate::mask::{FloorColor, Mask};
 use image::RgbaImage;
-use nalgebra::Point2;
+use nalgebra::{Isometry2, Point2, Vector2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
@@ -130,6 +130,78 @@ pub struct FreeSpace {
     /// Where the sensor axis stands in the robot frame, mm: the origin of every direction's
     /// distances.
     pub axis_mm: Point2<f64>,
+}
+
+impl FreeSpace {
+    /// The free space as the robot sees it after moving by `motion` (its pose now in the robot
+    /// frame of the frame that gave this free space), for a frame that arrives late or a cycle
+    /// without one, so that the controller acts from where the robot is, not where the frame
+    /// was taken. The directions stay the template's (fixed to the body); every point `p`
+    /// becomes `motion^-1 p`; a direction's free distance is the nearest moved obstacle point
+    /// inside its sector (measured from the sensor axis), or, with none there, the old
+    /// direction's at the same bearing shortened by the displacement along it,
+    /// `d - t . u` (exact for a face square to the ray), floored at 0; the same for the surely
+    /// free distance with its boundary points. A direction free to the template's edge stays
+    /// so (what lies beyond the edge was not seen from either place).
+    pub fn moved(&self, motion: &Isometry2<f64>) -> FreeSpace {
+        let back = motion.inverse();
+        let t = motion.translation.vector;
+        let turn = motion.rotation.angle();
+        let points = |pts: &[Point2<f64>]| -> Vec<Point2<f64>> {
+            pts.iter().map(|p| back.transform_point(p)).collect()
+        };
+        let obstacle_points = points(&self.obstacle_points);
+        let clear_points = points(&self.clear_points);
+        let free_mm = self.rebinned(&self.free_mm, &obstacle_points, t, turn);
+        let clear_mm = self.rebinned(&self.clear_mm, &clear_points, t, turn);
+        let front_mm = self.rebinned(&self.front_mm, &[], t, turn);
+        FreeSpace {
+            direction_rad: self.direction_rad.clone(),
+            a: self.a.clone(),
+            free_mm,
+            ratio: self.ratio.clone(),
+            obstacle_points,
+            range_mm: self.range_mm,
+            inner_mm: self.inner_mm,
+            clear_mm,
+            clear_points,
+            front_mm,
+            axis_mm: self.axis_mm,
+        }
+    }
+
+    /// Per direction, the nearest of `moved` points in its sector, else `old`'s value at the
+    /// same bearing (`turn` more in the old frame) less the displacement `t` along it.
+    fn rebinned(&self, old: &[f64], moved: &[Point2<f64>], t: Vector2<f64>, turn: f64) -> Vec<f64> {
+        let n = self.direction_rad.len();
+        if n == 0 || old.len() != n {
+            return old.to_vec();
+        }
+        let step = std::f64::consts::TAU / n as f64;
+        let first = self.direction_rad[0];
+        let index = |angle: f64| ((angle - first) / step).round().rem_euclid(n as f64) as usize % n;
+        let mut nearest = vec![f64::INFINITY; n];
+        for p in moved {
+            let v = p - self.axis_mm;
+            let j = index(v.y.atan2(v.x));
+            nearest[j] = nearest[j].min(v.norm());
+        }
+        let edge = self.range_mm - 1e-9;
+        (0..n)
+            .map(|j| {
+                if nearest[j].is_finite() {
+                    return nearest[j];
+                }
+                let bearing = self.direction_rad[j] + turn;
+                let d = old[index(bearing)];
+                if d >= edge {
+                    d
+                } else {
+                    (d - t.dot(&Vector2::new(bearing.cos(), bearing.sin()))).max(0.0)
+                }
+            })
+            .collect()
+    }
 }
 
 const NONE: u16 = u16::MAX;
@@ -556,6 +628,67 @@ impl FreeSpaceDetector {
 mod tests {
     use super::*;
     use image::Rgba;
+
+    /// Eight directions; a wall square to direction 0 at 500 mm (three points on it), the
+    /// other directions free to the 1000 mm edge.
+    fn wall_ahead() -> FreeSpace {
+        let n = 8;
+        let mut free_mm = vec![1000.0; n];
+        free_mm[0] = 500.0;
+        FreeSpace {
+            direction_rad: (0..n)
+                .map(|j| j as f64 * std::f64::consts::TAU / 8.0)
+                .collect(),
+            a: vec![0; n],
+            free_mm: free_mm.clone(),
+            ratio: Vec::new(),
+            obstacle_points: vec![
+                Point2::new(500.0, -30.0),
+                Point2::new(500.0, 0.0),
+                Point2::new(500.0, 30.0),
+            ],
+            range_mm: 1000.0,
+            inner_mm: 200.0,
+            clear_mm: free_mm.clone(),
+            clear_points: Vec::new(),
+            front_mm: free_mm,
+            axis_mm: Point2::origin(),
+        }
+    }
+
+    #[test]
+    fn moved_free_space_is_seen_from_where_the_robot_is_now() {
+        let fs = wall_ahead();
+        // 100 mm forward: the wall is 400 mm ahead; nothing else changes.
+        let ahead = fs.moved(&Isometry2::new(Vector2::new(100.0, 0.0), 0.0));
+        assert!(
+            (ahead.free_mm[0] - 400.0).abs() < 1e-9,
+            "{:?}",
+            ahead.free_mm
+        );
+        assert!(ahead.free_mm[1..].iter().all(|d| *d == 1000.0));
+        assert_eq!(ahead.obstacle_points[1], Point2::new(400.0, 0.0));
+        // Turned 90 degrees to the left on the spot: the wall is now to the right
+        // (direction 6, -90 degrees), 500 mm away; directions stay the body's.
+        let turned = fs.moved(&Isometry2::new(
+            Vector2::zeros(),
+            std::f64::consts::FRAC_PI_2,
+        ));
+        assert_eq!(turned.direction_rad, fs.direction_rad);
+        assert!(
+            (turned.free_mm[6] - 500.0).abs() < 1e-9,
+            "{:?}",
+            turned.free_mm
+        );
+        assert_eq!(turned.free_mm[0], 1000.0);
+        // Without points (the surely free distance here), the shortening along the bearing.
+        assert!((ahead.front_mm[0] - 400.0).abs() < 1e-9);
+        assert!((turned.front_mm[6] - 500.0).abs() < 1e-9);
+        // No motion: the same free space.
+        let still = fs.moved(&Isometry2::identity());
+        assert_eq!(still.free_mm, fs.free_mm);
+        assert_eq!(still.obstacle_points, fs.obstacle_points);
+    }
 
     use crate::calibration::tests::table as paper_calibration;
 

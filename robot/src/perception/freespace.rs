@@ -2,15 +2,18 @@
 //! floor-colour mask, eqs. (5)-(7).
 
 use super::stage::{
-    Belief, CameraNeed, Percepts, Stage, StageEntry, calibration, image, vision_camera,
-    vision_settings,
+    Belief, CameraNeed, Percepts, Stage, StageEntry, calibration, vision_camera, vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::RobotConfig;
+use crate::estimates::NotFound;
 use crate::tables::{ConfigProblem, Problems};
+use nalgebra::Isometry2;
+use omniloop_vision::FreeSpace;
 use omniloop_vision::freespace::PolarTemplate;
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, RadialCalibration};
+use std::collections::VecDeque;
 
 /// The registry's entry.
 pub const ENTRY: StageEntry = StageEntry {
@@ -110,10 +113,33 @@ fn check_values(fs: &FreeSpaceConfig, p: &mut Problems) {
     }
 }
 
-/// Detects free space in every frame of one mirror camera.
+/// Detects free space in every frame of one mirror camera. A frame taken before now (a
+/// camera with latency) or a cycle without a frame (a lost one) gives the last free space
+/// moved to where odometry says the robot is now ([`omniloop_vision::FreeSpace::moved`]), up
+/// to [`MAX_AGE_S`] after its frame was taken.
 pub struct FreeSpaceStage {
     camera: String,
     detector: FreeSpaceDetector,
+    /// The last free space and the odometry pose when its frame was taken.
+    last: Option<(FreeSpace, Isometry2<f64>, f64)>,
+    /// `(t_s, odometry pose)` at the start of recent cycles.
+    history: VecDeque<(f64, Isometry2<f64>)>,
+}
+
+/// The oldest free space the stage gives (s after its frame was taken); older, none.
+pub const MAX_AGE_S: f64 = 0.5;
+
+/// The odometry pose at `t_s` from `history` (linear between the cycles around it; the
+/// oldest or newest beyond them).
+fn pose_at(history: &VecDeque<(f64, Isometry2<f64>)>, t_s: f64) -> Option<Isometry2<f64>> {
+    let after = history.iter().position(|(t, _)| *t >= t_s - 1e-9)?;
+    let (t1, p1) = history[after];
+    if after == 0 || (t1 - t_s).abs() < 1e-9 {
+        return Some(p1);
+    }
+    let (t0, p0) = history[after - 1];
+    let k = (t_s - t0) / (t1 - t0);
+    Some(p0.lerp_slerp(&p1, k))
 }
 
 impl FreeSpaceStage {
@@ -126,6 +152,8 @@ impl FreeSpaceStage {
         Ok(Self {
             camera: camera.to_string(),
             detector: FreeSpaceDetector::new(config, cal)?,
+            last: None,
+            history: VecDeque::new(),
         })
     }
 }
@@ -139,14 +167,53 @@ impl Stage for FreeSpaceStage {
         vec![&self.camera]
     }
 
+    fn runs_without_frames(&self) -> bool {
+        true
+    }
+
+    fn carried(&mut self) {
+        self.last = None;
+        self.history.clear();
+    }
+
     fn run(
         &mut self,
         obs: &Observation<'_>,
-        _belief: &Belief,
+        belief: &Belief,
         out: &mut Percepts,
     ) -> Result<(), RobotError> {
-        let img = image(obs, &self.camera, self.name())?;
-        out.freespace = Some(self.detector.detect(img)?);
+        let now = belief.odometry_pose;
+        self.history.push_back((obs.t_s, now));
+        while self
+            .history
+            .front()
+            .is_some_and(|(t, _)| *t < obs.t_s - 2.0 * MAX_AGE_S)
+        {
+            self.history.pop_front();
+        }
+        match obs.frames.iter().find(|f| f.sensor == self.camera) {
+            Some(frame) if (obs.t_s - frame.t_s).abs() < 1e-9 => {
+                // Taken now: as it is.
+                let fs = self.detector.detect(frame.image)?;
+                self.last = Some((fs.clone(), now, frame.t_s));
+                out.freespace = Some(fs);
+                return Ok(());
+            }
+            Some(frame) => {
+                let taken = pose_at(&self.history, frame.t_s).unwrap_or(now);
+                self.last = Some((self.detector.detect(frame.image)?, taken, frame.t_s));
+            }
+            None => out.not_found.push(NotFound {
+                source: self.name(),
+                reason: format!("no frame of camera {:?} this cycle", self.camera),
+            }),
+        }
+        out.freespace = match &self.last {
+            Some((fs, taken, t)) if obs.t_s - t <= MAX_AGE_S => {
+                Some(fs.moved(&(taken.inverse() * now)))
+            }
+            _ => None,
+        };
         Ok(())
     }
 }

@@ -75,6 +75,11 @@ pub trait Stage: Send {
     fn wants_frames(&self) -> bool {
         true
     }
+    /// Whether it runs in a cycle that brought no frame of its cameras (a lost one); the
+    /// others are skipped that cycle, noted as finding nothing.
+    fn runs_without_frames(&self) -> bool {
+        false
+    }
     /// Processes the cycle's frames, knowing what the estimator predicts.
     fn run(
         &mut self,
