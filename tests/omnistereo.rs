@@ -54,11 +54,17 @@ fn e4_wander_of_450_frames_meets_the_targets() {
 
 /// Renders sensor `index` of the arena scenario with the robot at `pose`, with noise.
 fn frame(index: usize, pose: Isometry2<f64>, seed: u64) -> image::RgbaImage {
+    noisy_frame(index, pose, seed, 4.0)
+}
+
+/// The same with noise of `sigma` levels.
+fn noisy_frame(index: usize, pose: Isometry2<f64>, seed: u64, sigma: f64) -> image::RgbaImage {
     let s = scenario("omnistereo_arena.toml");
     let mut bodies = s.robot_bodies();
     bodies[0].start = pose;
     let world = World::new(&s.world, &bodies, 0.002).unwrap();
-    let sensor = s.robot.sensors[index].build();
+    let mut sensor = s.robot.sensors[index].build();
+    sensor.noise_sigma = sigma;
     let mut noise = SensorNoise::new(seed);
     Renderer::cpu()
         .render(&Scene::of_world(&world), &sensor, &pose, Some(&mut noise))
@@ -71,16 +77,44 @@ fn the_rim_calibrates_v_by_eq_2() {
     let Optics::Conical(cone) = s.robot.sensors[0].build().optics else {
         panic!("the arena's sensors are cones");
     };
-    let img = frame(0, Isometry2::new(Vector2::new(-600.0, 100.0), 0.3), 1);
-    let rim = MirrorRim::measure(&img).unwrap();
-    // Eq. (2): v = (d / R + 1) r_m; the robot never reads focal_px, the test compares with it.
-    let v = (cone.tip_distance_mm / cone.radius_mm + 1.0) * rim.radius_px;
-    assert!(
-        (v / cone.focal_px - 1.0).abs() < 1e-3,
-        "v = {v:.2} px from r_m = {:.3} px; focal {}",
-        rim.radius_px,
-        cone.focal_px
+    // Noise up to 12 levels: a few black pixels lifted over the threshold must not move the
+    // rim (at sigma 6 they once left no rim at all).
+    for (sigma, seed) in [(4.0, 1), (6.0, 2), (8.0, 3), (12.0, 4)] {
+        let img = noisy_frame(
+            0,
+            Isometry2::new(Vector2::new(-600.0, 100.0), 0.3),
+            seed,
+            sigma,
+        );
+        let rim = MirrorRim::measure(&img).unwrap();
+        // Eq. (2): v = (d / R + 1) r_m; the robot never reads focal_px, the test compares.
+        let v = (cone.tip_distance_mm / cone.radius_mm + 1.0) * rim.radius_px;
+        assert!(
+            (v / cone.focal_px - 1.0).abs() < 1e-3,
+            "sigma {sigma}: v = {v:.2} px from r_m = {:.3} px; focal {}",
+            rim.radius_px,
+            cone.focal_px
+        );
+    }
+}
+
+#[test]
+fn e4_holds_its_targets_at_noise_sigma_8() {
+    // The first 150 frames of the wander with twice the noise.
+    let mut s = scenario("omnistereo_arena.toml");
+    for sensor in &mut s.robot.sensors {
+        sensor.noise_sigma = 8.0;
+    }
+    s.run.duration_s = 7.5;
+    let m = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap().summary;
+    eprintln!(
+        "{}",
+        omniloop::experiments::omnistereo::omnistereo_table(&m)
     );
+    assert!(stat(&m, "range_error_pct", "n") > 3.0 * 150.0);
+    assert!(stat(&m, "range_error_pct", "median") <= 1.0);
+    assert!(stat(&m, "range_error_pct", "p95") <= 3.0);
+    assert!(stat(&m, "trilateration_error_mm", "median") <= 40.0);
 }
 
 #[test]

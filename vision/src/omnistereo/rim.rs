@@ -4,17 +4,21 @@
 //! Outside the rim the camera sees nothing of the mirror (black, up to the sensor's noise). The
 //! boundary is found between every pair of 4-neighbour pixels of which one is lit and the other
 //! dark, at their midpoint, and a circle is fitted to those points by linear least squares
-//! (Kasa's algebraic fit, `x^2 + y^2 + D x + E y + F = 0`); a second fit drops the points more
-//! than two pixels off the first (dark scene pixels inside the rim). With pixels sampled at
-//! their centres the midpoint is an unbiased place for the edge, and a few thousand of them put
-//! the radius within a tenth of a pixel.
+//! (Kasa's algebraic fit, `x^2 + y^2 + D x + E y + F = 0`); then fits again on the points within
+//! `max(2, 3 m)` px of the last fit (`m` the median distance of all points from it), until the
+//! points kept stay the same (at most five fits): dark scene pixels inside the rim, and the few
+//! black pixels that noise lifts above the threshold, drop out however far they are. A bright
+//! pixel with fewer than two bright 4-neighbours is noise in the black, not the mirror, and
+//! counts as dark. With
+//! pixels sampled at their centres the midpoint is an unbiased place for the edge, and a few
+//! thousand of them put the radius within a tenth of a pixel.
 
 use crate::VisionError;
 use image::RgbaImage;
 use nalgebra::{Matrix3, Vector3};
 
-/// A pixel is lit (inside the rim) when its brightest channel exceeds this: six sigma of the
-/// sensor noise (4 grey levels) above black.
+/// A pixel is bright when its brightest channel exceeds this: six sigma of the sensor noise (4
+/// grey levels) above black.
 const LIT: u8 = 24;
 
 /// The image of the mirror's rim.
@@ -32,13 +36,30 @@ impl MirrorRim {
     /// Measures the rim of the (single) mirror disc in `img`.
     pub fn measure(img: &RgbaImage) -> Result<Self, VisionError> {
         let points = boundary_points(img);
-        let first = fit_circle(&points)?;
-        let kept: Vec<[f64; 2]> = points
-            .iter()
-            .copied()
-            .filter(|p| (first.distance(p) - first.radius_px).abs() <= 2.0)
-            .collect();
-        let rim = fit_circle(&kept)?;
+        let mut rim = fit_circle(&points)?;
+        let mut kept_before = points.len() + 1;
+        for _ in 0..4 {
+            let mut off: Vec<f64> = points
+                .iter()
+                .map(|p| (rim.distance(p) - rim.radius_px).abs())
+                .collect();
+            let tol = {
+                let mut sorted = off.clone();
+                sorted.sort_by(f64::total_cmp);
+                (3.0 * sorted[sorted.len() / 2]).max(2.0)
+            };
+            let kept: Vec<[f64; 2]> = points
+                .iter()
+                .zip(off.iter_mut())
+                .filter(|(_, d)| **d <= tol)
+                .map(|(p, _)| *p)
+                .collect();
+            if kept.len() == kept_before {
+                break;
+            }
+            kept_before = kept.len();
+            rim = fit_circle(&kept)?;
+        }
         if rim.radius_px < 8.0 {
             return Err(VisionError::NotFound(format!(
                 "the lit disc is {:.1} px across: no mirror rim in the image",
@@ -58,22 +79,37 @@ impl MirrorRim {
     }
 }
 
-fn lit(img: &RgbaImage, x: u32, y: u32) -> bool {
-    let p = img.get_pixel(x, y).0;
-    p[0].max(p[1]).max(p[2]) > LIT
-}
-
-/// Midpoints (pixel coordinates) of every lit / dark pair of 4-neighbours.
+/// Midpoints (pixel coordinates) of every lit / dark pair of 4-neighbours: lit is bright with
+/// at least two bright 4-neighbours (inside the rim, and on its edge, every bright pixel has
+/// them; in the black, noise lifts single pixels and seldom three together).
 fn boundary_points(img: &RgbaImage) -> Vec<[f64; 2]> {
     let (w, h) = img.dimensions();
+    let bright: Vec<bool> = img
+        .pixels()
+        .map(|p| p.0[0].max(p.0[1]).max(p.0[2]) > LIT)
+        .collect();
+    let at = |x: u32, y: u32| bright[(y * w + x) as usize];
+    let lit: Vec<bool> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let neighbours = [
+                x > 0 && at(x - 1, y),
+                x + 1 < w && at(x + 1, y),
+                y > 0 && at(x, y - 1),
+                y + 1 < h && at(x, y + 1),
+            ];
+            at(x, y) && neighbours.iter().filter(|b| **b).count() >= 2
+        })
+        .collect();
+    let lit_at = |x: u32, y: u32| lit[(y * w + x) as usize];
     let mut pts = Vec::new();
     for y in 0..h {
         for x in 0..w {
-            let here = lit(img, x, y);
-            if x + 1 < w && lit(img, x + 1, y) != here {
+            let here = lit_at(x, y);
+            if x + 1 < w && lit_at(x + 1, y) != here {
                 pts.push([x as f64 + 1.0, y as f64 + 0.5]);
             }
-            if y + 1 < h && lit(img, x, y + 1) != here {
+            if y + 1 < h && lit_at(x, y + 1) != here {
                 pts.push([x as f64 + 0.5, y as f64 + 1.0]);
             }
         }
