@@ -20,7 +20,7 @@ pub struct RadialMap {
 }
 
 fn floor_distance(sensor: &Sensor, r_px: f64) -> Option<f64> {
-    let ray = sensor.optics.scene_ray(r_px.max(1e-9), 0.0)?;
+    let ray = sensor.calibration_ray(r_px.max(1e-9), 0.0)?;
     let hit = ray.floor_hit()?;
     Some(hit.coords.xy().norm())
 }
@@ -88,7 +88,7 @@ fn trace_elevation(sensor: &Sensor, step_px: f64, r_max: f64) -> Vec<[f64; 2]> {
         .map(|k| k as f64 * step_px)
         .take_while(|&big_r| big_r <= r_max)
         .map_while(|big_r| {
-            let ray = sensor.optics.scene_ray(big_r.max(1e-9), 0.0)?;
+            let ray = sensor.calibration_ray(big_r.max(1e-9), 0.0)?;
             Some([big_r, ray.dir.z.atan2(ray.dir.xy().norm())])
         })
         .collect()

@@ -1,7 +1,8 @@
 //! Sensors mounted on a robot: image size, principal point, noise and optics.
 
 use crate::optics::{
-    CalibratedCamera, ConicalMirror, HyperbolicMirror, Optics, PinholeCamera, SphericalMirror,
+    CalibratedCamera, ConicalMirror, HyperbolicMirror, MirrorMounting, Optics, PinholeCamera,
+    SphericalMirror,
 };
 use crate::render::effects::CameraEffects;
 use serde::{Deserialize, Serialize};
@@ -33,6 +34,8 @@ pub struct SensorSpec {
     pub optics: Optics,
     /// What the real camera does to the image (`[robot.sensors.effects]`; default: nothing).
     pub effects: CameraEffects,
+    /// How the mirror is off its nominal place (`[robot.sensors.mounting]`; default: on it).
+    pub mounting: MirrorMounting,
 }
 
 /// A sensor as the file writes it: the optics as four optional tables, of which exactly one
@@ -55,6 +58,8 @@ struct RawSensorSpec {
     mount_mm: [f64; 2],
     #[serde(default, skip_serializing_if = "CameraEffects::is_off")]
     effects: CameraEffects,
+    #[serde(default, skip_serializing_if = "MirrorMounting::is_nominal")]
+    mounting: MirrorMounting,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     hyperbolic: Option<HyperbolicMirror>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -103,6 +108,7 @@ impl TryFrom<RawSensorSpec> for SensorSpec {
             mount_mm: r.mount_mm,
             optics,
             effects: r.effects,
+            mounting: r.mounting,
         })
     }
 }
@@ -118,6 +124,7 @@ impl From<SensorSpec> for RawSensorSpec {
             grey_levels: s.grey_levels,
             mount_mm: s.mount_mm,
             effects: s.effects,
+            mounting: s.mounting,
             hyperbolic: None,
             conical: None,
             spherical: None,
@@ -158,6 +165,7 @@ impl SensorSpec {
             mount_mm: [0.0, 0.0],
             optics: Optics::Hyperbolic(HyperbolicMirror::corner_paper()),
             effects: CameraEffects::default(),
+            mounting: MirrorMounting::default(),
         }
     }
 
@@ -178,6 +186,7 @@ impl SensorSpec {
             mount_mm: self.mount_mm,
             optics: self.optics.clone(),
             effects: self.effects.clone(),
+            mounting: self.mounting.clone(),
         }
     }
 }
@@ -205,9 +214,34 @@ pub struct Sensor {
     pub optics: Optics,
     /// Camera effects applied to each traced frame.
     pub effects: CameraEffects,
+    /// How the mirror is off its nominal place.
+    pub mounting: MirrorMounting,
 }
 
 impl Sensor {
+    /// The scene ray of image coordinates `(X, Y)` in the sensor frame, the mirror as it is
+    /// mounted.
+    pub fn scene_ray(&self, x_px: f64, y_px: f64) -> Option<crate::optics::Ray> {
+        match self
+            .optics
+            .mirror_frame()
+            .filter(|_| !self.mounting.is_nominal())
+        {
+            Some(frame) => frame.scene_ray(&self.mounting, x_px, y_px),
+            None => self.optics.scene_ray(x_px, y_px),
+        }
+    }
+
+    /// The scene ray the robot's calibration is traced with: the nominal mirror's, unless the
+    /// robot calibrated itself on the mirror as it is mounted.
+    pub fn calibration_ray(&self, x_px: f64, y_px: f64) -> Option<crate::optics::Ray> {
+        if self.mounting.self_calibrated {
+            self.scene_ray(x_px, y_px)
+        } else {
+            self.optics.scene_ray(x_px, y_px)
+        }
+    }
+
     /// Image coordinates `(X, Y)` (from the principal point, Y up) of pixel `(u, v)`'s centre.
     pub fn image_coords(&self, u: u32, v: u32) -> (f64, f64) {
         (u as f64 + 0.5 - self.cx_px, self.cy_px - (v as f64 + 0.5))
@@ -217,7 +251,7 @@ impl Sensor {
     /// mirror.
     pub fn pixel_ray(&self, u: u32, v: u32) -> Option<crate::optics::Ray> {
         let (x, y) = self.image_coords(u, v);
-        let mut ray = self.optics.scene_ray(x, y)?;
+        let mut ray = self.scene_ray(x, y)?;
         ray.origin.x += self.mount_mm[0];
         ray.origin.y += self.mount_mm[1];
         Some(ray)

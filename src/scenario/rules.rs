@@ -7,6 +7,7 @@ use nalgebra::Point2;
 use omniloop_robot::controllers::{self, CONTROLLERS};
 use omniloop_robot::perception::{self, CameraNeed, STAGES};
 use omniloop_robot::{ControllerEntry, RobotConfig, StageEntry};
+use omniloop_sim::optics::Optics;
 use omniloop_sim::{Layout, SensorSpec};
 
 fn in_floor(world: &Layout, p: Point2<f64>) -> bool {
@@ -556,6 +557,18 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
     }
     for (key, why) in s.effects.problems() {
         c.fail(format!("{p}.effects.{key}"), why);
+    }
+    for (key, why) in s.mounting.problems() {
+        c.fail(format!("{p}.mounting.{key}"), why);
+    }
+    if !s.mounting.is_nominal() && matches!(s.optics, Optics::Pinhole(_) | Optics::Calibrated(_)) {
+        c.fail(
+            format!("{p}.mounting"),
+            format!(
+                "a {} camera has no mirror to mount off its place",
+                s.optics.kind()
+            ),
+        );
     }
     if let Some(model) = s.optics.calibrated().and_then(|cam| cam.model()) {
         check_calibrated_size(c, p, s, model);

@@ -13,6 +13,7 @@
 pub mod calibrated;
 pub mod conical;
 pub mod hyperbolic;
+pub mod mounting;
 pub mod pinhole;
 pub mod problems;
 pub mod ray;
@@ -21,6 +22,7 @@ pub mod spherical;
 pub use calibrated::CalibratedCamera;
 pub use conical::ConicalMirror;
 pub use hyperbolic::HyperbolicMirror;
+pub use mounting::{MirrorFrame, MirrorMounting};
 pub use pinhole::PinholeCamera;
 pub use ray::{Ray, reflect, solve_quadratic};
 pub use spherical::SphericalMirror;
@@ -95,6 +97,50 @@ impl Optics {
             Optics::Conical(m) => Some(m),
             _ => None,
         }
+    }
+
+    /// The frame of its mirror, for tracing it off its place (`None` for a camera without a
+    /// mirror).
+    pub fn mirror_frame(&self) -> Option<MirrorFrame> {
+        Some(match self {
+            Optics::Hyperbolic(m) => {
+                let c = m.focal_half_distance_mm();
+                let z0 = m.focus_height_mm - c;
+                MirrorFrame {
+                    surface: mounting::Surface::Hyperboloid {
+                        a: m.a_mm,
+                        b: m.b_mm,
+                        rim: m.rim_radius_mm,
+                    },
+                    z0_mm: z0,
+                    pinhole_mm: z0 - c,
+                    pivot_mm: z0 + m.b_mm,
+                    focal_px: m.focal_px,
+                }
+            }
+            Optics::Conical(m) => MirrorFrame {
+                surface: mounting::Surface::Cone {
+                    k: (m.apex_angle_deg.to_radians() / 2.0).tan(),
+                    tip: m.tip_distance_mm,
+                    radius: m.radius_mm,
+                },
+                z0_mm: m.lens_height_mm,
+                pinhole_mm: m.lens_height_mm,
+                pivot_mm: m.lens_height_mm + m.tip_distance_mm,
+                focal_px: m.focal_px,
+            },
+            Optics::Spherical(m) => MirrorFrame {
+                surface: mounting::Surface::Sphere {
+                    centre: m.camera_distance_mm,
+                    r: m.radius_mm,
+                },
+                z0_mm: m.lens_height_mm,
+                pinhole_mm: m.lens_height_mm,
+                pivot_mm: m.lens_height_mm + m.camera_distance_mm - m.radius_mm,
+                focal_px: m.focal_px,
+            },
+            Optics::Pinhole(_) | Optics::Calibrated(_) => return None,
+        })
     }
 
     /// The calibrated camera, when the optics are one.

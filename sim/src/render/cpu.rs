@@ -96,10 +96,16 @@ impl SensorRays {
     pub fn new(sensor: &Sensor) -> Self {
         let (w, h) = (sensor.width_px, sensor.height_px);
         let mut rays = Vec::with_capacity((w * h) as usize);
+        // The farthest a ray starts from the axis: the optics' bound, or beyond it where a
+        // mirror is mounted off its place.
+        let mut max_offset = sensor.optics.max_origin_offset_mm();
         for v in 0..h {
             for u in 0..w {
                 rays.push(match sensor.pixel_ray(u, v) {
                     Some(r) => {
+                        let axis_offset = (r.origin.x - sensor.mount_mm[0])
+                            .hypot(r.origin.y - sensor.mount_mm[1]);
+                        max_offset = max_offset.max(axis_offset);
                         let d = [r.dir.x as f32, r.dir.y as f32, r.dir.z as f32];
                         PixelRay {
                             o: [r.origin.x as f32, r.origin.y as f32, r.origin.z as f32],
@@ -121,7 +127,7 @@ impl SensorRays {
             width: w,
             rays,
             axis: [sensor.mount_mm[0] as f32, sensor.mount_mm[1] as f32],
-            max_offset_mm: sensor.optics.max_origin_offset_mm() as f32,
+            max_offset_mm: max_offset as f32,
             body: None,
         }
     }

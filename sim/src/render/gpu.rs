@@ -98,6 +98,21 @@ impl SensorParams {
                 (kind, 0.0)
             }
         };
+        // A mirror off its place: its frame in p3 (pivot, pinhole and frame heights, the
+        // flag) and the tilt's rows with the offset in the intrinsics' slots.
+        if let Some(frame) = s.optics.mirror_frame().filter(|_| !s.mounting.is_nominal()) {
+            let r = s.mounting.rotation();
+            let o = s.mounting.mirror_offset_mm;
+            p3 = [
+                frame.pivot_mm as f32,
+                frame.pinhole_mm as f32,
+                frame.z0_mm as f32,
+                1.0,
+            ];
+            for (i, row) in model.iter_mut().enumerate() {
+                *row = [r[(i, 0)], r[(i, 1)], r[(i, 2)], o[i]].map(|v| v as f32);
+            }
+        }
         let theta = pose.rotation.angle();
         Self {
             size: [s.width_px, s.height_px, kind, 0],

@@ -186,10 +186,75 @@ fn calibrated_ray(kind: u32, x: f32, y: f32) -> Ray {
     return Ray(vec3<f32>(sensor.p0.w, sensor.p1.w, sensor.p2.w), dir, true);
 }
 
+// R v and R^T v for the mounting's tilt R, its rows in p4..p6 (xyz).
+fn tilt(v: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(sensor.p4.xyz, v), dot(sensor.p5.xyz, v), dot(sensor.p6.xyz, v));
+}
+fn untilt(v: vec3<f32>) -> vec3<f32> {
+    return sensor.p4.xyz * v.x + sensor.p5.xyz * v.y + sensor.p6.xyz * v.z;
+}
+
+// A mirror off its place (sim/src/optics/mounting.rs): the camera's ray taken into the nominal
+// mirror's frame, met with its surface from that origin, and the reflected ray moved back.
+fn mounted_ray(kind: u32, x: f32, y: f32) -> Ray {
+    var fail = Ray(vec3<f32>(0.0), vec3<f32>(0.0), false);
+    let pivot = vec3<f32>(0.0, 0.0, sensor.p3.x);
+    let offset = vec3<f32>(sensor.p4.w, sensor.p5.w, sensor.p6.w);
+    let z0 = vec3<f32>(0.0, 0.0, sensor.p3.z);
+    let d = untilt(normalize(vec3<f32>(x, y, sensor.intr.z)));
+    let o = untilt(vec3<f32>(0.0, 0.0, sensor.p3.y) - pivot - offset) + pivot - z0;
+    var t = -1.0;
+    var n = vec3<f32>(0.0);
+    if (kind == 0u) {
+        let a2 = sensor.p0.x * sensor.p0.x;
+        let b2 = sensor.p0.y * sensor.p0.y;
+        let roots = quadratic(d.z * d.z / b2 - (d.x * d.x + d.y * d.y) / a2,
+            2.0 * (o.z * d.z / b2 - (o.x * d.x + o.y * d.y) / a2),
+            o.z * o.z / b2 - (o.x * o.x + o.y * o.y) / a2 - 1.0);
+        if (roots.z < 0.0) { return fail; }
+        if (roots.x > 0.0 && o.z + roots.x * d.z > 0.0) {
+            t = roots.x;
+        } else if (roots.y > 0.0 && o.z + roots.y * d.z > 0.0) {
+            t = roots.y;
+        }
+        if (t <= 0.0) { return fail; }
+        let p = o + d * t;
+        if (p.x * p.x + p.y * p.y > sensor.p1.x * sensor.p1.x) { return fail; }
+        n = normalize(vec3<f32>(p.x / a2, p.y / a2, -p.z / b2));
+    } else if (kind == 1u) {
+        let k2 = sensor.p0.x * sensor.p0.x;
+        let h = o.z - sensor.p0.y;
+        let roots = quadratic(d.x * d.x + d.y * d.y - k2 * d.z * d.z,
+            2.0 * (o.x * d.x + o.y * d.y) - 2.0 * k2 * h * d.z,
+            o.x * o.x + o.y * o.y - k2 * h * h);
+        if (roots.z < 0.0) { return fail; }
+        if (roots.x > 0.0 && h + roots.x * d.z >= 0.0) {
+            t = roots.x;
+        } else if (roots.y > 0.0 && h + roots.y * d.z >= 0.0) {
+            t = roots.y;
+        }
+        if (t <= 0.0) { return fail; }
+        let p = o + d * t;
+        let rho = sqrt(p.x * p.x + p.y * p.y);
+        if (rho > sensor.p0.z || rho < 1e-12) { return fail; }
+        n = normalize(vec3<f32>(p.x / rho, p.y / rho, -sensor.p0.x));
+    } else {
+        let oc = o - vec3<f32>(0.0, 0.0, sensor.p0.y);
+        let r = sensor.p0.x;
+        let roots = quadratic(1.0, 2.0 * dot(d, oc), dot(oc, oc) - r * r);
+        if (roots.z < 0.0 || roots.x <= 0.0) { return fail; }
+        t = roots.x;
+        n = (oc + d * t) / r;
+    }
+    let s = o + d * t + z0;
+    return Ray(tilt(s - pivot) + pivot + offset, tilt(reflect_n(d, n)), true);
+}
+
 // The scene ray of image coordinates (x, y) in the robot frame (see sim/src/optics).
 fn scene_ray(x: f32, y: f32) -> Ray {
     let kind = sensor.size.z;
     if (kind >= 4u) { return calibrated_ray(kind, x, y); }
+    if (kind <= 2u && sensor.p3.w > 0.5) { return mounted_ray(kind, x, y); }
     let f = sensor.intr.z;
     var fail = Ray(vec3<f32>(0.0), vec3<f32>(0.0), false);
     if (kind == 3u) {
