@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{bin, cpu, gpu_or_skip, scenario, scenario_path, tmp};
+use common::{bin, cpu, gpu_or_skip, scenario, scenario_path, share_within, tmp};
 use nalgebra::{Isometry2, Matrix3, Vector2};
 use omniloop::Scenario;
 use omniloop::run::render_snapshot;
@@ -55,16 +55,6 @@ fn reimported(format: CameraFormat, dir: &Path) -> Scenario {
     s
 }
 
-/// The fraction of pixels whose every channel is within `levels` of the other image's.
-fn within(a: &image::RgbaImage, b: &image::RgbaImage, levels: i32) -> f64 {
-    let close = a
-        .pixels()
-        .zip(b.pixels())
-        .filter(|(p, q)| (0..3).all(|c| (p.0[c] as i32 - q.0[c] as i32).abs() <= levels))
-        .count();
-    close as f64 / (a.width() * a.height()) as f64
-}
-
 #[test]
 fn the_hyperbolic_sensor_exported_and_imported_renders_the_analytic_mirrors_frames() {
     let dir = tmp("camera_models_round_trip");
@@ -75,7 +65,7 @@ fn the_hyperbolic_sensor_exported_and_imported_renders_the_analytic_mirrors_fram
         for pose in poses() {
             let a = render_snapshot(&analytic, &mut r, None, pose, false).unwrap();
             let b = render_snapshot(&s, &mut r, None, pose, false).unwrap();
-            let frac = within(&a, &b, 1);
+            let frac = share_within(&a, &b, 1);
             eprintln!(
                 "{}: {:.4}% of pixels within 1 level",
                 format.name(),
@@ -100,7 +90,7 @@ fn calibrated_cameras_render_alike_on_the_gpu_and_the_cpu() {
         for pose in poses() {
             let a = render_snapshot(&s, &mut cpu_renderer, None, pose, true).unwrap();
             let b = render_snapshot(&s, &mut gpu, None, pose, true).unwrap();
-            let frac = within(&a, &b, 2);
+            let frac = share_within(&a, &b, 2);
             eprintln!(
                 "{}: {:.4}% of pixels within 2 levels ({})",
                 format.name(),

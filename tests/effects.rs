@@ -6,30 +6,12 @@
 
 mod common;
 
-use common::{gpu_or_skip, scenario};
+use common::{gpu_or_skip, paper_f, paper_f_inverse, scenario, share_within};
 use image::RgbaImage;
 use nalgebra::{Isometry2, Vector2};
 use omniloop::run::render_snapshot;
 use omniloop_sim::render::effects::exposure_poses;
 use omniloop_sim::{CameraEffects, FloorRect, Layout, Renderer, Scene, SensorSpec};
-
-/// The corner paper's f(R) (floor distance of image radius R) and its inverse.
-fn paper_f(r_px: f64) -> f64 {
-    r_px / (10.12 - 2.054e-2 * (2.298e5 + r_px * r_px).sqrt())
-}
-
-fn paper_f_inverse(r_mm: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, 113.0);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if paper_f(mid) < r_mm {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
 
 /// A floor stripe (floor colour) from `near` to `far` mm ahead of the robot on the outside
 /// colour, and nothing else.
@@ -200,12 +182,7 @@ fn the_gpu_and_the_cpu_develop_the_same_frames_with_the_effects_on() {
     let mut cpu = Renderer::cpu();
     let a = render_snapshot(&s, &mut cpu, None, None, true).unwrap();
     let b = render_snapshot(&s, &mut gpu, None, None, true).unwrap();
-    let close = a
-        .pixels()
-        .zip(b.pixels())
-        .filter(|(p, q)| (0..3).all(|c| (p.0[c] as i32 - q.0[c] as i32).abs() <= 2))
-        .count();
-    let frac = close as f64 / (a.width() * a.height()) as f64;
+    let frac = share_within(&a, &b, 2);
     eprintln!(
         "{:.4}% of pixels within 2 levels ({})",
         100.0 * frac,

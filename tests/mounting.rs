@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{gpu_or_skip, scenario};
+use common::{gpu_or_skip, scenario, share_within};
 use nalgebra::{Isometry2, Vector2, Vector3};
 use omniloop::run::render_snapshot;
 use omniloop_sim::optics::{HyperbolicMirror, MirrorMounting};
@@ -128,12 +128,7 @@ fn gpu_and_cpu_agree_with_a_mirror_off_its_place() {
     for pose in [None, pose] {
         let a = render_snapshot(&s, &mut cpu, None, pose, true).unwrap();
         let b = render_snapshot(&s, &mut gpu, None, pose, true).unwrap();
-        let close = a
-            .pixels()
-            .zip(b.pixels())
-            .filter(|(p, q)| (0..3).all(|c| (p.0[c] as i32 - q.0[c] as i32).abs() <= 2))
-            .count();
-        let frac = close as f64 / (a.width() * a.height()) as f64;
+        let frac = share_within(&a, &b, 2);
         eprintln!(
             "{:.4}% of pixels within 2 levels ({})",
             100.0 * frac,

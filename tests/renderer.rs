@@ -14,26 +14,10 @@ use omniloop_sim::{
 };
 mod common;
 
-use common::{gpu_or_skip, omniloop, scenario_path as scenario};
+use common::{
+    gpu_or_skip, omniloop, paper_f, paper_f_inverse, scenario_path as scenario, share_within,
+};
 use std::path::Path;
-
-/// The paper's f(R) and its inverse.
-fn paper_f(r_px: f64) -> f64 {
-    r_px / (10.12 - 2.054e-2 * (2.298e5 + r_px * r_px).sqrt())
-}
-
-fn paper_f_inverse(r_mm: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, 113.0);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if paper_f(mid) < r_mm {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
 
 #[test]
 fn every_pixel_of_the_corner_mirror_sees_the_floor_where_the_papers_f_says() {
@@ -295,13 +279,7 @@ fn gpu_and_cpu_renders_agree() {
             // counter (the frame's key, the pixel, the channel).
             let a = render_snapshot(&s, &mut cpu, Some(&spec.name), pose, true).unwrap();
             let b = render_snapshot(&s, &mut gpu, Some(&spec.name), pose, true).unwrap();
-            let total = (a.width() * a.height()) as usize;
-            let close = a
-                .pixels()
-                .zip(b.pixels())
-                .filter(|(p, q)| (0..3).all(|c| (p.0[c] as i32 - q.0[c] as i32).abs() <= 2))
-                .count();
-            let frac = close as f64 / total as f64;
+            let frac = share_within(&a, &b, 2);
             eprintln!(
                 "{name}/{}: {:.4}% of pixels within 2 levels ({})",
                 spec.name,

@@ -88,3 +88,33 @@ pub fn check_variant(scenario: &str, name: &str, from: &str, to: &str) -> (Optio
         String::from_utf8_lossy(&out.stderr).into_owned(),
     )
 }
+
+/// The share of the pixels whose every colour channel is within `levels` of the other
+/// image's.
+pub fn share_within(a: &image::RgbaImage, b: &image::RgbaImage, levels: i32) -> f64 {
+    let close = a
+        .pixels()
+        .zip(b.pixels())
+        .filter(|(p, q)| (0..3).all(|c| (p.0[c] as i32 - q.0[c] as i32).abs() <= levels))
+        .count();
+    close as f64 / (a.width() * a.height()) as f64
+}
+
+/// The corner paper's f(R): the floor distance (mm) of image radius R (px).
+pub fn paper_f(r_px: f64) -> f64 {
+    r_px / (10.12 - 2.054e-2 * (2.298e5 + r_px * r_px).sqrt())
+}
+
+/// The image radius (px) of floor distance `r_mm` by the paper's f(R), by bisection.
+pub fn paper_f_inverse(r_mm: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0, 113.0);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if paper_f(mid) < r_mm {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
