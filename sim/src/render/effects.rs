@@ -336,7 +336,7 @@ mod tests {
             ..CameraEffects::default()
         };
         assert_eq!(
-            develop(&dim, &[frame.clone()], [4, 4], [2.0, 2.0], None)[0],
+            develop(&dim, std::slice::from_ref(&frame), [4, 4], [2.0, 2.0], None)[0],
             50
         );
         let bright = CameraEffects {
