@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{bin, cpu, gpu_or_skip, scenario, scenario_path, share_within, tmp};
+use common::{assert_alike, bin, cpu, gpu_or_skip, scenario, scenario_path, tmp};
 use nalgebra::{Isometry2, Matrix3, Vector2};
 use omniloop::Scenario;
 use omniloop::run::render_snapshot;
@@ -65,13 +65,7 @@ fn the_hyperbolic_sensor_exported_and_imported_renders_the_analytic_mirrors_fram
         for pose in poses() {
             let a = render_snapshot(&analytic, &mut r, None, pose, false).unwrap();
             let b = render_snapshot(&s, &mut r, None, pose, false).unwrap();
-            let frac = share_within(&a, &b, 1);
-            eprintln!(
-                "{}: {:.4}% of pixels within 1 level",
-                format.name(),
-                100.0 * frac
-            );
-            assert!(frac >= 0.999, "{}: {:.4}%", format.name(), 100.0 * frac);
+            assert_alike(&a, &b, 1, format.name());
             // Not trivially: the frames are not black.
             assert!(b.pixels().filter(|p| p.0[..3] != [0, 0, 0]).count() > 50_000);
         }
@@ -90,14 +84,7 @@ fn calibrated_cameras_render_alike_on_the_gpu_and_the_cpu() {
         for pose in poses() {
             let a = render_snapshot(&s, &mut cpu_renderer, None, pose, true).unwrap();
             let b = render_snapshot(&s, &mut gpu, None, pose, true).unwrap();
-            let frac = share_within(&a, &b, 2);
-            eprintln!(
-                "{}: {:.4}% of pixels within 2 levels ({})",
-                format.name(),
-                100.0 * frac,
-                gpu.name()
-            );
-            assert!(frac >= 0.999, "{}: {:.4}%", format.name(), 100.0 * frac);
+            assert_alike(&a, &b, 2, &format!("{} ({})", format.name(), gpu.name()));
         }
     }
 }

@@ -5,11 +5,10 @@ use super::error::RunError;
 use crate::scenario::Scenario;
 use crate::scenario::TimingSpec;
 use image::RgbaImage;
-use nalgebra::Isometry2;
 use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
 use omniloop_sim::optics::Optics;
 use omniloop_sim::render::BatchHandle;
-use omniloop_sim::render::effects::exposure_poses;
+use omniloop_sim::render::effects::{exposure_poses, pose_after};
 use omniloop_sim::{Renderer, RendererChoice, Scene, Sensor, SensorNoise, World};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -203,10 +202,7 @@ impl Cameras {
     ) -> Result<(), RunError> {
         let mut state = world.robot_state(0);
         let offset = self.delivery.offset_s;
-        state.pose = Isometry2::new(
-            state.pose.translation.vector + state.velocity_mm_s * offset,
-            state.pose.rotation.angle() + state.omega_rad_s * offset,
-        );
+        state.pose = pose_after(&state.pose, state.velocity_mm_s, state.omega_rad_s, offset);
         let scene = Scene::of_world(world);
         let now = world.time_s();
         let mut images = Vec::with_capacity(self.cameras.len());

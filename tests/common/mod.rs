@@ -100,6 +100,17 @@ pub fn share_within(a: &image::RgbaImage, b: &image::RgbaImage, levels: i32) -> 
     close as f64 / (a.width() * a.height()) as f64
 }
 
+/// Requires at least 99.9% of the pixels within `levels` of the other image's (each channel),
+/// and prints the share found under `what`.
+pub fn assert_alike(a: &image::RgbaImage, b: &image::RgbaImage, levels: i32, what: &str) {
+    let frac = share_within(a, b, levels);
+    eprintln!(
+        "{what}: {:.4}% of pixels within {levels} levels",
+        100.0 * frac
+    );
+    assert!(frac >= 0.999, "{what}: only {:.4}%", 100.0 * frac);
+}
+
 /// The corner paper's f(R): the floor distance (mm) of image radius R (px).
 pub fn paper_f(r_px: f64) -> f64 {
     r_px / (10.12 - 2.054e-2 * (2.298e5 + r_px * r_px).sqrt())

@@ -122,6 +122,20 @@ impl CameraEffects {
     }
 }
 
+/// `pose` moved on for `dt_s` (negative: back) at `velocity_mm_s` (world frame) and
+/// `omega_rad_s`.
+pub fn pose_after(
+    pose: &Isometry2<f64>,
+    velocity_mm_s: Vector2<f64>,
+    omega_rad_s: f64,
+    dt_s: f64,
+) -> Isometry2<f64> {
+    Isometry2::new(
+        pose.translation.vector + velocity_mm_s * dt_s,
+        pose.rotation.angle() + omega_rad_s * dt_s,
+    )
+}
+
 /// The robot's poses while the shutter is open, for `samples` sub-frames: the exposure ends at
 /// `pose` and lasts `exposure_s`, the robot moving at `velocity_mm_s` (world frame) and
 /// `omega_rad_s`; sub-frame `j` is at the middle of its slice, `s_j = exposure (j + 0.5) / n`
@@ -139,10 +153,7 @@ pub fn exposure_poses(
     (0..n)
         .map(|j| {
             let s = effects.exposure_s * (j as f64 + 0.5) / n as f64;
-            Isometry2::new(
-                pose.translation.vector - velocity_mm_s * s,
-                pose.rotation.angle() - omega_rad_s * s,
-            )
+            pose_after(pose, velocity_mm_s, omega_rad_s, -s)
         })
         .collect()
 }
