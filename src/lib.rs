@@ -9,13 +9,17 @@
 //! - [`report`]: a run's files and figures;
 //! - [`experiments`]: the registered experiments, which drive the loop, with their replays;
 //!   [`run_scenario`], [`Runner`] and [`load_scenario`];
-//! - [`sweep`]: many runs over a grid of values and seeds.
+//! - [`sweep`]: many runs over a grid of values and seeds;
+//! - [`robustness`]: every estimator against each knob of realism, as one sweep;
+//! - [`replays`]: the registry of `omniloop replay`.
 //!
 //! The robot's software is anything that implements [`robot::RobotSoftware`]; the world lives
 //! in `omniloop-sim`, image processing in [`vision`], motion and avoidance in [`control`].
 
 pub mod experiments;
+pub mod replays;
 pub mod report;
+pub mod robustness;
 pub mod run;
 pub mod scenario;
 pub mod sweep;

@@ -182,3 +182,23 @@ fn the_robot_goes_round_the_field_through_its_four_corners_on_localization() {
         m.cycles
     );
 }
+
+/// E2 with frames 30 ms late and 30% of them lost: only frames taken at a place count, a lost
+/// one is taken again, so every place still has its ten fixes within 30 mm (before, the first
+/// late frame at each place showed the last place, and a lost one counted as not localized).
+#[test]
+fn e2_counts_only_frames_taken_at_the_place_under_latency_and_loss() {
+    let mut s = scenario("selfloc_field.toml");
+    s.robot.timing.frame_latency_s = 0.03;
+    s.robot.timing.frame_drop_rate = 0.3;
+    let out = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
+    let places = place_results(&out.summary);
+    assert_eq!(places.len(), 6);
+    for p in &places {
+        eprintln!("{p:?}");
+        assert_eq!((p.frames, p.not_localized), (10, 0), "{p:?}");
+        assert!(p.rms_position_mm <= 30.0, "{p:?}");
+    }
+    // More cycles than frames: the late and the lost ones were taken again.
+    assert!(out.trajectory.len() > 60, "{} cycles", out.trajectory.len());
+}

@@ -329,7 +329,8 @@ pub const PAPER_LEGS_IN: [(f64, f64, f64); 4] = [
     (9.5, 8.3, 8.6),
 ];
 
-fn moves_of(summary: &crate::run::Summary) -> Vec<MoveResult> {
+/// The scripted moves of a summary (`moves`), empty without them.
+pub fn moves_of(summary: &crate::run::Summary) -> Vec<MoveResult> {
     summary
         .experiment
         .get("moves")

@@ -19,7 +19,7 @@ pub mod run;
 pub mod session;
 
 pub use experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, drive};
-pub use registry::{EXPERIMENTS, REPLAYS, replay};
+pub use registry::EXPERIMENTS;
 pub use replay::{Replay, ReplayContext, ReplayRun};
 pub use run::{Runner, load_scenario, parse_scenario, run_dyn, run_scenario, run_scenario_with};
 pub use session::Session;

@@ -1,9 +1,7 @@
-//! The registries of experiments and of replays: a new experiment is its own file with its
-//! [`ExperimentEntry`] and one line in [`EXPERIMENTS`]; a replay of a paper's experiment one
-//! line in [`REPLAYS`].
+//! The registry of experiments: a new experiment is its own file with its [`ExperimentEntry`]
+//! and one line in [`EXPERIMENTS`] (its replay goes in `crate::replays`).
 
 use super::experiment::{ExperimentEntry, ExperimentSetup};
-use super::replay::Replay;
 use super::{clutter, corner, forward, heading, localization_map, omnistereo, places, resection};
 use crate::scenario::{Checker, Scenario};
 use omniloop_robot::ConfigProblem;
@@ -19,21 +17,6 @@ pub const EXPERIMENTS: &[ExperimentEntry] = &[
     forward::ENTRY,
     clutter::ENTRY,
 ];
-
-/// Every replay, in the order `omniloop replay --list` shows them.
-pub const REPLAYS: &[Replay] = &[
-    corner::REPLAY,
-    places::REPLAY,
-    heading::REPLAY,
-    omnistereo::REPLAY,
-    resection::REPLAY,
-    forward::REPLAY,
-];
-
-/// The replay called `name`.
-pub fn replay(name: &str) -> Option<&'static Replay> {
-    REPLAYS.iter().find(|r| r.name == name)
-}
 
 /// The experiment called `name`.
 pub fn find(name: &str) -> Option<&'static ExperimentEntry> {

@@ -72,6 +72,15 @@ impl PanUnit {
     }
 }
 
+/// `sensor` with its pinhole camera turned to `pan_rad` on its pan unit.
+fn turned_to(sensor: &Sensor, pan_rad: f64) -> Sensor {
+    let mut s = sensor.clone();
+    if let Optics::Pinhole(cam) = &mut s.optics {
+        cam.pan_deg = pan_rad.to_degrees();
+    }
+    s
+}
+
 struct Camera {
     sensor: Sensor,
     noise: SensorNoise,
@@ -192,9 +201,9 @@ impl Cameras {
     /// Renders the live cameras named in `wanted` (all live ones with `None`) at robot 0's
     /// true pose, with their noise; the others give no frame this cycle. With a frame
     /// latency, the frames rendered now arrive that much later (taken `offset_s` into this
-    /// cycle, the robot moved on along its velocity; the rest of the world as at the cycle's
-    /// start), and the capture that arrives now is the one the software gets; a lost frame
-    /// never arrives.
+    /// cycle, the robot moved on along its velocity and the pan units on toward their goals;
+    /// the rest of the world as at the cycle's start), and the capture that arrives now is the
+    /// one the software gets; a lost frame never arrives.
     pub fn capture_some(
         &mut self,
         world: &World,
@@ -215,9 +224,14 @@ impl Cameras {
                     state.omega_rad_s,
                     &c.sensor.effects,
                 );
+                let turned = c.pan.filter(|_| offset > 0.0).map(|mut unit| {
+                    unit.advance(offset);
+                    turned_to(&c.sensor, unit.pan_rad())
+                });
+                let sensor = turned.as_ref().unwrap_or(&c.sensor);
                 Some(
                     self.renderer
-                        .render_exposed(&scene, &c.sensor, &poses, Some(&mut c.noise))?,
+                        .render_exposed(&scene, sensor, &poses, Some(&mut c.noise))?,
                 )
             } else {
                 None

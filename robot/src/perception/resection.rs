@@ -9,6 +9,9 @@
 //!   column (Sect. 3.2), averaged over the frames that show it within `central_fraction` of
 //!   the half-image from the axis; the sweep ends once every mark has been seen and has left
 //!   the view again, or at the left stop;
+//! - the frame's pan angle is the pan unit's reading when the frame was taken: a frame that
+//!   arrives late was taken at an earlier angle (60 degrees/s for 30 ms is 1.8 degrees), so
+//!   the readings of the last cycles are kept and interpolated at the frame's time;
 //! - the other observation point is `move_mm` away, square to the middle of the widest gap
 //!   between the bearings of the marks that were found (where the missing one must be) and to
 //!   its left, so that the line of sight to it moves past what hides it; straight ahead when
@@ -191,6 +194,49 @@ pub struct ResectionStage {
     patterns: Vec<StripePattern>,
     state: State,
     moves: u32,
+    pans: PanHistory,
+}
+
+/// The pan unit's readings of the last cycles, to know the angle at which a late frame was
+/// taken.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct PanHistory {
+    /// (time s, pan rad), oldest first.
+    readings: std::collections::VecDeque<(f64, f64)>,
+}
+
+impl PanHistory {
+    /// Readings kept: a second of cycles at 40 ms and more.
+    const KEPT: usize = 32;
+
+    fn record(&mut self, t_s: f64, pan_rad: f64) {
+        match self.readings.back() {
+            Some(&(t, _)) if t == t_s => {
+                self.readings.pop_back();
+            }
+            Some(&(t, _)) if t > t_s => self.readings.clear(),
+            _ => {}
+        }
+        self.readings.push_back((t_s, pan_rad));
+        if self.readings.len() > Self::KEPT {
+            self.readings.pop_front();
+        }
+    }
+
+    /// The pan at `t_s`, linear between the readings around it; the oldest or newest reading
+    /// outside them (none without readings).
+    fn at(&self, t_s: f64) -> Option<f64> {
+        let (&(t0, p0), &(t1, p1)) = (self.readings.front()?, self.readings.back()?);
+        if t_s <= t0 {
+            return Some(p0);
+        }
+        if t_s >= t1 {
+            return Some(p1);
+        }
+        let k = self.readings.iter().position(|&(t, _)| t >= t_s)?;
+        let ((ta, pa), (tb, pb)) = (self.readings[k - 1], self.readings[k]);
+        Some(pa + (pb - pa) * (t_s - ta) / (tb - ta))
+    }
 }
 
 impl ResectionStage {
@@ -226,6 +272,7 @@ impl ResectionStage {
             search,
             state: State::Start,
             moves: 0,
+            pans: PanHistory::default(),
         })
     }
 
@@ -260,8 +307,12 @@ impl ResectionStage {
         obs: &Observation<'_>,
         cal: &ColumnCalibration,
     ) -> Result<f64, RobotError> {
-        let pan = self.pan_rad(obs)?;
+        let now = self.pan_rad(obs)?;
         let img = image(obs, &self.camera, NAME)?;
+        let pan = obs
+            .frame(&self.camera)
+            .and_then(|f| self.pans.at(f.t_s))
+            .unwrap_or(now);
         let seen = find_marks(img, &self.patterns, &self.config).unwrap_or_default();
         let half = 0.5 * cal.width_px as f64 * self.search.central_fraction;
         for (k, t) in tracks.iter_mut().enumerate() {
@@ -271,7 +322,7 @@ impl ResectionStage {
                 t.bearings.push(wrap(pan + cal.bearing_rad(s.centre)));
             }
         }
-        Ok(pan)
+        Ok(now)
     }
 
     /// The bearings of the marks in one omnidirectional frame.
@@ -411,6 +462,10 @@ impl Stage for ResectionStage {
         belief: &Belief,
         out: &mut Percepts,
     ) -> Result<(), RobotError> {
+        if matches!(self.view, View::Pan(_)) {
+            let pan = self.pan_rad(obs)?;
+            self.pans.record(obs.t_s, pan);
+        }
         match std::mem::replace(&mut self.state, State::Done) {
             State::Done => {}
             State::Start => match &self.view {
@@ -477,6 +532,22 @@ mod tests {
         // One mark: the gap is the whole circle from it.
         let d = move_direction(&[None, Some(0.5), None]);
         assert!((wrap(d - 0.5 - 1.5 * PI)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_late_frame_gets_the_pan_of_when_it_was_taken() {
+        let mut h = PanHistory::default();
+        assert_eq!(h.at(0.0), None);
+        for k in 0..5 {
+            h.record(0.04 * f64::from(k), 0.1 * f64::from(k));
+        }
+        // 30 ms before the last reading (0.16 s, 0.4 rad): 0.13 s, 0.325 rad.
+        assert!((h.at(0.13).unwrap() - 0.325).abs() < 1e-12);
+        assert_eq!(h.at(1.0), Some(0.4));
+        assert_eq!(h.at(-1.0), Some(0.0));
+        // Time going back (a new run of the stage) starts the history again.
+        h.record(0.0, 2.0);
+        assert_eq!(h.at(0.13), Some(2.0));
     }
 
     #[test]

@@ -43,6 +43,9 @@ pub struct MarkConfig {
     /// The colours are first looked for within this fraction of the rim's radius, where every
     /// pillar's stripe starts (see [`detect_marks`]).
     pub seed_fraction: f64,
+    /// A colour with too few pixels there is looked for again out to this fraction: a
+    /// defocused camera washes out a stripe where it is thinner than its blur, near the centre.
+    pub wide_seed_fraction: f64,
 }
 
 impl Default for MarkConfig {
@@ -55,6 +58,7 @@ impl Default for MarkConfig {
             min_radius_px: 4.0,
             rim_margin_px: 1.5,
             seed_fraction: 0.12,
+            wide_seed_fraction: 0.3,
         }
     }
 }
@@ -67,6 +71,7 @@ impl MarkConfig {
         positive("marks.min_radius_px", self.min_radius_px)?;
         positive("marks.rim_margin_px", self.rim_margin_px)?;
         positive("marks.seed_fraction", self.seed_fraction)?;
+        positive("marks.wide_seed_fraction", self.wide_seed_fraction)?;
         below(
             "marks.min_saturation",
             self.min_saturation,
@@ -112,13 +117,19 @@ fn classify(p: [u8; 3], palette: &[[f64; 2]], cfg: &MarkConfig) -> Option<usize>
     (d2 <= cfg.max_chroma_distance * cfg.max_chroma_distance).then_some(k)
 }
 
+/// Seed pixels a colour needs to be looked for as a stripe.
+const MIN_SEEDS: usize = 3;
+
 /// Finds the marks of `palette`'s colours in `img`, whose mirror rim is `rim`: at most one a
 /// colour (the densest direction of it).
 ///
 /// Every pillar's stripe starts at the image centre, so the colours are first looked for in the
 /// small disc within `seed_fraction` of the rim's radius (pixels nearer than `min_radius_px`
 /// left out), then each stripe is measured on the pixels of the wedge around the direction it
-/// was seen in: a tenth of the image's pixels instead of all of them.
+/// was seen in: a tenth of the image's pixels instead of all of them. Near the centre a stripe
+/// is a pixel or less wide, and a defocused lens mixes it with the floor until no pixel keeps
+/// its colour: a colour found there on fewer than three pixels is looked for again within
+/// `wide_seed_fraction` of the rim's radius, where the stripe is wider.
 pub fn detect_marks(
     img: &RgbaImage,
     rim: &MirrorRim,
@@ -126,11 +137,24 @@ pub fn detect_marks(
     cfg: &MarkConfig,
 ) -> Vec<ColourMark> {
     let chromas: Vec<[f64; 2]> = palette.iter().map(|c| chroma(*c)).collect();
-    let seed_radius = (cfg.seed_fraction * rim.radius_px).max(cfg.min_radius_px + 4.0);
-    let seeds = coloured_pixels(img, rim, seed_radius, &chromas, cfg);
+    let near = (cfg.seed_fraction * rim.radius_px).max(cfg.min_radius_px + 4.0);
+    let mut seeds: Vec<(f64, Vec<[f64; 2]>)> = coloured_pixels(img, rim, near, &chromas, cfg)
+        .into_iter()
+        .map(|pts| (near, pts))
+        .collect();
+    let wide = (cfg.wide_seed_fraction * rim.radius_px).max(near);
+    if wide > near && seeds.iter().any(|(_, pts)| pts.len() < MIN_SEEDS) {
+        let again = coloured_pixels(img, rim, wide, &chromas, cfg);
+        for ((r, pts), more) in seeds.iter_mut().zip(again) {
+            if pts.len() < MIN_SEEDS {
+                (*r, *pts) = (wide, more);
+            }
+        }
+    }
     let mut marks = Vec::new();
-    for (label, pts) in seeds.iter().enumerate() {
-        let Some((axis, _)) = densest_direction(pts, cfg).filter(|_| pts.len() >= 3) else {
+    for (label, (seed_radius, pts)) in seeds.iter().enumerate() {
+        let seed_radius = *seed_radius;
+        let Some((axis, _)) = densest_direction(pts, cfg).filter(|_| pts.len() >= MIN_SEEDS) else {
             continue;
         };
         // The stripe's half-angle: each seed pixel's angle off the axis, less its own angular

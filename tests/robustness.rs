@@ -1,0 +1,99 @@
+//! The robustness replay's machinery on a part of its grid: E1's free space against the
+//! mirror's tilt (run), and knobs the rules or the experiment keep from an estimator (not run).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
+
+mod common;
+
+use omniloop::robustness::{
+    GridOptions, Outcome, Selection, estimator, knob, report, run_grid, write_outputs,
+};
+use omniloop_sim::RendererChoice;
+
+fn cpu(seed: Option<u64>) -> GridOptions {
+    GridOptions {
+        renderer: RendererChoice::Cpu,
+        seed,
+        workers: 0,
+    }
+}
+
+/// E1 with its mirror tilted 0 to 2 degrees: five runs, each scored; the free-space error
+/// grows with the tilt, and at 2 degrees the robot misses the goal (docs/realism.md); the
+/// table, the CSV and the figure are written.
+#[test]
+fn free_space_against_mirror_tilt() {
+    let selection = Selection {
+        estimators: vec![estimator("free_space").unwrap()],
+        knobs: vec![knob("tilt").unwrap()],
+        max_levels: None,
+    };
+    let mut calls = 0;
+    let grid = run_grid(&selection, &cpu(None), |_, _| calls += 1).unwrap();
+    assert_eq!(grid.runs, 5);
+    assert!(calls >= 1, "progress was never reported");
+    let scores: Vec<_> = grid
+        .cells
+        .iter()
+        .map(|c| match &c.outcome {
+            Outcome::Scored(s) => s.clone(),
+            o => panic!("tilt {}: {o:?}", c.level),
+        })
+        .collect();
+    let errors: Vec<f64> = scores.iter().map(|s| s.error).collect();
+    println!("free-space error at tilt 0, 0.5, 1, 1.5, 2 degrees: {errors:?} mm");
+    assert!(
+        errors.windows(2).all(|w| w[1] >= w[0]) && errors[4] > 2.0 * errors[0],
+        "the error does not grow with the tilt: {errors:?}"
+    );
+    assert!(scores[0].meets(), "untilted: {:?}", scores[0].missed);
+    assert_eq!(scores[4].missed.as_deref(), Some("goal not reached"));
+    let dir = common::tmp("robustness_tilt");
+    let md = write_outputs(&dir, &grid, 0.0).unwrap();
+    assert!(
+        md.contains("| mirror tilt, degrees | 0, 0.5, 1, 1.5, 2 |") && md.contains("| 2 |\n"),
+        "{md}"
+    );
+    let csv = std::fs::read_to_string(dir.join("robustness.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 6, "{csv}");
+    let png = image::open(dir.join("robustness.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (430, 320));
+}
+
+/// A mirror's tilt cannot reach the pinhole camera of E5 (the rules refuse it), nor latency
+/// E3's frames, which the experiment renders itself: whole rows not applicable, with the
+/// reason, and nothing run.
+#[test]
+fn knobs_that_cannot_reach_an_estimator() {
+    for (e, k, reason) in [
+        ("resection", "tilt", "mounting"),
+        ("heading", "latency", "outside"),
+    ] {
+        let selection = Selection {
+            estimators: vec![estimator(e).unwrap()],
+            knobs: vec![knob(k).unwrap()],
+            max_levels: None,
+        };
+        let grid = run_grid(&selection, &cpu(Some(3)), |_, _| {}).unwrap();
+        assert_eq!(grid.runs, 0, "{e} x {k} ran");
+        assert_eq!(grid.cells.len(), 5);
+        for c in &grid.cells {
+            match &c.outcome {
+                Outcome::NotApplicable(why) => assert!(why.contains(reason), "{e} x {k}: {why}"),
+                o => panic!("{e} x {k} at {}: {o:?}", c.level),
+            }
+        }
+        let md = report::markdown(&grid, "");
+        let row = format!(
+            "| {} | {} | n/a [1]",
+            knob(k).unwrap().label,
+            "0, 30, 60, 90, 120"
+        );
+        let row = if k == "tilt" {
+            "| mirror tilt, degrees | 0, 0.5, 1, 1.5, 2 | n/a [1]".to_string()
+        } else {
+            row
+        };
+        assert!(md.contains(&row), "{md}");
+        assert!(md.contains("| n/a |"), "{md}");
+    }
+}
