@@ -131,3 +131,35 @@ fn gpu_and_cpu_agree_with_a_mirror_off_its_place() {
         assert_alike(&a, &b, 2, gpu.name());
     }
 }
+
+/// E1 with its mirror shifted 1 mm forward: the free-space stage finds the robot's own dark
+/// image off the calibration's centre in the first frame and lays its template about it, so the robot still turns the corner without contact (before, the dark image filled
+/// the first ring ahead and the robot never started). Off by default, it stays where it was.
+#[test]
+fn e1_turns_the_corner_with_its_mirror_shifted_1_mm() {
+    let run = |recentre_px: f64| {
+        let mut s = scenario("corner55_velocity_aware.toml");
+        s.robot.sensors[0].mounting.mirror_offset_mm = [1.0, 0.0, 0.0];
+        let mut fs: omniloop_vision::FreeSpaceConfig = s.vision.table("freespace").unwrap();
+        fs.recentre_px = recentre_px;
+        s.vision.tables.set("freespace", &fs).unwrap();
+        omniloop::run_scenario(&s, &common::cpu(), |_| {}, |_, _| {})
+            .unwrap()
+            .summary
+    };
+    let m = run(1.0);
+    eprintln!(
+        "recentred: goal {}, {} contacts, min clearance {:.1} mm, free-space error {:.1} mm",
+        m.reached_goal,
+        m.wall_contacts,
+        m.min_clearance_mm,
+        m.freespace_error_mm.unwrap_or(f64::NAN)
+    );
+    assert!(m.reached_goal && m.wall_contacts == 0);
+    assert!(m.freespace_error_mm.unwrap() < 30.0);
+    let stuck = run(0.0);
+    assert!(
+        !stuck.reached_goal && stuck.path_length_mm < 100.0,
+        "{stuck:?}"
+    );
+}

@@ -72,6 +72,11 @@ pub struct FreeSpaceConfig {
     pub floor: FloorColor,
     /// Dilation/erosion passes when cleaning the mask.
     pub morphology_iterations: u32,
+    /// When the robot's own image (the dark disc about the mirror's axis) lies more than this
+    /// many pixels from the calibration's principal point in the first frame, the template is
+    /// laid about the disc's centre instead: a mirror shifted off its place moves its image
+    /// (0: never).
+    pub recentre_px: f64,
 }
 
 impl Default for FreeSpaceConfig {
@@ -88,6 +93,7 @@ impl Default for FreeSpaceConfig {
             method: FreeSpaceMethod::Count,
             floor: FloorColor::default(),
             morphology_iterations: 1,
+            recentre_px: 1.0,
         }
     }
 }

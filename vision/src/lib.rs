@@ -9,6 +9,7 @@ pub mod floor_localization;
 pub mod forward;
 pub mod freespace;
 pub mod geometry;
+pub mod image_centre;
 pub mod luminance_heading;
 pub mod mask;
 pub mod omnistereo;

@@ -9,9 +9,11 @@ use crate::boundary::Observation;
 use crate::config::RobotConfig;
 use crate::estimates::NotFound;
 use crate::tables::{ConfigProblem, Problems};
+use image::RgbaImage;
 use nalgebra::Isometry2;
 use omniloop_vision::FreeSpace;
 use omniloop_vision::freespace::PolarTemplate;
+use omniloop_vision::image_centre::dark_disc_centre;
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, RadialCalibration};
 use std::collections::VecDeque;
 
@@ -120,6 +122,10 @@ fn check_values(fs: &FreeSpaceConfig, p: &mut Problems) {
 pub struct FreeSpaceStage {
     camera: String,
     detector: FreeSpaceDetector,
+    /// The camera's calibration, its principal point the nominal one.
+    cal: RadialCalibration,
+    /// Whether the image's centre was checked (on the first frame).
+    centred: bool,
     /// The last free space and the odometry pose when its frame was taken.
     last: Option<(FreeSpace, Isometry2<f64>, f64)>,
     /// `(t_s, odometry pose)` at the start of recent cycles.
@@ -152,11 +158,40 @@ impl FreeSpaceStage {
         Ok(Self {
             camera: camera.to_string(),
             detector: FreeSpaceDetector::new(config, cal)?,
+            cal: cal.clone(),
+            centred: false,
             last: None,
             history: VecDeque::new(),
         })
     }
+
+    /// Lays the template about the robot's own image when the first frame shows it more than
+    /// `recentre_px` off the calibration's principal point (a mirror off its place).
+    fn recentre(&mut self, img: &RgbaImage) -> Result<(), RobotError> {
+        self.centred = true;
+        let limit = self.detector.config().recentre_px;
+        let inner = self.detector.template().edges_px().first().copied();
+        let (Some(inner), true) = (inner, limit > 0.0) else {
+            return Ok(());
+        };
+        let pp = self.cal.principal_point_px;
+        let min_pixels = (0.25 * std::f64::consts::PI * inner * inner) as usize;
+        let Some(c) = dark_disc_centre(img, pp, inner, DARK_LEVEL, min_pixels) else {
+            return Ok(());
+        };
+        let moved = (c[0] - pp[0]).hypot(c[1] - pp[1]);
+        if moved > limit {
+            let mut cal = self.cal.clone();
+            cal.principal_point_px = c;
+            self.detector = FreeSpaceDetector::new(self.detector.config().clone(), &cal)?;
+        }
+        Ok(())
+    }
 }
+
+/// The brightest channel of the robot's own dark image (its top and the camera seen in the
+/// mirror).
+const DARK_LEVEL: u8 = 64;
 
 impl Stage for FreeSpaceStage {
     fn name(&self) -> &'static str {
@@ -190,6 +225,9 @@ impl Stage for FreeSpaceStage {
             .is_some_and(|(t, _)| *t < obs.t_s - 2.0 * MAX_AGE_S)
         {
             self.history.pop_front();
+        }
+        if let Some(frame) = obs.frame(&self.camera).filter(|_| !self.centred) {
+            self.recentre(frame.image)?;
         }
         match obs.frames.iter().find(|f| f.sensor == self.camera) {
             Some(frame) if (obs.t_s - frame.t_s).abs() < 1e-9 => {
