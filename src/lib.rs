@@ -11,7 +11,8 @@
 //!   [`run_scenario`], [`Runner`] and [`load_scenario`];
 //! - [`sweep`]: many runs over a grid of values and seeds;
 //! - [`robustness`]: every estimator against each knob of realism, as one sweep;
-//! - [`replays`]: the registry of `omniloop replay`.
+//! - [`replays`]: the registry of `omniloop replay`;
+//! - [`viewing`]: a run on Foxglove's channels, into an MCAP file.
 //!
 //! The robot's software is anything that implements [`robot::RobotSoftware`]; the world lives
 //! in `omniloop-sim`, image processing in [`vision`], motion and avoidance in [`control`].
@@ -23,6 +24,7 @@ pub mod robustness;
 pub mod run;
 pub mod scenario;
 pub mod sweep;
+pub mod viewing;
 
 pub use experiments::{Runner, Session, load_scenario, parse_scenario, run_scenario};
 pub use run::{RunOptions, RunOutput, Simulation, Summary, TrajectoryRow, Truth};

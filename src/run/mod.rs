@@ -6,6 +6,7 @@
 pub mod cameras;
 pub mod column_calibration;
 pub mod error;
+pub mod observer;
 pub mod odometry;
 pub mod pilot;
 pub mod record;

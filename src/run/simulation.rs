@@ -5,6 +5,7 @@
 use super::cameras::{Cameras, sensor_noise_seed};
 use super::column_calibration::calibrate_columns;
 use super::error::RunError;
+use super::observer::{CycleView, ObserverHandle};
 use super::odometry::WheelOdometry;
 use super::pilot::Pilot;
 use super::record::{Summary, TrajectoryRow};
@@ -37,6 +38,8 @@ pub struct RunOptions {
     /// The experimenter takes frames of vision's camera (the camera is rendered and calibrated
     /// whatever the robot's software reads); the scenario's experiment sets it.
     pub takes_frames: bool,
+    /// Sees every cycle after it is recorded (a log, a live view); it cannot change the run.
+    pub observer: Option<ObserverHandle>,
 }
 
 /// Everything a run produced.
@@ -177,6 +180,9 @@ impl Simulation {
             options.shared_gpu.as_ref(),
             notice,
         )?;
+        if let Some(o) = &options.observer {
+            o.with(|o| o.start(&world));
+        }
         Ok(Self {
             scenario: scenario.clone(),
             world,
@@ -357,6 +363,7 @@ impl Simulation {
         }
         self.drive_others();
         self.record(t, command, out.estimates);
+        self.observe();
 
         let dt = self.scenario.run.control_period_s;
         self.advance_applying_commands(t + dt);
@@ -427,6 +434,26 @@ impl Simulation {
         }
         self.trajectory.push(row);
         self.estimates.push(estimates);
+    }
+
+    /// Shows the cycle just recorded to the observer, if any.
+    fn observe(&self) {
+        let (Some(o), Some(row), Some(estimates)) = (
+            &self.options.observer,
+            self.trajectory.last(),
+            self.estimates.last(),
+        ) else {
+            return;
+        };
+        let frames = self.frames();
+        o.with(|o| {
+            o.cycle(&CycleView {
+                cycle: self.cycle,
+                row,
+                estimates,
+                frames: &frames,
+            });
+        });
     }
 
     /// Closes the trajectory with the final state (driving runs).

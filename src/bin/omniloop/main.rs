@@ -12,6 +12,7 @@ use omniloop::run::{RunOptions, render_snapshot};
 use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
 use omniloop::sweep::Seeds;
+use omniloop::viewing::McapLog;
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice, SensorSpec};
 use std::io::IsTerminal;
@@ -56,6 +57,10 @@ enum Command {
         #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "1",
               value_parser = clap::value_parser!(u64).range(1..))]
         save_frames: Option<u64>,
+        /// Record the run as MCAP (camera frames, true and estimated poses, the world, free
+        /// space, commands, estimates) for Foxglove: into FILE, or OUT/run.mcap.
+        #[arg(long, value_name = "FILE", num_args = 0..=1)]
+        mcap: Option<Option<PathBuf>>,
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
@@ -291,6 +296,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             seed,
             renderer,
             save_frames,
+            mcap,
             quiet,
             print_default,
         } => {
@@ -306,10 +312,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 s.seed = seed;
             }
             let dir = out.unwrap_or_else(|| default_out_dir(&s));
+            let log = match mcap {
+                Some(f) => Some(McapLog::create(&f.unwrap_or_else(|| dir.join("run.mcap")))?),
+                None => None,
+            };
             let options = RunOptions {
                 renderer,
                 save_frames_every: save_frames,
                 frames_dir: save_frames.map(|_| dir.join("frames")),
+                observer: log.as_ref().map(McapLog::observer),
                 ..RunOptions::default()
             };
             let bar = progress_bar(s.max_cycles(), quiet);
@@ -323,6 +334,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             .with_context(|| format!("running {}", path.display()))?;
             bar.finish_and_clear();
             write_run(&dir, &s, &output)?;
+            if let Some(log) = log {
+                let file = log.finish(&output.summary)?;
+                eprintln!("recorded {}", file.display());
+            }
             let m = &output.summary;
             let experiment = setup_of(&s).ok().flatten();
             if let Some(table) = experiment.and_then(|e| e.table(m)) {

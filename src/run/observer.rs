@@ -1,0 +1,55 @@
+//! Watching a run as it goes: a [`CycleObserver`] registered in the run's options sees every
+//! control cycle (the frames the robot got, the truth, what the robot believed and commanded)
+//! after the cycle is recorded. It cannot change the run: a run with an observer is the run
+//! without one, bit for bit. `omniloop run --mcap` and `--live` are observers.
+
+use super::record::TrajectoryRow;
+use omniloop_robot::{Estimates, Frame};
+use omniloop_sim::World;
+use std::sync::{Arc, Mutex};
+
+/// One control cycle as an observer sees it.
+pub struct CycleView<'a> {
+    /// The cycle's number, from 0.
+    pub cycle: u64,
+    /// Its row of `trajectory.csv`: time, true pose and velocity, command, estimated pose.
+    pub row: &'a TrajectoryRow,
+    /// What the robot's software believed (its line of `estimates.jsonl`).
+    pub estimates: &'a Estimates,
+    /// The frames it got this cycle, stamped with when they were taken.
+    pub frames: &'a [Frame<'a>],
+}
+
+/// Something that watches a run: a log, a live view.
+pub trait CycleObserver: Send {
+    /// The world before the first cycle (its static scene).
+    fn start(&mut self, world: &World) {
+        let _ = world;
+    }
+
+    /// One cycle, after it was recorded.
+    fn cycle(&mut self, view: &CycleView<'_>);
+}
+
+/// An observer shared between the run and whoever set it up (to read it back after the run).
+#[derive(Clone)]
+pub struct ObserverHandle(pub Arc<Mutex<dyn CycleObserver>>);
+
+impl ObserverHandle {
+    /// Shares `observer` with a run.
+    pub fn new(observer: impl CycleObserver + 'static) -> Self {
+        Self(Arc::new(Mutex::new(observer)))
+    }
+
+    /// Runs `f` on the observer (a poisoned lock still gives it: an observer only records).
+    pub fn with<R>(&self, f: impl FnOnce(&mut dyn CycleObserver) -> R) -> R {
+        let mut guard = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        f(&mut *guard)
+    }
+}
+
+impl std::fmt::Debug for ObserverHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ObserverHandle")
+    }
+}

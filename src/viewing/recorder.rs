@@ -1,0 +1,256 @@
+//! Every cycle of a run on Foxglove channels, with Foxglove's well-known schemas; a sink (an
+//! MCAP file, a live WebSocket server) on the same context gets them. Message times are the
+//! simulation's, from 0 at the run's start.
+
+use super::scene::{free_space, path, pose_in, stamp, transform, world_scene};
+use crate::run::observer::CycleView;
+use foxglove::messages::{CompressedImage, FrameTransform, PoseInFrame, SceneUpdate};
+use foxglove::{Channel, ChannelBuilder, Context, PartialMetadata, RawChannel};
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_robot::Frame;
+use omniloop_sim::World;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// The channels of a run: `/camera/NAME`, `/truth/pose`, `/truth/tf`, `/estimate/pose`,
+/// `/estimate/tf`, `/estimate/error`, `/world`, `/estimate/free_space`, `/estimate/path`,
+/// `/command`, `/estimate/record`, `/summary`.
+pub struct Recorder {
+    ctx: Arc<Context>,
+    cameras: BTreeMap<String, Channel<CompressedImage>>,
+    truth_pose: Channel<PoseInFrame>,
+    truth_tf: Channel<FrameTransform>,
+    estimate_pose: Channel<PoseInFrame>,
+    estimate_tf: Channel<FrameTransform>,
+    world: Channel<SceneUpdate>,
+    free_space: Channel<SceneUpdate>,
+    path: Channel<SceneUpdate>,
+    command: Arc<RawChannel>,
+    error: Arc<RawChannel>,
+    record: Arc<RawChannel>,
+    summary: Arc<RawChannel>,
+    /// Why a message could not be made, the first time (a frame that did not encode).
+    pub problem: Option<String>,
+}
+
+/// The frames of the tree: the world, the true robot, the robot as it believes it is.
+pub const WORLD: &str = "world";
+/// The true robot's frame.
+pub const TRUTH: &str = "truth/base_link";
+/// The estimated robot's frame.
+pub const ESTIMATE: &str = "estimate/base_link";
+
+/// A channel of JSON messages on `topic`.
+fn json(ctx: &Arc<Context>, topic: &str) -> Result<Arc<RawChannel>, foxglove::FoxgloveError> {
+    ChannelBuilder::new(topic)
+        .context(ctx)
+        .message_encoding("json")
+        .build_raw()
+}
+
+impl Recorder {
+    /// The channels, on `ctx`.
+    pub fn new(ctx: &Arc<Context>) -> Result<Self, foxglove::FoxgloveError> {
+        let typed = |topic: &str| ChannelBuilder::new(topic).context(ctx);
+        Ok(Self {
+            ctx: ctx.clone(),
+            cameras: BTreeMap::new(),
+            truth_pose: typed("/truth/pose").build(),
+            truth_tf: typed("/truth/tf").build(),
+            estimate_pose: typed("/estimate/pose").build(),
+            estimate_tf: typed("/estimate/tf").build(),
+            world: typed("/world").build(),
+            free_space: typed("/estimate/free_space").build(),
+            path: typed("/estimate/path").build(),
+            command: json(ctx, "/command")?,
+            error: json(ctx, "/estimate/error")?,
+            record: json(ctx, "/estimate/record")?,
+            summary: json(ctx, "/summary")?,
+            problem: None,
+        })
+    }
+
+    /// The run's summary on `/summary`, at `t_s`, without its wall-clock figures
+    /// (`wall_time_s`, `cycles_per_s`: `summary.json` has them), so that the same scenario and
+    /// seed give the same file.
+    pub fn summary(&self, t_s: f64, summary: &crate::run::Summary) {
+        let mut json = serde_json::to_value(summary).unwrap_or_default();
+        if let Some(m) = json.as_object_mut() {
+            m.remove("wall_time_s");
+            m.remove("cycles_per_s");
+        }
+        self.summary
+            .log_with_meta(json.to_string().as_bytes(), at(t_s));
+    }
+
+    /// A camera's frame as a PNG on `/camera/NAME`.
+    fn frame(&mut self, t_s: f64, f: &OwnedFrame) {
+        let channel = self.cameras.entry(f.sensor.clone()).or_insert_with(|| {
+            ChannelBuilder::new(format!("/camera/{}", f.sensor))
+                .context(&self.ctx)
+                .build()
+        });
+        let mut png = Vec::new();
+        let encoder = image::codecs::png::PngEncoder::new_with_quality(
+            &mut png,
+            image::codecs::png::CompressionType::Fast,
+            image::codecs::png::FilterType::Sub,
+        );
+        if let Err(e) = f.image.write_with_encoder(encoder) {
+            self.problem
+                .get_or_insert(format!("camera {}: {e}", f.sensor));
+            return;
+        }
+        channel.log_with_meta(
+            &CompressedImage {
+                timestamp: Some(stamp(f.t_s)),
+                frame_id: format!("camera/{}", f.sensor),
+                data: png.into(),
+                format: "png".into(),
+            },
+            at(t_s),
+        );
+    }
+
+    /// The world's static scene on `/world`.
+    pub fn world(&self, scene: &SceneUpdate) {
+        self.world.log_with_meta(scene, at(0.0));
+    }
+
+    /// One cycle on every channel.
+    pub fn cycle(&mut self, c: &Cycle) {
+        let r = &c.row;
+        let t = r.t_s;
+        for f in &c.frames {
+            self.frame(t, f);
+        }
+        let truth = Isometry2::new(Vector2::new(r.x_mm, r.y_mm), r.theta_rad);
+        self.truth_pose
+            .log_with_meta(&pose_in(t, WORLD, &truth), at(t));
+        self.truth_tf
+            .log_with_meta(&transform(t, WORLD, TRUTH, &truth), at(t));
+        if let Some(est) = &c.estimate {
+            self.estimate_pose
+                .log_with_meta(&pose_in(t, WORLD, est), at(t));
+            self.estimate_tf
+                .log_with_meta(&transform(t, WORLD, ESTIMATE, est), at(t));
+            let off = est.inverse() * truth;
+            let error = serde_json::json!({
+                "t_s": t,
+                "position_mm": (est.translation.vector - truth.translation.vector).norm(),
+                "heading_deg": off.rotation.angle().to_degrees(),
+            });
+            self.error
+                .log_with_meta(error.to_string().as_bytes(), at(t));
+        }
+        if let Some(fs) = &c.freespace {
+            self.free_space
+                .log_with_meta(&free_space(t, TRUTH, fs), at(t));
+        }
+        if let Some(p) = &c.path {
+            self.path.log_with_meta(&path(t, p), at(t));
+        }
+        let command = serde_json::json!({
+            "t_s": t,
+            "vx_mm_s": r.cmd_vx_mm_s,
+            "vy_mm_s": r.cmd_vy_mm_s,
+        });
+        self.command
+            .log_with_meta(command.to_string().as_bytes(), at(t));
+        self.record.log_with_meta(c.record.as_bytes(), at(t));
+    }
+}
+
+/// A camera frame the recorder owns.
+pub struct OwnedFrame {
+    /// The camera.
+    pub sensor: String,
+    /// When it was taken, s.
+    pub t_s: f64,
+    /// The image.
+    pub image: image::RgbaImage,
+}
+
+/// One cycle as the recorder keeps it (the loop goes on while it is written).
+pub struct Cycle {
+    /// Its row of `trajectory.csv`.
+    pub row: crate::run::TrajectoryRow,
+    /// The frames the software got.
+    pub frames: Vec<OwnedFrame>,
+    /// The pose the robot believed.
+    pub estimate: Option<Isometry2<f64>>,
+    /// The free space it saw.
+    pub freespace: Option<omniloop_vision::FreeSpace>,
+    /// Its planner's path, world mm.
+    pub path: Option<Vec<Point2<f64>>>,
+    /// Its line of `estimates.jsonl`.
+    pub record: String,
+}
+
+impl Cycle {
+    /// What the recorder keeps of a cycle.
+    pub fn of(v: &CycleView<'_>) -> Self {
+        Self {
+            row: *v.row,
+            frames: v
+                .frames
+                .iter()
+                .map(|f: &Frame<'_>| OwnedFrame {
+                    sensor: f.sensor.to_string(),
+                    t_s: f.t_s,
+                    image: f.image.clone(),
+                })
+                .collect(),
+            estimate: v.estimates.pose,
+            freespace: v.estimates.freespace.clone(),
+            path: v.estimates.navigation.as_ref().map(|n| n.path_mm.clone()),
+            record: crate::run::record::estimates_line(v.row, v.estimates),
+        }
+    }
+}
+
+/// The world's static scene: its solids and, under them, its floor.
+pub fn world_update(world: &World) -> SceneUpdate {
+    let solids = world.solids();
+    let floor = bounds(solids).map(|b| (b, world.layout().floor_rgb.0));
+    world_scene(solids, floor)
+}
+
+/// Message metadata: logged at simulation time `t_s`.
+fn at(t_s: f64) -> PartialMetadata {
+    PartialMetadata::with_log_time(stamp(t_s).total_nanos())
+}
+
+/// The bounding box `[x0, y0, x1, y1]` (mm) of the solids' footprints, with a margin.
+fn bounds(solids: &[omniloop_sim::Solid]) -> Option<[f64; 4]> {
+    let mut pts: Vec<Point2<f64>> = Vec::new();
+    for s in solids {
+        match &s.shape {
+            omniloop_sim::SolidShape::Box {
+                center_mm,
+                half_extents_mm,
+                ..
+            } => {
+                let r = half_extents_mm.norm();
+                pts.extend([
+                    center_mm - Vector2::new(r, r),
+                    center_mm + Vector2::new(r, r),
+                ]);
+            }
+            omniloop_sim::SolidShape::Cylinder {
+                center_mm,
+                radius_mm,
+            } => pts.extend([
+                center_mm - Vector2::new(*radius_mm, *radius_mm),
+                center_mm + Vector2::new(*radius_mm, *radius_mm),
+            ]),
+            omniloop_sim::SolidShape::Quad { corners_mm } => pts.extend(corners_mm.iter()),
+        }
+    }
+    let first = pts.first()?;
+    let init = [first.x, first.y, first.x, first.y];
+    let b = pts.iter().fold(init, |b, p| {
+        [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)]
+    });
+    Some([b[0] - 200.0, b[1] - 200.0, b[2] + 200.0, b[3] + 200.0])
+}

@@ -1,0 +1,108 @@
+//! `omniloop run --mcap`: E1 recorded as MCAP, read back with the `mcap` crate and Foxglove's
+//! own decoders: every channel, a camera message a cycle, the true pose of cycle k equal to
+//! `trajectory.csv`'s row k, the first frame equal to the `--save-frames` PNG of cycle 0, and
+//! the same file from the same scenario and seed.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
+
+mod common;
+
+use common::{omniloop, scenario_path, tmp};
+use foxglove::Decode;
+use foxglove::messages::{CompressedImage, PoseInFrame};
+use std::collections::BTreeMap;
+
+/// Runs E1 into `dir` with `--mcap` and `--save-frames`; the MCAP file's bytes.
+fn record(dir: &std::path::Path) -> Vec<u8> {
+    let (file, out) = (
+        scenario_path("corner55_velocity_aware.toml"),
+        dir.display().to_string(),
+    );
+    let file = file.display().to_string();
+    omniloop([
+        "run",
+        file.as_str(),
+        "--renderer",
+        "cpu",
+        "--out",
+        out.as_str(),
+        "--mcap",
+        "--save-frames",
+        "-q",
+    ]);
+    std::fs::read(dir.join("run.mcap")).unwrap()
+}
+
+#[test]
+fn e1_recorded_as_mcap_reads_back_as_the_run() {
+    let dir = tmp("mcap_e1");
+    let bytes = record(&dir);
+    let mut by_topic: BTreeMap<String, Vec<(u64, Vec<u8>)>> = BTreeMap::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        by_topic
+            .entry(m.channel.topic.clone())
+            .or_default()
+            .push((m.log_time, m.data.into_owned()));
+    }
+    let counts: BTreeMap<&String, usize> = by_topic.iter().map(|(t, v)| (t, v.len())).collect();
+    eprintln!("{counts:?}");
+    let trajectory = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = trajectory
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let cycles = summary["cycles"].as_u64().unwrap() as usize;
+    for topic in [
+        "/camera/omni",
+        "/truth/pose",
+        "/truth/tf",
+        "/estimate/pose",
+        "/estimate/tf",
+        "/estimate/error",
+        "/estimate/free_space",
+        "/command",
+        "/estimate/record",
+    ] {
+        assert_eq!(
+            counts.get(&topic.to_string()),
+            Some(&cycles),
+            "{topic}: {counts:?}"
+        );
+    }
+    assert_eq!(counts.get(&"/world".to_string()), Some(&1));
+    assert_eq!(counts.get(&"/summary".to_string()), Some(&1));
+    // The true pose of every cycle is trajectory.csv's row, in metres; times are simulation times.
+    for (k, (t_ns, data)) in by_topic["/truth/pose"].iter().enumerate() {
+        let p = PoseInFrame::decode(&data[..]).unwrap();
+        let pos = p.pose.unwrap().position.unwrap();
+        let row = &rows[k];
+        assert!(
+            (*t_ns as f64 * 1e-9 - row[0]).abs() < 1e-6,
+            "cycle {k}: {t_ns} ns"
+        );
+        assert!((pos.x * 1e3 - row[1]).abs() < 1e-6 && (pos.y * 1e3 - row[2]).abs() < 1e-6);
+    }
+    // The first frame is the PNG --save-frames wrote for cycle 0, pixel for pixel.
+    let first = CompressedImage::decode(&by_topic["/camera/omni"][0].1[..]).unwrap();
+    assert_eq!(first.format, "png");
+    let from_mcap = image::load_from_memory(&first.data).unwrap().to_rgba8();
+    let saved = image::open(dir.join("frames").join("omni_000000.png"))
+        .unwrap()
+        .to_rgba8();
+    assert!(
+        from_mcap == saved,
+        "the first frame differs from omni_000000.png"
+    );
+    // The same scenario and seed give the same file.
+    assert!(
+        record(&tmp("mcap_e1_again")) == bytes,
+        "a second recording differs"
+    );
+}
