@@ -28,7 +28,7 @@ fn main() {
         );
         let log = McapLog::create(&file).unwrap();
         let options = RunOptions {
-            observer: Some(log.observer()),
+            observers: vec![log.observer()],
             ..options
         };
         let out = run_scenario(&s, &options, |_| {}, |_, _| {}).unwrap();

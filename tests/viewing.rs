@@ -106,3 +106,42 @@ fn e1_recorded_as_mcap_reads_back_as_the_run() {
         "a second recording differs"
     );
 }
+
+/// `omniloop run --gif`: E1 as an animation of every fifth cycle (42 frames for 207 cycles),
+/// each the camera beside the top view, shown 200 ms (five 40 ms periods), a few MB.
+#[test]
+fn e1_as_an_animated_gif() {
+    use image::AnimationDecoder;
+    let dir = tmp("gif_e1");
+    let (file, out) = (
+        scenario_path("corner55_velocity_aware.toml"),
+        dir.display().to_string(),
+    );
+    let file = file.display().to_string();
+    omniloop([
+        "run",
+        file.as_str(),
+        "--renderer",
+        "cpu",
+        "--out",
+        out.as_str(),
+        "--gif",
+        "-q",
+    ]);
+    let gif = dir.join("run.gif");
+    let size = std::fs::metadata(&gif).unwrap().len();
+    let reader = std::io::BufReader::new(std::fs::File::open(&gif).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(reader)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    eprintln!("{} frames, {:.1} MB", frames.len(), size as f64 / 1e6);
+    assert_eq!(frames.len(), 207usize.div_ceil(5));
+    assert!(size < 5_000_000, "{size} bytes");
+    let (num, den) = frames[0].delay().numer_denom_ms();
+    assert_eq!(num / den, 200);
+    // The camera (256 x 220) on the left, the top view beside it.
+    let first = frames[0].buffer();
+    assert!(first.width() > 256 + 300 && first.height() >= 220);
+}

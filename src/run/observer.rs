@@ -1,7 +1,7 @@
-//! Watching a run as it goes: a [`CycleObserver`] registered in the run's options sees every
+//! Watching a run as it goes: each [`CycleObserver`] registered in the run's options sees every
 //! control cycle (the frames the robot got, the truth, what the robot believed and commanded)
 //! after the cycle is recorded. It cannot change the run: a run with an observer is the run
-//! without one, bit for bit. `omniloop run --mcap` and `--live` are observers.
+//! without one, bit for bit. `omniloop run --mcap` and `--gif` are observers.
 
 use super::record::TrajectoryRow;
 use omniloop_robot::{Estimates, Frame};

@@ -38,8 +38,8 @@ pub struct RunOptions {
     /// The experimenter takes frames of vision's camera (the camera is rendered and calibrated
     /// whatever the robot's software reads); the scenario's experiment sets it.
     pub takes_frames: bool,
-    /// Sees every cycle after it is recorded (a log, a live view); it cannot change the run.
-    pub observer: Option<ObserverHandle>,
+    /// See every cycle after it is recorded (a log, an animation); they cannot change the run.
+    pub observers: Vec<ObserverHandle>,
 }
 
 /// Everything a run produced.
@@ -180,7 +180,7 @@ impl Simulation {
             options.shared_gpu.as_ref(),
             notice,
         )?;
-        if let Some(o) = &options.observer {
+        for o in &options.observers {
             o.with(|o| o.start(&world));
         }
         Ok(Self {
@@ -436,24 +436,24 @@ impl Simulation {
         self.estimates.push(estimates);
     }
 
-    /// Shows the cycle just recorded to the observer, if any.
+    /// Shows the cycle just recorded to the observers.
     fn observe(&self) {
-        let (Some(o), Some(row), Some(estimates)) = (
-            &self.options.observer,
-            self.trajectory.last(),
-            self.estimates.last(),
-        ) else {
+        let (Some(row), Some(estimates)) = (self.trajectory.last(), self.estimates.last()) else {
             return;
         };
+        if self.options.observers.is_empty() {
+            return;
+        }
         let frames = self.frames();
-        o.with(|o| {
-            o.cycle(&CycleView {
-                cycle: self.cycle,
-                row,
-                estimates,
-                frames: &frames,
-            });
-        });
+        let view = CycleView {
+            cycle: self.cycle,
+            row,
+            estimates,
+            frames: &frames,
+        };
+        for o in &self.options.observers {
+            o.with(|o| o.cycle(&view));
+        }
     }
 
     /// Closes the trajectory with the final state (driving runs).

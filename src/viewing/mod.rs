@@ -1,14 +1,17 @@
 //! Watching a run in the tools robotics people use: every cycle on Foxglove channels with
 //! Foxglove's well-known schemas ([`Recorder`]), written to an MCAP file ([`McapLog`], `omniloop
-//! run --mcap`), which Foxglove, Rerun and ROS 2's tools open. See `docs/viewing.md`.
+//! run --mcap`), which Foxglove, Rerun and ROS 2's tools open; an animated GIF of the run
+//! ([`GifLog`], `omniloop run --gif`). See `docs/viewing.md`.
 //!
 //! The loop hands each cycle over (its frames copied) and goes on; one thread of the log's own
 //! encodes the frames and writes every message, in the order the cycles came, so the file is
 //! the same from run to run. A few cycles may wait to be written; more, and the loop waits.
 
+pub mod gif;
 pub mod recorder;
 pub mod scene;
 
+pub use gif::GifLog;
 pub use recorder::{Cycle, Recorder};
 
 use crate::run::Summary;

@@ -176,13 +176,24 @@ pub fn free_space(t_s: f64, frame: &str, fs: &FreeSpace) -> SceneUpdate {
     if let Some(first) = points.first().cloned() {
         points.push(first);
     }
+    polyline(t_s, frame, "free_space", points, [230, 120, 20])
+}
+
+/// The planned path (world mm) as a line in frame `world`.
+pub fn path(t_s: f64, path_mm: &[nalgebra::Point2<f64>]) -> SceneUpdate {
+    let points = path_mm.iter().map(|p| point(p.x, p.y, 12.0)).collect();
+    polyline(t_s, "world", "path", points, [40, 90, 220])
+}
+
+/// One entity `id` in `frame`: a line through `points` (metres), 1 cm thick.
+fn polyline(t_s: f64, frame: &str, id: &str, points: Vec<Point3>, rgb: [u8; 3]) -> SceneUpdate {
     let line = LinePrimitive {
         r#type: 0,
         pose: Some(pose(&Isometry2::identity(), 0.0)),
         thickness: 0.01,
         scale_invariant: false,
         points,
-        color: Some(color([230, 120, 20])),
+        color: Some(color(rgb)),
         ..LinePrimitive::default()
     };
     SceneUpdate {
@@ -190,29 +201,7 @@ pub fn free_space(t_s: f64, frame: &str, fs: &FreeSpace) -> SceneUpdate {
         entities: vec![SceneEntity {
             timestamp: Some(stamp(t_s)),
             frame_id: frame.into(),
-            id: "free_space".into(),
-            lines: vec![line],
-            ..SceneEntity::default()
-        }],
-    }
-}
-
-/// The planned path (world mm) as a line in frame `world`.
-pub fn path(t_s: f64, path_mm: &[nalgebra::Point2<f64>]) -> SceneUpdate {
-    let line = LinePrimitive {
-        r#type: 0,
-        pose: Some(pose(&Isometry2::identity(), 0.0)),
-        thickness: 0.01,
-        points: path_mm.iter().map(|p| point(p.x, p.y, 12.0)).collect(),
-        color: Some(color([40, 90, 220])),
-        ..LinePrimitive::default()
-    };
-    SceneUpdate {
-        deletions: Vec::new(),
-        entities: vec![SceneEntity {
-            timestamp: Some(stamp(t_s)),
-            frame_id: "world".into(),
-            id: "path".into(),
+            id: id.into(),
             lines: vec![line],
             ..SceneEntity::default()
         }],

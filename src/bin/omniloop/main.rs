@@ -12,7 +12,7 @@ use omniloop::run::{RunOptions, render_snapshot};
 use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
 use omniloop::sweep::Seeds;
-use omniloop::viewing::McapLog;
+use omniloop::viewing::{GifLog, McapLog};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice, SensorSpec};
 use std::io::IsTerminal;
@@ -61,6 +61,14 @@ enum Command {
         /// space, commands, estimates) for Foxglove: into FILE, or OUT/run.mcap.
         #[arg(long, value_name = "FILE", num_args = 0..=1)]
         mcap: Option<Option<PathBuf>>,
+        /// Write an animated GIF of the run (each camera beside the top view with the paths so
+        /// far): into FILE, or OUT/run.gif.
+        #[arg(long, value_name = "FILE", num_args = 0..=1)]
+        gif: Option<Option<PathBuf>>,
+        /// The GIF shows every K-th cycle.
+        #[arg(long, value_name = "K", default_value_t = 5,
+              value_parser = clap::value_parser!(u64).range(1..))]
+        gif_every: u64,
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
@@ -297,6 +305,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             renderer,
             save_frames,
             mcap,
+            gif,
+            gif_every,
             quiet,
             print_default,
         } => {
@@ -316,11 +326,22 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 Some(f) => Some(McapLog::create(&f.unwrap_or_else(|| dir.join("run.mcap")))?),
                 None => None,
             };
+            let gif = gif.map(|f| {
+                (
+                    f.unwrap_or_else(|| dir.join("run.gif")),
+                    GifLog::new(gif_every),
+                )
+            });
+            let observers = log
+                .iter()
+                .map(McapLog::observer)
+                .chain(gif.iter().map(|(_, g)| g.observer()))
+                .collect();
             let options = RunOptions {
                 renderer,
                 save_frames_every: save_frames,
                 frames_dir: save_frames.map(|_| dir.join("frames")),
-                observer: log.as_ref().map(McapLog::observer),
+                observers,
                 ..RunOptions::default()
             };
             let bar = progress_bar(s.max_cycles(), quiet);
@@ -337,6 +358,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             if let Some(log) = log {
                 let file = log.finish(&output.summary)?;
                 eprintln!("recorded {}", file.display());
+            }
+            if let Some((file, g)) = gif {
+                let n = g.write(&file, &s, &output)?;
+                eprintln!("animated {} ({n} frames)", file.display());
             }
             let m = &output.summary;
             let experiment = setup_of(&s).ok().flatten();
