@@ -11,24 +11,29 @@ use foxglove::Decode;
 use foxglove::messages::{CompressedImage, PoseInFrame};
 use std::collections::BTreeMap;
 
-/// Runs E1 into `dir` with `--mcap` and `--save-frames`; the MCAP file's bytes.
-fn record(dir: &std::path::Path) -> Vec<u8> {
+/// Runs E1 on the CPU into `dir` with the options `extra`.
+fn run_e1(dir: &std::path::Path, extra: &[&str]) {
     let (file, out) = (
         scenario_path("corner55_velocity_aware.toml"),
         dir.display().to_string(),
     );
     let file = file.display().to_string();
-    omniloop([
+    let mut args = vec![
         "run",
         file.as_str(),
         "--renderer",
         "cpu",
         "--out",
         out.as_str(),
-        "--mcap",
-        "--save-frames",
         "-q",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    omniloop(args);
+}
+
+/// Runs E1 into `dir` with `--mcap` and `--save-frames`; the MCAP file's bytes.
+fn record(dir: &std::path::Path) -> Vec<u8> {
+    run_e1(dir, &["--mcap", "--save-frames"]);
     std::fs::read(dir.join("run.mcap")).unwrap()
 }
 
@@ -113,21 +118,7 @@ fn e1_recorded_as_mcap_reads_back_as_the_run() {
 fn e1_as_an_animated_gif() {
     use image::AnimationDecoder;
     let dir = tmp("gif_e1");
-    let (file, out) = (
-        scenario_path("corner55_velocity_aware.toml"),
-        dir.display().to_string(),
-    );
-    let file = file.display().to_string();
-    omniloop([
-        "run",
-        file.as_str(),
-        "--renderer",
-        "cpu",
-        "--out",
-        out.as_str(),
-        "--gif",
-        "-q",
-    ]);
+    run_e1(&dir, &["--gif"]);
     let gif = dir.join("run.gif");
     let size = std::fs::metadata(&gif).unwrap().len();
     let reader = std::io::BufReader::new(std::fs::File::open(&gif).unwrap());

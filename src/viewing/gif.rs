@@ -64,21 +64,30 @@ impl GifLog {
         let name = file.display().to_string();
         let mut frames = Vec::with_capacity(kept.frames.len());
         for (cycle, images) in &kept.frames {
-            let mut partial = out.clone();
-            let n = (cycle + 1).min(partial.trajectory.len());
-            partial.trajectory.truncate(n);
-            partial.estimates.truncate(n);
-            partial.other_paths.iter_mut().for_each(|p| p.truncate(n));
-            let top = run_topview_image(&name, s, &partial, TOP_VIEW_PX)?;
+            let top = run_topview_image(&name, s, &up_to(out, cycle + 1), TOP_VIEW_PX)?;
             frames.push(Frame::from_parts(side_by_side(images, &top), 0, 0, delay));
         }
         let f = std::fs::File::create(file).with_context(|| format!("writing {name}"))?;
+        let count = frames.len();
         let mut encoder = GifEncoder::new_with_speed(std::io::BufWriter::new(f), 20);
         encoder
             .set_repeat(Repeat::Infinite)
-            .and_then(|()| encoder.encode_frames(frames.clone()))
+            .and_then(|()| encoder.encode_frames(frames))
             .with_context(|| format!("writing {name}"))?;
-        Ok(frames.len())
+        Ok(count)
+    }
+}
+
+/// What the top view draws of the run's first `n` cycles: its paths so far (no records).
+fn up_to(out: &RunOutput, n: usize) -> RunOutput {
+    let head = |v: &[nalgebra::Point2<f64>]| v[..n.min(v.len())].to_vec();
+    RunOutput {
+        summary: out.summary.clone(),
+        trajectory: out.trajectory[..n.min(out.trajectory.len())].to_vec(),
+        estimates: Vec::new(),
+        other_paths: out.other_paths.iter().map(|p| head(p)).collect(),
+        files: Vec::new(),
+        map: out.map.clone(),
     }
 }
 
