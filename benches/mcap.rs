@@ -7,7 +7,7 @@
 
 mod common;
 
-use omniloop::viewing::McapLog;
+use omniloop::viewing::{FoxgloveLog, Sinks};
 use omniloop::{RunOptions, load_scenario, run_scenario};
 use omniloop_sim::RendererChoice;
 
@@ -26,7 +26,11 @@ fn main() {
                 .summary
                 .cycles_per_s,
         );
-        let log = McapLog::create(&file).unwrap();
+        let sinks = Sinks {
+            mcap: Some(file.clone()),
+            live: None,
+        };
+        let log = FoxgloveLog::create(&sinks, &["omni".to_string()]).unwrap();
         let options = RunOptions {
             observers: vec![log.observer()],
             ..options

@@ -136,3 +136,133 @@ fn e1_as_an_animated_gif() {
     let first = frames[0].buffer();
     assert!(first.width() > 256 + 300 && first.height() >= 220);
 }
+
+/// A Foxglove WebSocket client's view of a served run: the true poses (x, y in m) it got on
+/// `/truth/pose`, and whether `/summary` came last.
+struct Watched {
+    poses: Vec<(f64, f64)>,
+    summary: bool,
+}
+
+/// Connects to `port` as the Foxglove app does (subprotocol `foxglove.sdk.v1`, the
+/// `foxglove.websocket.v1` protocol's name in the Foxglove SDK), subscribes to `/truth/pose` (subscription 1)
+/// and `/summary` (2), and reads until the summary comes or the server closes.
+fn watch(port: u16) -> Watched {
+    use tungstenite::Message;
+    use tungstenite::client::IntoClientRequest;
+    let mut request = format!("ws://127.0.0.1:{port}")
+        .into_client_request()
+        .unwrap();
+    request
+        .headers_mut()
+        .insert("Sec-WebSocket-Protocol", "foxglove.sdk.v1".parse().unwrap());
+    let (mut ws, _) = tungstenite::connect(request).unwrap();
+    let mut ids: BTreeMap<String, u64> = BTreeMap::new();
+    while !(ids.contains_key("/truth/pose") && ids.contains_key("/summary")) {
+        if let Message::Text(text) = ws.read().unwrap() {
+            let m: serde_json::Value = serde_json::from_str(&text).unwrap();
+            if m["op"] == "advertise" {
+                for c in m["channels"].as_array().unwrap() {
+                    ids.insert(
+                        c["topic"].as_str().unwrap().into(),
+                        c["id"].as_u64().unwrap(),
+                    );
+                }
+            }
+        }
+    }
+    let subscribe = serde_json::json!({"op": "subscribe", "subscriptions": [
+        {"id": 1, "channelId": ids["/truth/pose"]},
+        {"id": 2, "channelId": ids["/summary"]},
+    ]});
+    ws.send(Message::text(subscribe.to_string())).unwrap();
+    let mut watched = Watched {
+        poses: Vec::new(),
+        summary: false,
+    };
+    while let Ok(m) = ws.read() {
+        let Message::Binary(b) = m else { continue };
+        // Message data: opcode 1, subscription id (u32), log time (u64), payload; little-endian.
+        assert_eq!(b[0], 1, "opcode");
+        let sub = u32::from_le_bytes(b[1..5].try_into().unwrap());
+        if sub == 2 {
+            watched.summary = true;
+            break;
+        }
+        let p = PoseInFrame::decode(&b[13..]).unwrap();
+        let pos = p.pose.unwrap().position.unwrap();
+        watched.poses.push((pos.x, pos.y));
+    }
+    let _ = ws.close(None);
+    watched
+}
+
+/// `omniloop run --live`: E1 served on a free loopback port waits for its viewer, which gets
+/// the true pose of every cycle (trajectory.csv's rows but the final state's) and then the
+/// summary; the run's
+/// trajectory.csv is the run's without a viewer, byte for byte.
+#[test]
+fn e1_served_live_reaches_a_foxglove_client_a_pose_a_cycle() {
+    use std::io::BufRead;
+    let (live_dir, plain_dir) = (tmp("live_e1"), tmp("live_e1_plain"));
+    let mut child = common::bin()
+        .arg("run")
+        .arg(scenario_path("corner55_velocity_aware.toml"))
+        .args([
+            "--renderer",
+            "cpu",
+            "-q",
+            "--live",
+            "127.0.0.1:0",
+            "--live-wait",
+        ])
+        .arg("--out")
+        .arg(&live_dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    let port: u16 = loop {
+        line.clear();
+        assert!(stderr.read_line(&mut line).unwrap() > 0, "no live address");
+        if let Some(rest) = line.split("ws://127.0.0.1:").nth(1) {
+            break rest.split_whitespace().next().unwrap().parse().unwrap();
+        }
+    };
+    let drain = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap());
+    let watched = watch(port);
+    let status = child.wait().unwrap();
+    let messages = drain.join().unwrap();
+    assert!(status.success(), "{status}: {messages}");
+    run_e1(&plain_dir, &[]);
+    let trajectory = std::fs::read_to_string(live_dir.join("trajectory.csv")).unwrap();
+    assert!(
+        trajectory == std::fs::read_to_string(plain_dir.join("trajectory.csv")).unwrap(),
+        "trajectory.csv differs with a live viewer"
+    );
+    let rows: Vec<(f64, f64)> = trajectory
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').take(3).map(|v| v.parse().unwrap()).collect();
+            (v[1], v[2])
+        })
+        .collect();
+    // A row a cycle, then the final state.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(live_dir.join("summary.json")).unwrap())
+            .unwrap();
+    let cycles = summary["cycles"].as_u64().unwrap() as usize;
+    assert_eq!(rows.len(), cycles + 1);
+    eprintln!("{} poses received for {cycles} cycles", watched.poses.len());
+    assert!(watched.summary, "the summary did not come");
+    assert_eq!(watched.poses.len(), cycles);
+    for (k, (got, row)) in watched.poses.iter().zip(&rows).enumerate() {
+        assert!(
+            (got.0 * 1e3 - row.0).abs() < 1e-6 && (got.1 * 1e3 - row.1).abs() < 1e-6,
+            "cycle {k}: {got:?} against {row:?}"
+        );
+    }
+}

@@ -1,27 +1,33 @@
 //! Watching a run in the tools robotics people use: every cycle on Foxglove channels with
-//! Foxglove's well-known schemas ([`Recorder`]), written to an MCAP file ([`McapLog`], `omniloop
-//! run --mcap`), which Foxglove, Rerun and ROS 2's tools open; an animated GIF of the run
+//! Foxglove's well-known schemas ([`Recorder`]), written to an MCAP file (`omniloop run --mcap`),
+//! which Foxglove, Rerun and ROS 2's tools open, and served live to the Foxglove app over its
+//! WebSocket protocol ([`LiveServer`], `omniloop run --live`), both through one [`FoxgloveLog`];
+//! the run paced to real time ([`RealTime`], `--realtime`); an animated GIF of the run
 //! ([`GifLog`], `omniloop run --gif`). See `docs/viewing.md`.
 //!
 //! The loop hands each cycle over (its frames copied) and goes on; one thread of the log's own
-//! encodes the frames and writes every message, in the order the cycles came, so the file is
-//! the same from run to run. A few cycles may wait to be written; more, and the loop waits.
+//! encodes the frames and logs every message, in the order the cycles came, so the file is the
+//! same from run to run. A few cycles may wait to be logged; more, and the loop waits.
 
 pub mod gif;
+pub mod live;
+pub mod pace;
 pub mod recorder;
 pub mod scene;
 
 pub use gif::GifLog;
+pub use live::{LiveOptions, LiveServer};
+pub use pace::RealTime;
 pub use recorder::{Cycle, Recorder};
 
 use crate::run::Summary;
 use crate::run::observer::{CycleObserver, CycleView, ObserverHandle};
 use foxglove::messages::SceneUpdate;
-use foxglove::{Context, McapWriter, McapWriterHandle};
+use foxglove::{Context, McapWriteOptions, McapWriter, McapWriterHandle};
 use recorder::world_update;
 use std::fs::File;
 use std::io::BufWriter;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::mpsc::{SyncSender, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
@@ -50,7 +56,7 @@ impl CycleObserver for Feed {
     }
 }
 
-/// Why a run cannot be recorded.
+/// Why a run cannot be recorded or served.
 #[derive(Debug, thiserror::Error)]
 pub enum ViewingError {
     /// The file cannot be written.
@@ -62,48 +68,74 @@ pub enum ViewingError {
         source: std::io::Error,
     },
     /// The Foxglove SDK refused (a channel, the writer).
-    #[error("{}: {message}", file.display())]
+    #[error("{what}: {message}")]
     Foxglove {
-        /// The file.
-        file: PathBuf,
+        /// The file, or the live server's address.
+        what: String,
         /// What the SDK said.
         message: String,
     },
 }
 
-/// A run recorded into an MCAP file: its own Foxglove context, the channels (on the log's
-/// thread), the writer.
-pub struct McapLog {
-    file: PathBuf,
+/// Where a run's Foxglove channels go: an MCAP file, a live server, or both.
+#[derive(Debug, Clone, Default)]
+pub struct Sinks {
+    /// The MCAP file to write.
+    pub mcap: Option<PathBuf>,
+    /// How to serve the run live.
+    pub live: Option<LiveOptions>,
+}
+
+impl Sinks {
+    /// What the sinks are, for messages: the file and the address.
+    fn name(&self) -> String {
+        let file = self.mcap.iter().map(|f| f.display().to_string());
+        let live = self.live.iter().map(|l| format!("ws://{}", l.addr));
+        file.chain(live).collect::<Vec<_>>().join(" and ")
+    }
+}
+
+/// A run's Foxglove channels on their own context, logged from a thread of the log's own into
+/// an MCAP file and to a live server.
+pub struct FoxgloveLog {
+    what: String,
     feed: Arc<Mutex<Feed>>,
     worker: JoinHandle<Recorder>,
-    writer: McapWriterHandle<BufWriter<File>>,
+    writer: Option<(PathBuf, McapWriterHandle<BufWriter<File>>)>,
+    live: Option<LiveServer>,
     _ctx: Arc<Context>,
 }
 
-impl McapLog {
-    /// Creates (or replaces) `file` and the channels that write into it.
-    pub fn create(file: &Path) -> Result<Self, ViewingError> {
-        let fail = |e: foxglove::FoxgloveError| ViewingError::Foxglove {
-            file: file.to_path_buf(),
-            message: e.to_string(),
+impl FoxgloveLog {
+    /// Creates (or replaces) the MCAP file, starts the live server and makes the channels
+    /// (`sensors`' cameras among them, so a viewer sees them before the first frame).
+    pub fn create(sinks: &Sinks, sensors: &[String]) -> Result<Self, ViewingError> {
+        let what = sinks.name();
+        let fail = |message: String| ViewingError::Foxglove {
+            what: what.clone(),
+            message,
         };
-        let io = |source| ViewingError::Io {
-            file: file.to_path_buf(),
-            source,
-        };
-        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(io)?;
-        }
-        let out = BufWriter::new(File::create(file).map_err(io)?);
         let ctx = Context::new();
-        let writer = McapWriter::new().context(&ctx).create(out).map_err(fail)?;
-        let mut recorder = Recorder::new(&ctx).map_err(fail)?;
+        let writer = match &sinks.mcap {
+            Some(file) => Some((file.clone(), mcap_writer(&ctx, file)?)),
+            None => None,
+        };
+        let live = match &sinks.live {
+            Some(options) => Some(LiveServer::start(&ctx, options).map_err(&fail)?),
+            None => None,
+        };
+        let mut recorder = Recorder::new(&ctx, sensors).map_err(|e| fail(e.to_string()))?;
+        let keeper = live.as_ref().map(LiveServer::world_keeper);
         let (tx, rx) = sync_channel::<Job>(QUEUE);
         let worker = std::thread::spawn(move || {
             while let Ok(job) = rx.recv() {
                 match job {
-                    Job::World(scene) => recorder.world(&scene),
+                    Job::World(scene) => {
+                        recorder.world(&scene);
+                        if let Some(k) = &keeper {
+                            k.keep(recorder.world_channel(), scene);
+                        }
+                    }
                     Job::Cycle(c) => recorder.cycle(&c),
                     Job::End => break,
                 }
@@ -111,25 +143,31 @@ impl McapLog {
             recorder
         });
         Ok(Self {
-            file: file.to_path_buf(),
+            what,
             feed: Arc::new(Mutex::new(Feed(tx))),
             worker,
             writer,
+            live,
             _ctx: ctx,
         })
     }
 
-    /// What the run's options take to record every cycle.
+    /// The live server, when there is one.
+    pub fn live(&self) -> Option<&LiveServer> {
+        self.live.as_ref()
+    }
+
+    /// What the run's options take to log every cycle.
     pub fn observer(&self) -> ObserverHandle {
         let shared: Arc<Mutex<dyn CycleObserver>> = self.feed.clone();
         ObserverHandle(shared)
     }
 
-    /// Waits for every cycle to be written, writes the summary (at the run's last time) and
-    /// closes the file.
-    pub fn finish(self, summary: &Summary) -> Result<PathBuf, ViewingError> {
+    /// Waits for every cycle to be logged, logs the summary (at the run's last time), closes
+    /// the file and lets the live viewers have the rest; the MCAP file, if any.
+    pub fn finish(self, summary: &Summary) -> Result<Option<PathBuf>, ViewingError> {
         let fail = |message: String| ViewingError::Foxglove {
-            file: self.file.clone(),
+            what: self.what.clone(),
             message,
         };
         let sent = self
@@ -147,10 +185,39 @@ impl McapLog {
             return Err(fail(p.clone()));
         }
         drop(recorder);
-        self.writer.close().map_err(|e| ViewingError::Foxglove {
-            file: self.file.clone(),
-            message: e.to_string(),
-        })?;
-        Ok(self.file)
+        if let Some(live) = self.live {
+            live.finish();
+        }
+        match self.writer {
+            Some((file, w)) => {
+                w.close().map_err(|e| fail(e.to_string()))?;
+                Ok(Some(file))
+            }
+            None => Ok(None),
+        }
     }
+}
+
+/// An MCAP writer into `file` (created with its folder) on `ctx`.
+fn mcap_writer(
+    ctx: &Arc<Context>,
+    file: &std::path::Path,
+) -> Result<McapWriterHandle<BufWriter<File>>, ViewingError> {
+    let io = |source| ViewingError::Io {
+        file: file.to_path_buf(),
+        source,
+    };
+    if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(io)?;
+    }
+    let out = BufWriter::new(File::create(file).map_err(io)?);
+    // Chunks are not compressed: zstd over the noisy frames costs a tenth of the loop's time
+    // and saves little (see `docs/viewing.md`).
+    McapWriter::with_options(McapWriteOptions::new().compression(None))
+        .context(ctx)
+        .create(out)
+        .map_err(|e| ViewingError::Foxglove {
+            what: file.display().to_string(),
+            message: e.to_string(),
+        })
 }

@@ -22,7 +22,7 @@ pub struct Recorder {
     truth_tf: Channel<FrameTransform>,
     estimate_pose: Channel<PoseInFrame>,
     estimate_tf: Channel<FrameTransform>,
-    world: Channel<SceneUpdate>,
+    world: Arc<Channel<SceneUpdate>>,
     free_space: Channel<SceneUpdate>,
     path: Channel<SceneUpdate>,
     command: Arc<RawChannel>,
@@ -40,6 +40,13 @@ pub const TRUTH: &str = "truth/base_link";
 /// The estimated robot's frame.
 pub const ESTIMATE: &str = "estimate/base_link";
 
+/// The channel of `sensor`'s frames, `/camera/NAME`.
+fn camera_channel(ctx: &Arc<Context>, sensor: &str) -> Channel<CompressedImage> {
+    ChannelBuilder::new(format!("/camera/{sensor}"))
+        .context(ctx)
+        .build()
+}
+
 /// A channel of JSON messages on `topic`.
 fn json(ctx: &Arc<Context>, topic: &str) -> Result<Arc<RawChannel>, foxglove::FoxgloveError> {
     ChannelBuilder::new(topic)
@@ -49,17 +56,21 @@ fn json(ctx: &Arc<Context>, topic: &str) -> Result<Arc<RawChannel>, foxglove::Fo
 }
 
 impl Recorder {
-    /// The channels, on `ctx`.
-    pub fn new(ctx: &Arc<Context>) -> Result<Self, foxglove::FoxgloveError> {
+    /// The channels, on `ctx`, with a camera channel for each of `sensors` (another camera's
+    /// is made at its first frame).
+    pub fn new(ctx: &Arc<Context>, sensors: &[String]) -> Result<Self, foxglove::FoxgloveError> {
         let typed = |topic: &str| ChannelBuilder::new(topic).context(ctx);
         Ok(Self {
             ctx: ctx.clone(),
-            cameras: BTreeMap::new(),
+            cameras: sensors
+                .iter()
+                .map(|s| (s.clone(), camera_channel(ctx, s)))
+                .collect(),
             truth_pose: typed("/truth/pose").build(),
             truth_tf: typed("/truth/tf").build(),
             estimate_pose: typed("/estimate/pose").build(),
             estimate_tf: typed("/estimate/tf").build(),
-            world: typed("/world").build(),
+            world: Arc::new(typed("/world").build()),
             free_space: typed("/estimate/free_space").build(),
             path: typed("/estimate/path").build(),
             command: json(ctx, "/command")?,
@@ -83,20 +94,22 @@ impl Recorder {
             .log_with_meta(json.to_string().as_bytes(), at(t_s));
     }
 
-    /// A camera's frame as a PNG on `/camera/NAME`.
+    /// A camera's frame as a PNG on `/camera/NAME`: RGB, stored without deflate or filters
+    /// (the sensor noise leaves a quarter of it to compress, for most of a core; see
+    /// `docs/viewing.md`).
     fn frame(&mut self, t_s: f64, f: &OwnedFrame) {
-        let channel = self.cameras.entry(f.sensor.clone()).or_insert_with(|| {
-            ChannelBuilder::new(format!("/camera/{}", f.sensor))
-                .context(&self.ctx)
-                .build()
-        });
+        let channel = self
+            .cameras
+            .entry(f.sensor.clone())
+            .or_insert_with(|| camera_channel(&self.ctx, &f.sensor));
         let mut png = Vec::new();
         let encoder = image::codecs::png::PngEncoder::new_with_quality(
             &mut png,
-            image::codecs::png::CompressionType::Fast,
-            image::codecs::png::FilterType::Sub,
+            image::codecs::png::CompressionType::Uncompressed,
+            image::codecs::png::FilterType::NoFilter,
         );
-        if let Err(e) = f.image.write_with_encoder(encoder) {
+        let rgb: image::RgbImage = image::buffer::ConvertBuffer::convert(&f.image);
+        if let Err(e) = rgb.write_with_encoder(encoder) {
             self.problem
                 .get_or_insert(format!("camera {}: {e}", f.sensor));
             return;
@@ -115,6 +128,11 @@ impl Recorder {
     /// The world's static scene on `/world`.
     pub fn world(&self, scene: &SceneUpdate) {
         self.world.log_with_meta(scene, at(0.0));
+    }
+
+    /// The `/world` channel.
+    pub fn world_channel(&self) -> Arc<Channel<SceneUpdate>> {
+        self.world.clone()
     }
 
     /// One cycle on every channel.

@@ -8,11 +8,12 @@ use omniloop::experiments::registry::setup_of;
 use omniloop::experiments::{ReplayContext, parse_scenario, run_dyn};
 use omniloop::replays::{REPLAYS, replay};
 use omniloop::report::output::{default_out_dir, write_run};
+use omniloop::run::observer::ObserverHandle;
 use omniloop::run::{RunOptions, render_snapshot};
 use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
 use omniloop::sweep::Seeds;
-use omniloop::viewing::{GifLog, McapLog};
+use omniloop::viewing::{FoxgloveLog, GifLog, LiveOptions, RealTime, Sinks};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice, SensorSpec};
 use std::io::IsTerminal;
@@ -61,6 +62,20 @@ enum Command {
         /// space, commands, estimates) for Foxglove: into FILE, or OUT/run.mcap.
         #[arg(long, value_name = "FILE", num_args = 0..=1)]
         mcap: Option<Option<PathBuf>>,
+        /// Serve the run live to the Foxglove app (WebSocket, the same channels as --mcap) on
+        /// ADDR.
+        #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8765",
+              value_parser = live_addr)]
+        live: Option<String>,
+        /// With --live: wait before the first cycle until a viewer subscribes.
+        #[arg(long, requires = "live")]
+        live_wait: bool,
+        /// With --live: after the run, serve the viewers until they disconnect, at most S seconds.
+        #[arg(long, value_name = "S", requires = "live", default_value_t = 2.0)]
+        live_linger: f64,
+        /// Pace the run to real time (each cycle waits for its simulation time on the clock).
+        #[arg(long)]
+        realtime: bool,
         /// Write an animated GIF of the run (each camera beside the top view with the paths so
         /// far): into FILE, or OUT/run.gif.
         #[arg(long, value_name = "FILE", num_args = 0..=1)]
@@ -170,6 +185,15 @@ enum Command {
 mod sweep;
 
 /// A camera model format by its command-line name.
+/// A `--live` address, `HOST:PORT`, checked before the run.
+fn live_addr(addr: &str) -> Result<String, String> {
+    let options = LiveOptions {
+        addr: addr.to_string(),
+        ..LiveOptions::default()
+    };
+    options.host_port().map(|_| options.addr)
+}
+
 fn camera_format(name: &str) -> Result<CameraFormat, String> {
     CameraFormat::ALL
         .iter()
@@ -280,6 +304,28 @@ fn parse_pose(text: &str) -> anyhow::Result<Isometry2<f64>> {
     }
 }
 
+/// The run's Foxglove log, when it is recorded or served; a live server says where it is and,
+/// when asked, waits for a viewer.
+fn start_log(s: &Scenario, sinks: &Sinks) -> anyhow::Result<Option<FoxgloveLog>> {
+    if sinks.mcap.is_none() && sinks.live.is_none() {
+        return Ok(None);
+    }
+    let sensors: Vec<String> = s.robot.sensors.iter().map(|c| c.name.clone()).collect();
+    let log = FoxgloveLog::create(sinks, &sensors)?;
+    if let Some(live) = log.live() {
+        eprintln!(
+            "serving the run live on ws://{}:{} (Foxglove: Open connection)",
+            live.host(),
+            live.port()
+        );
+        if live.waits_for_viewer() {
+            eprintln!("waiting for a viewer to subscribe...");
+            live.wait_for_viewer();
+        }
+    }
+    Ok(Some(log))
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Check { files } => {
@@ -305,6 +351,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             renderer,
             save_frames,
             mcap,
+            live,
+            live_wait,
+            live_linger,
+            realtime,
             gif,
             gif_every,
             quiet,
@@ -322,10 +372,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 s.seed = seed;
             }
             let dir = out.unwrap_or_else(|| default_out_dir(&s));
-            let log = match mcap {
-                Some(f) => Some(McapLog::create(&f.unwrap_or_else(|| dir.join("run.mcap")))?),
-                None => None,
+            let sinks = Sinks {
+                mcap: mcap.map(|f| f.unwrap_or_else(|| dir.join("run.mcap"))),
+                live: live.map(|addr| LiveOptions {
+                    addr,
+                    wait_for_viewer: live_wait,
+                    linger_s: live_linger,
+                }),
             };
+            let log = start_log(&s, &sinks)?;
             let gif = gif.map(|f| {
                 (
                     f.unwrap_or_else(|| dir.join("run.gif")),
@@ -334,8 +389,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             });
             let observers = log
                 .iter()
-                .map(McapLog::observer)
+                .map(FoxgloveLog::observer)
                 .chain(gif.iter().map(|(_, g)| g.observer()))
+                .chain(realtime.then(|| ObserverHandle::new(RealTime::default())))
                 .collect();
             let options = RunOptions {
                 renderer,
@@ -355,8 +411,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             .with_context(|| format!("running {}", path.display()))?;
             bar.finish_and_clear();
             write_run(&dir, &s, &output)?;
-            if let Some(log) = log {
-                let file = log.finish(&output.summary)?;
+            if let Some(log) = log
+                && let Some(file) = log.finish(&output.summary)?
+            {
                 eprintln!("recorded {}", file.display());
             }
             if let Some((file, g)) = gif {
