@@ -48,6 +48,21 @@ fn table(dir: &Path) -> Vec<BTreeMap<String, String>> {
         .collect()
 }
 
+/// The small sweep's arguments after `sweep` (the scenario, the set, the seeds).
+fn small_sweep_args() -> Vec<String> {
+    [
+        scenario_path("corner55_velocity_aware.toml")
+            .to_str()
+            .unwrap(),
+        "--set",
+        "robot.max_speed_mm_s=300,400",
+        "--seeds",
+        "2",
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
 fn sweep(out: &Path, jobs: &str) {
     let out = out.display().to_string();
     omniloop([
@@ -226,4 +241,85 @@ fn gpu_batches_across_runs_give_each_run_its_own_trajectory() {
             "run {k}"
         );
     }
+}
+
+/// The plan of a sweep run job by job with `omniloop run --plan --job`, then `--collect`ed,
+/// gives the sweep's own table and each run's trajectory; a sweep resumed after losing rows
+/// runs only those again, and its table is the whole sweep's.
+#[test]
+fn a_planned_sweep_run_job_by_job_and_collected_is_the_sweep() {
+    let root = tmp("sweep_planned");
+    let (whole, planned) = (root.join("whole"), root.join("planned"));
+    sweep(&whole, "2");
+    let mut args = vec!["sweep".to_string()];
+    args.extend(small_sweep_args());
+    args.extend([
+        "--plan".into(),
+        planned.join("plan.jsonl").display().to_string(),
+    ]);
+    omniloop(&args);
+    let plan = std::fs::read_to_string(planned.join("plan.jsonl")).unwrap();
+    assert_eq!(plan.lines().count(), 1 + 4, "{plan}");
+    assert!(!planned.join("runs").exists(), "--plan ran something");
+    for job in 0..4 {
+        let plan_file = planned.join("plan.jsonl").display().to_string();
+        let n = job.to_string();
+        omniloop([
+            "run",
+            "--plan",
+            plan_file.as_str(),
+            "--job",
+            n.as_str(),
+            "--renderer",
+            "cpu",
+        ]);
+    }
+    omniloop(["sweep", "--collect", planned.to_str().unwrap()]);
+    assert_eq!(table(&planned), table(&whole), "collected rows differ");
+    for (a, b) in run_dirs(&planned).iter().zip(&run_dirs(&whole)) {
+        assert_eq!(a.file_name(), b.file_name());
+        assert!(
+            std::fs::read(a.join("trajectory.csv")).unwrap()
+                == std::fs::read(b.join("trajectory.csv")).unwrap(),
+            "{a:?}: the planned run's trajectory differs"
+        );
+    }
+    // A job the plan does not have exits 2 naming the plan.
+    let out = bin()
+        .args([
+            "run",
+            "--plan",
+            planned.join("plan.jsonl").to_str().unwrap(),
+            "--job",
+            "9",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("plan.jsonl:1: no job 9"));
+
+    // Resumed: two rows lost, two runs again, the same table.
+    let journal = whole.join("rows.jsonl");
+    let lines: Vec<String> = std::fs::read_to_string(&journal)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
+    assert_eq!(lines.len(), 4);
+    let before = table(&whole);
+    std::fs::write(&journal, format!("{}\n{}\n", lines[0], lines[3])).unwrap();
+    let mut args = vec!["sweep".to_string()];
+    args.extend(small_sweep_args());
+    args.extend(["--renderer", "cpu", "--resume", "--out"].map(String::from));
+    args.push(whole.display().to_string());
+    let md = omniloop(&args);
+    assert!(
+        md.contains("2 of 4 runs") && md.contains("2 more from the sweep resumed"),
+        "{md}"
+    );
+    assert_eq!(table(&whole), before, "the resumed sweep's rows differ");
+    assert_eq!(
+        std::fs::read_to_string(&journal).unwrap().lines().count(),
+        4
+    );
 }

@@ -3,7 +3,29 @@
 use super::plan::Plan;
 use super::plot;
 use super::report::{self, Row};
+use super::workers::Outcome;
 use std::path::Path;
+
+/// The report of `outcomes` into `dir`: `sweep.csv`, `sweep.md` (after `header` and the
+/// figure's name) and `sweep.png` of `plot` (success_rate when no run has that number, with a
+/// warning on standard error); the markdown and the rows.
+pub fn report(
+    dir: &Path,
+    plan: &Plan,
+    outcomes: &[Option<Outcome>],
+    plot: &str,
+    header: &str,
+) -> anyhow::Result<(String, Vec<Row>)> {
+    let rows = report::rows(plan, outcomes);
+    let mut metric = plot.to_string();
+    if !known_metric(&rows, &metric) {
+        eprintln!("--plot {metric}: no run has this number; plotting success_rate");
+        metric = "success_rate".into();
+    }
+    let header = format!("{header} Figure: sweep.png ({metric}).");
+    let md = write_outputs(dir, plan, &rows, &metric, &header)?;
+    Ok((md, rows))
+}
 
 /// Writes `sweep.csv`, `sweep.md` (after `header`) and `sweep.png` of `metric` into `dir`;
 /// returns the markdown.

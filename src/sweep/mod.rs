@@ -6,14 +6,18 @@
 //! in the plan's order whatever finished first.
 
 pub mod files;
+pub mod journal;
 pub mod plan;
+pub mod plan_file;
 pub mod plot;
 pub mod report;
 pub mod set;
 pub mod workers;
 
-pub use files::{known_metric, write_outputs};
+pub use files::{known_metric, report as write_report, write_outputs};
+pub use journal::{Journal, Record, collect_runs, read_journal};
 pub use plan::{Job, Plan, PlanError, Seeds, describe, plan, with_values};
-pub use report::{Aggregate, Row, rows};
+pub use plan_file::{PlanFileError, PlannedJob, planned_job, read_plan, write_plan};
+pub use report::{Aggregate, Row, row_json, rows};
 pub use set::{Set, SetError};
-pub use workers::{Outcome, SweepOptions, run_jobs, shared_gpu};
+pub use workers::{Outcome, SweepOptions, run_job, run_jobs, run_remaining, shared_gpu};

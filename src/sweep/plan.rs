@@ -53,6 +53,16 @@ impl FromStr for Seeds {
     }
 }
 
+impl std::fmt::Display for Seeds {
+    /// As `--seeds` takes them: `N` or `A..B`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Count(n) => write!(f, "{n}"),
+            Self::Range(a, b) => write!(f, "{a}..{b}"),
+        }
+    }
+}
+
 impl Seeds {
     /// The seeds, given the scenario's.
     pub fn list(&self, base: u64) -> Vec<u64> {
@@ -299,6 +309,9 @@ mod tests {
         assert!("0".parse::<Seeds>().is_err());
         assert!("4..2".parse::<Seeds>().is_err());
         assert!("x".parse::<Seeds>().is_err());
+        for s in ["3", "2..4"] {
+            assert_eq!(s.parse::<Seeds>().unwrap().to_string(), s);
+        }
     }
 
     #[test]

@@ -74,6 +74,25 @@ pub fn rows(plan: &Plan, outcomes: &[Option<Outcome>]) -> Vec<Row> {
         .collect()
 }
 
+/// A row as one JSON object, the columns of `sweep.csv`: `run`, each swept key and its value,
+/// `seed`, `success`, `error` (null when none), then every scalar of the run's summary.
+pub fn row_json(plan: &Plan, row: &Row) -> Json {
+    let mut m = serde_json::Map::new();
+    m.insert("run".into(), row.run.into());
+    if let Some(job) = plan.jobs.get(row.run) {
+        for (s, v) in plan.sets.iter().zip(&job.values) {
+            m.insert(s.key.clone(), serde_json::to_value(v).unwrap_or(Json::Null));
+        }
+    }
+    m.insert("seed".into(), row.seed.into());
+    m.insert("success".into(), row.success.into());
+    m.insert("error".into(), row.error.clone().into());
+    for (k, v) in &row.scalars {
+        m.entry(k.clone()).or_insert_with(|| v.clone());
+    }
+    Json::Object(m)
+}
+
 /// The scalars of `v` under `prefix`: objects flattened with dots, arrays left out.
 fn flatten(prefix: &str, v: &Json, out: &mut Vec<(String, Json)>) {
     match v {

@@ -8,9 +8,10 @@ use crate::experiments::run_scenario;
 use crate::report::output::write_run;
 use crate::run::RunOptions;
 use crate::run::record::Summary;
+use crate::scenario::Scenario;
 use omniloop_sim::render::{BatchHandle, BatchServer, GpuRenderer};
 use omniloop_sim::{RenderError, RendererChoice};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Duration;
@@ -81,16 +82,35 @@ pub fn run_jobs(
     stop: &AtomicBool,
     done: impl Fn(&Outcome) + Sync,
 ) -> Vec<Option<Outcome>> {
+    run_remaining(plan, options, stop, vec![None; plan.jobs.len()], done)
+}
+
+/// [`run_jobs`] for the jobs `previous` has no outcome of (a resumed sweep); the others keep
+/// theirs.
+pub fn run_remaining(
+    plan: &Plan,
+    options: &SweepOptions,
+    stop: &AtomicBool,
+    previous: Vec<Option<Outcome>>,
+    done: impl Fn(&Outcome) + Sync,
+) -> Vec<Option<Outcome>> {
+    let todo: Vec<usize> = (0..plan.jobs.len())
+        .filter(|&i| previous.get(i).is_none_or(Option::is_none))
+        .collect();
+    let mut previous = previous;
+    previous.resize(plan.jobs.len(), None);
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<Outcome>>> = Mutex::new(vec![None; plan.jobs.len()]);
-    let workers = options.workers.clamp(1, plan.jobs.len().max(1));
+    let results: Mutex<Vec<Option<Outcome>>> = Mutex::new(previous);
+    let workers = options.workers.clamp(1, todo.len().max(1));
     let worker = || {
         loop {
             if stop.load(Ordering::SeqCst) {
                 break;
             }
-            let i = next.fetch_add(1, Ordering::SeqCst);
-            let Some(job) = plan.jobs.get(i) else { break };
+            let Some(&i) = todo.get(next.fetch_add(1, Ordering::SeqCst)) else {
+                break;
+            };
+            let job = &plan.jobs[i];
             let outcome = Outcome {
                 job: i,
                 result: run_one(plan, job, options),
@@ -121,11 +141,23 @@ fn run_one(plan: &Plan, job: &Job, options: &SweepOptions) -> Result<Summary, St
         shared_gpu: options.shared_gpu.clone(),
         ..RunOptions::default()
     };
-    let out = run_scenario(&job.scenario, &run_options, |_| {}, |_, _| {})
-        .map_err(|e| format!("{e:#}"))?;
-    if let Some(dir) = &options.keep_runs {
-        let dir = dir.join(job.dir_name(&plan.sets));
-        write_run(&dir, &job.scenario, &out).map_err(|e| format!("{e:#}"))?;
+    let keep = options
+        .keep_runs
+        .as_ref()
+        .map(|d| d.join(job.dir_name(&plan.sets)));
+    run_job(&job.scenario, &run_options, keep.as_deref())
+}
+
+/// Runs `scenario` as a sweep's job, its outputs written into `keep` when given: its summary,
+/// or why it failed.
+pub fn run_job(
+    scenario: &Scenario,
+    options: &RunOptions,
+    keep: Option<&Path>,
+) -> Result<Summary, String> {
+    let out = run_scenario(scenario, options, |_| {}, |_, _| {}).map_err(|e| format!("{e:#}"))?;
+    if let Some(dir) = keep {
+        write_run(dir, scenario, &out).map_err(|e| format!("{e:#}"))?;
     }
     Ok(out.summary)
 }

@@ -42,13 +42,26 @@ enum Command {
     /// Run a scenario headless and write summary.json, trajectory.csv and topview.png.
     Run {
         /// Scenario file.
-        #[arg(required_unless_present = "print_default")]
+        #[arg(required_unless_present_any = ["print_default", "plan"])]
         scenario: Option<PathBuf>,
+        /// Run a job of a sweep's plan (`omniloop sweep --plan`) instead of a scenario file:
+        /// its outputs go to `runs/NAME` beside the plan (or --out); a failed run leaves its
+        /// error in `error.txt` there.
+        #[arg(
+            long,
+            value_name = "FILE",
+            requires = "job",
+            conflicts_with = "scenario"
+        )]
+        plan: Option<PathBuf>,
+        /// The plan's job to run (its index, from 0).
+        #[arg(long, value_name = "N", requires = "plan")]
+        job: Option<usize>,
         /// Output folder (default: runs/<scenario name>).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Seed overriding the scenario's.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "plan")]
         seed: Option<u64>,
         /// Renderer for the sensors' images: auto, gpu or cpu.
         #[arg(long, default_value = "auto")]
@@ -134,7 +147,8 @@ enum Command {
     /// Run a scenario over a grid of values and seeds in parallel: sweep.csv, sweep.md, sweep.png.
     Sweep {
         /// Scenario file.
-        scenario: PathBuf,
+        #[arg(required_unless_present = "collect")]
+        scenario: Option<PathBuf>,
         /// A dotted key of the scenario and its values: TOML literals, bare words for strings,
         /// ranges A..B:STEP (ends included); array items as `name[2].key`. Repeat for a grid.
         #[arg(long = "set", value_name = "KEY=V1,V2,...")]
@@ -160,6 +174,18 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        /// Write every job (its values, seed, output name, scenario) as JSON lines into FILE
+        /// (default OUT/plan.jsonl) and run nothing: run job N with `omniloop run --plan FILE
+        /// --job N`, then report with --collect.
+        #[arg(long, value_name = "FILE", num_args = 0..=1, conflicts_with = "resume")]
+        plan: Option<Option<PathBuf>>,
+        /// Build sweep.csv, sweep.md and sweep.png of DIR/plan.jsonl from its runs' folders in
+        /// DIR/runs/ (as `omniloop run --plan` leaves them).
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["plan", "resume"])]
+        collect: Option<PathBuf>,
+        /// Go on with the sweep in OUT: the jobs OUT/rows.jsonl has are not run again.
+        #[arg(long)]
+        resume: bool,
     },
     /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate;
     /// with --format, fit a standard camera model to its rays and write that tool's file.
@@ -346,6 +372,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Run {
             scenario,
+            plan,
+            job,
             out,
             seed,
             renderer,
@@ -363,6 +391,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             if print_default {
                 print!("{DEFAULT_SCENARIO}");
                 return Ok(());
+            }
+            if let (Some(plan), Some(job)) = (&plan, job) {
+                return sweep::run_planned(plan, job, out, renderer);
             }
             let Some(path) = scenario else {
                 bail!("omniloop run needs a scenario file (or --print-default)");
@@ -534,6 +565,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plot,
             keep_runs,
             quiet,
+            plan,
+            collect,
+            resume,
         } => sweep::command(sweep::Args {
             scenario,
             sets: set,
@@ -544,6 +578,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plot,
             keep_runs,
             quiet,
+            plan,
+            collect,
+            resume,
         }),
         Command::Calibrate {
             scenario,

@@ -1,12 +1,15 @@
 //! `omniloop sweep`: parse the `--set`s, check every combination, run them on all cores with a
 //! progress bar, write the table and the picture; Ctrl-C stops taking new runs and keeps what
-//! finished (a second Ctrl-C quits at once).
+//! finished (a second Ctrl-C quits at once), `--resume` goes on from what finished. `--plan`
+//! writes the jobs for another engine instead, `--collect` reports on their runs.
 
 use super::Exit;
 use anyhow::Context;
+use omniloop::RunOptions;
+use omniloop::sweep::journal::ERROR_FILE;
 use omniloop::sweep::{
-    PlanError, Seeds, Set, SweepOptions, known_metric, plan, rows, run_jobs, shared_gpu,
-    write_outputs,
+    Journal, Outcome, Plan, PlanError, PlanFileError, Record, Seeds, Set, SweepOptions,
+    collect_runs, plan, planned_job, read_plan, run_job, run_remaining, shared_gpu, write_plan,
 };
 use omniloop::{LoadError, report::default_out_dir};
 use omniloop_sim::RendererChoice;
@@ -16,7 +19,7 @@ use std::time::Instant;
 
 /// The command's arguments.
 pub struct Args {
-    pub scenario: PathBuf,
+    pub scenario: Option<PathBuf>,
     pub sets: Vec<String>,
     pub seeds: Seeds,
     pub jobs: usize,
@@ -25,6 +28,12 @@ pub struct Args {
     pub plot: String,
     pub keep_runs: bool,
     pub quiet: bool,
+    /// Write the plan (into this file, or OUT/plan.jsonl) and run nothing.
+    pub plan: Option<Option<PathBuf>>,
+    /// Report on the runs of this sweep folder's plan.
+    pub collect: Option<PathBuf>,
+    /// Go on from the sweep folder's rows.jsonl.
+    pub resume: bool,
 }
 
 /// Set by Ctrl-C: no new runs start.
@@ -42,14 +51,13 @@ fn parse_sets(args: &[String]) -> anyhow::Result<Vec<Set>> {
     Ok(sets.into_iter().filter_map(Result::ok).collect())
 }
 
-/// Runs the sweep.
-pub fn command(a: Args) -> anyhow::Result<()> {
-    let sets = parse_sets(&a.sets)?;
-    let plan = match plan(&a.scenario, &sets, &a.seeds) {
-        Ok(p) => p,
+/// The sweep's plan, or exit 2 with every problem.
+fn checked_plan(scenario: &std::path::Path, sets: &[Set], seeds: &Seeds) -> anyhow::Result<Plan> {
+    match plan(scenario, sets, seeds) {
+        Ok(p) => Ok(p),
         Err(PlanError::Scenario(e @ LoadError::Invalid { .. })) => {
             eprintln!("{e}");
-            return Err(Exit(2).into());
+            Err(Exit(2).into())
         }
         Err(PlanError::Invalid(messages)) => {
             for m in messages.iter().take(12) {
@@ -59,15 +67,50 @@ pub fn command(a: Args) -> anyhow::Result<()> {
                 eprintln!("... and {} more", messages.len() - 12);
             }
             eprintln!("nothing was run");
-            return Err(Exit(2).into());
+            Err(Exit(2).into())
         }
-        Err(e) => return Err(e.into()),
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// Runs the sweep, writes its plan, or collects its runs.
+pub fn command(a: Args) -> anyhow::Result<()> {
+    if let Some(dir) = &a.collect {
+        return collect(dir, &a.plot);
+    }
+    let Some(scenario) = &a.scenario else {
+        anyhow::bail!("omniloop sweep needs a scenario file (or --collect DIR)");
     };
+    let sets = parse_sets(&a.sets)?;
+    let plan = checked_plan(scenario, &sets, &a.seeds)?;
     let base = &plan.jobs[0].scenario;
-    let dir = a.out.unwrap_or_else(|| {
+    let dir = a.out.clone().unwrap_or_else(|| {
         let d = default_out_dir(base);
         d.with_file_name(format!("{}_sweep", plan.name))
     });
+    if let Some(file) = &a.plan {
+        let file = file.clone().unwrap_or_else(|| dir.join("plan.jsonl"));
+        write_plan(&plan, &a.seeds, &file)?;
+        let runs = file
+            .parent()
+            .unwrap_or(std::path::Path::new("."))
+            .join("runs");
+        println!(
+            "{} jobs planned in {}: run job N with `omniloop run --plan {} --job N` (into {}), \
+             then `omniloop sweep --collect {}`",
+            plan.jobs.len(),
+            file.display(),
+            file.display(),
+            runs.join("NAME").display(),
+            file.parent().unwrap_or(std::path::Path::new(".")).display()
+        );
+        return Ok(());
+    }
+    run_sweep(&a, &plan, &dir)
+}
+
+/// Runs `plan` into `dir`: its plan and journal first, every run on the pool, the report.
+fn run_sweep(a: &Args, plan: &Plan, dir: &std::path::Path) -> anyhow::Result<()> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut options = SweepOptions::new(a.jobs, cores, a.renderer);
     options.keep_runs = a.keep_runs.then(|| dir.join("runs"));
@@ -78,7 +121,10 @@ pub fn command(a: Args) -> anyhow::Result<()> {
         Some(h) => h.name().to_string(),
         None => "cpu".to_string(),
     };
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    write_plan(plan, &a.seeds, &dir.join("plan.jsonl"))?;
+    let (journal, previous) = Journal::open(dir, plan, a.resume)?;
+    let skipped = previous.iter().flatten().count();
     let _ = ctrlc::set_handler(|| {
         if STOP.swap(true, Ordering::SeqCst) {
             std::process::exit(130);
@@ -93,9 +139,14 @@ pub fn command(a: Args) -> anyhow::Result<()> {
         "{prefix} [{bar:40}] {pos}/{len} runs {msg} eta {eta}",
     );
     progress.set_prefix(plan.name.clone());
+    progress.set_position(skipped as u64);
     let failed = AtomicUsize::new(0);
     let start = Instant::now();
-    let outcomes = run_jobs(&plan, &options, &STOP, |o| {
+    let outcomes = run_remaining(plan, &options, &STOP, previous, |o: &Outcome| {
+        let job = &plan.jobs[o.job];
+        if let Err(e) = journal.record(&Record::new(o, &job.dir_name(&plan.sets), job.seed)) {
+            progress.println(format!("{e}"));
+        }
         if let Err(e) = &o.result {
             let f = failed.fetch_add(1, Ordering::SeqCst) + 1;
             progress.set_message(format!("({f} failed)"));
@@ -105,28 +156,109 @@ pub fn command(a: Args) -> anyhow::Result<()> {
     });
     progress.finish_and_clear();
     let wall_s = start.elapsed().as_secs_f64();
-    let ran = outcomes.iter().flatten().count();
-    let rows = rows(&plan, &outcomes);
-    let mut metric = a.plot.clone();
-    if !known_metric(&rows, &metric) {
-        eprintln!("--plot {metric}: no run has this number; plotting success_rate");
-        metric = "success_rate".into();
-    }
+    let ran = outcomes.iter().flatten().count() - skipped;
     let stopped = STOP.load(Ordering::SeqCst);
     let header = format!(
-        "{ran} of {n} runs ({combos} combinations x {} seeds){}, {} at a time on {} threads, \
-         renderer {renderer}: {wall_s:.1} s, {:.2} runs/s. Figure: sweep.png ({metric}).",
+        "{ran} of {n} runs ({combos} combinations x {} seeds){}{}, {} at a time on {} threads, \
+         renderer {renderer}: {wall_s:.1} s, {:.2} runs/s.",
         n / combos.max(1),
+        if skipped > 0 {
+            format!(", {skipped} more from the sweep resumed")
+        } else {
+            String::new()
+        },
         if stopped { ", stopped by Ctrl-C" } else { "" },
         options.workers.min(n),
         options.threads,
         ran as f64 / wall_s.max(1e-9),
     );
-    let md = write_outputs(&dir, &plan, &rows, &metric, &header)?;
-    print!("{md}");
-    println!("\nwritten to {}", dir.display());
+    report(dir, plan, &outcomes, &a.plot, &header)?;
     if stopped {
         return Err(Exit(130).into());
     }
     Ok(())
+}
+
+/// `sweep.csv`, `sweep.md` and `sweep.png` of `outcomes` into `dir`; the table printed.
+fn report(
+    dir: &std::path::Path,
+    plan: &Plan,
+    outcomes: &[Option<Outcome>],
+    plot: &str,
+    header: &str,
+) -> anyhow::Result<()> {
+    let (md, _) = omniloop::sweep::write_report(dir, plan, outcomes, plot, header)?;
+    print!("{md}");
+    println!("\nwritten to {}", dir.display());
+    Ok(())
+}
+
+/// `--collect DIR`: the report of `DIR/plan.jsonl`'s jobs from their folders in `DIR/runs/`.
+fn collect(dir: &std::path::Path, plot: &str) -> anyhow::Result<()> {
+    let (plan, _) = read_plan(&dir.join("plan.jsonl"))?;
+    let outcomes = collect_runs(&dir.join("runs"), &plan)?;
+    let found = outcomes.iter().flatten().count();
+    let failed = outcomes
+        .iter()
+        .flatten()
+        .filter(|o| o.result.is_err())
+        .count();
+    let header = format!(
+        "{found} of {} runs collected from {} ({failed} failed).",
+        plan.jobs.len(),
+        dir.join("runs").display()
+    );
+    report(dir, &plan, &outcomes, plot, &header)
+}
+
+/// `omniloop run --plan FILE --job N`: the job's run, its outputs into `out` (default
+/// `runs/NAME` beside the plan); a failed run leaves `error.txt` there instead of a summary.
+pub fn run_planned(
+    file: &std::path::Path,
+    index: usize,
+    out: Option<PathBuf>,
+    renderer: RendererChoice,
+) -> anyhow::Result<()> {
+    let (job, scenario) = match planned_job(file, index) {
+        Ok(j) => j,
+        Err(e @ PlanFileError::Line { .. }) => {
+            eprintln!("{e}");
+            return Err(Exit(2).into());
+        }
+        Err(e) => return Err(e.into()),
+    };
+    let dir = out.unwrap_or_else(|| {
+        let base = file.parent().unwrap_or(std::path::Path::new("."));
+        base.join("runs").join(&job.name)
+    });
+    let (summary, error) = (dir.join("summary.json"), dir.join(ERROR_FILE));
+    let _ = std::fs::remove_file(&error);
+    let options = RunOptions {
+        renderer,
+        ..RunOptions::default()
+    };
+    match run_job(&scenario, &options, Some(&dir)) {
+        Ok(m) => {
+            println!(
+                "job {index} ({}): {} cycles; goal {}; contacts {}; results in {}",
+                job.name,
+                m.cycles,
+                if m.reached_goal {
+                    "reached"
+                } else {
+                    "not reached"
+                },
+                m.wall_contacts,
+                dir.display()
+            );
+            Ok(())
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&summary);
+            std::fs::create_dir_all(&dir)
+                .and_then(|()| std::fs::write(&error, format!("{e}\n")))
+                .with_context(|| format!("writing {}", error.display()))?;
+            anyhow::bail!("job {index} ({}) failed: {e}", job.name)
+        }
+    }
 }
