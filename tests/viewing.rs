@@ -197,6 +197,17 @@ fn watch(port: u16) -> Watched {
     watched
 }
 
+/// A child process killed when the test stops early (a server waiting for a viewer that never
+/// came would otherwise outlive it).
+struct Reaped(std::process::Child);
+
+impl Drop for Reaped {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
 /// `omniloop run --live`: E1 served on a free loopback port waits for its viewer, which gets
 /// the true pose of every cycle (trajectory.csv's rows but the final state's) and then the
 /// summary; the run's
@@ -205,24 +216,26 @@ fn watch(port: u16) -> Watched {
 fn e1_served_live_reaches_a_foxglove_client_a_pose_a_cycle() {
     use std::io::BufRead;
     let (live_dir, plain_dir) = (tmp("live_e1"), tmp("live_e1_plain"));
-    let mut child = common::bin()
-        .arg("run")
-        .arg(scenario_path("corner55_velocity_aware.toml"))
-        .args([
-            "--renderer",
-            "cpu",
-            "-q",
-            "--live",
-            "127.0.0.1:0",
-            "--live-wait",
-        ])
-        .arg("--out")
-        .arg(&live_dir)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut child = Reaped(
+        common::bin()
+            .arg("run")
+            .arg(scenario_path("corner55_velocity_aware.toml"))
+            .args([
+                "--renderer",
+                "cpu",
+                "-q",
+                "--live",
+                "127.0.0.1:0",
+                "--live-wait",
+            ])
+            .arg("--out")
+            .arg(&live_dir)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap(),
+    );
+    let mut stderr = std::io::BufReader::new(child.0.stderr.take().unwrap());
     let mut line = String::new();
     let port: u16 = loop {
         line.clear();
@@ -233,7 +246,7 @@ fn e1_served_live_reaches_a_foxglove_client_a_pose_a_cycle() {
     };
     let drain = std::thread::spawn(move || std::io::read_to_string(stderr).unwrap());
     let watched = watch(port);
-    let status = child.wait().unwrap();
+    let status = child.0.wait().unwrap();
     let messages = drain.join().unwrap();
     assert!(status.success(), "{status}: {messages}");
     run_e1(&plain_dir, &[]);

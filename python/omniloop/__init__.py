@@ -18,6 +18,9 @@ The loop itself, from Python::
 - ``Simulation(scenario, seed=None, renderer="cpu", robot="python")``: ``reset``, ``step``,
   ``truth``, ``summary``, ``write``, ``topview``; ``robot="builtin"`` steps the built-in stack.
 - ``VectorSimulation(scenario, num_envs, ...)``: N runs stepped together in parallel.
+- ``sweep(scenario, sets={...}, seeds=..., executor="local"|"ray")``: a grid of runs, on
+  this machine or a Ray cluster (``pip install omniloop[ray]``), with ``omniloop sweep``'s
+  report; ``resume=True`` goes on from what finished.
 - ``omniloop.gym``: the Gymnasium environments (``pip install omniloop[gym]``).
 
 Units are millimetres, seconds and radians. The robot never sees the truth: an
@@ -36,6 +39,7 @@ from ._omniloop import (
     default_scenario,
     run,
 )
+from .sweeps import SweepResult, sweep, without_timing
 
 __all__ = [
     "Observation",
@@ -48,4 +52,7 @@ __all__ = [
     "__version__",
     "default_scenario",
     "run",
+    "sweep",
+    "SweepResult",
+    "without_timing",
 ]

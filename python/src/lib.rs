@@ -5,6 +5,7 @@
 mod convert;
 mod scenario;
 mod simulation;
+mod sweep;
 mod vector;
 
 use convert::{ScenarioError, json_to_py, run_error, trajectory_columns};
@@ -117,6 +118,11 @@ fn _omniloop(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<vector::PyVectorSimulation>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(default_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep_open, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep_local, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::run_planned_job, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep_report, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
