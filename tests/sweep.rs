@@ -64,24 +64,11 @@ fn small_sweep_args() -> Vec<String> {
 }
 
 fn sweep(out: &Path, jobs: &str) {
-    let out = out.display().to_string();
-    omniloop([
-        "sweep",
-        scenario_path("corner55_velocity_aware.toml")
-            .to_str()
-            .unwrap(),
-        "--set",
-        "robot.max_speed_mm_s=300,400",
-        "--seeds",
-        "2",
-        "--jobs",
-        jobs,
-        "--renderer",
-        "cpu",
-        "--keep-runs",
-        "--out",
-        out.as_str(),
-    ]);
+    let mut args = vec!["sweep".to_string()];
+    args.extend(small_sweep_args());
+    args.extend(["--jobs", jobs, "--renderer", "cpu", "--keep-runs", "--out"].map(String::from));
+    args.push(out.display().to_string());
+    omniloop(&args);
 }
 
 /// The run folders of a sweep, in run order.

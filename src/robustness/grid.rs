@@ -187,8 +187,8 @@ fn plan_cell(
 ) -> Planned {
     let (file, text) = e.scenario;
     let values = (k.values)(base, level);
-    let mut scenario = match with_values(Path::new(file), text, &values) {
-        Ok((s, _)) => s,
+    let (mut scenario, toml) = match with_values(Path::new(file), text, &values) {
+        Ok(st) => st,
         Err(problems) => return Planned::NotApplicable(problems.join("; ")),
     };
     if let Some(seed) = seed {
@@ -204,6 +204,7 @@ fn plan_cell(
         values,
         seed: scenario.seed,
         scenario,
+        toml: toml.into(),
     });
     Planned::Run(jobs.len() - 1)
 }

@@ -7,6 +7,7 @@ use crate::scenario::LoadError;
 use crate::scenario::Scenario;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
+use std::sync::Arc;
 use toml::{Table, Value};
 
 /// The seeds of each combination: `N` (the scenario's seed and the N - 1 after it) or `A..B`
@@ -86,6 +87,9 @@ pub struct Job {
     pub seed: u64,
     /// The scenario with the values and the seed in.
     pub scenario: Scenario,
+    /// The scenario's TOML with the values in (the seed is `seed`), shared by the seeds of a
+    /// combination.
+    pub toml: Arc<str>,
 }
 
 impl Job {
@@ -157,8 +161,8 @@ pub fn plan(file: &Path, sets: &[Set], seeds: &Seeds) -> Result<Plan, PlanError>
     let mut errors: Vec<String> = Vec::new();
     let mut jobs = Vec::new();
     for (c, values) in combos.into_iter().enumerate() {
-        let scenario = match combination(file, &doc, sets, &values) {
-            Ok(s) => s,
+        let (scenario, toml) = match combination(file, &doc, sets, &values) {
+            Ok((s, t)) => (s, Arc::<str>::from(t)),
             Err(e) => {
                 errors.extend(
                     e.into_iter()
@@ -177,6 +181,7 @@ pub fn plan(file: &Path, sets: &[Set], seeds: &Seeds) -> Result<Plan, PlanError>
                 values: values.clone(),
                 seed,
                 scenario,
+                toml: toml.clone(),
             });
         }
     }
@@ -207,13 +212,7 @@ pub fn with_values(
         sets.push(Set::single(key, value.clone()).map_err(|e| vec![e.to_string()])?);
     }
     let vals: Vec<Value> = values.iter().map(|(_, v)| v.clone()).collect();
-    let scenario = combination(file, &doc, &sets, &vals)?;
-    let mut doc = doc;
-    for (s, v) in sets.iter().zip(&vals) {
-        s.apply(&mut doc, v).map_err(|m| vec![m])?;
-    }
-    let text = toml::to_string(&doc).map_err(|e| vec![format!("{}: {e}", file.display())])?;
-    Ok((scenario, text))
+    combination(file, &doc, &sets, &vals)
 }
 
 /// Every combination of the sets' values, the first set slowest.
@@ -234,14 +233,15 @@ fn combinations(sets: &[Set]) -> Vec<Vec<Value>> {
     out
 }
 
-/// The scenario with `values` written in, validated; each problem names the `--set` it came
-/// from (`--set ARG:1:COL: field ...`), or the whole combination when none covers its field.
+/// The scenario with `values` written in, validated, and its TOML; each problem names the
+/// `--set` it came from (`--set ARG:1:COL: field ...`), or the whole combination when none
+/// covers its field.
 fn combination(
     file: &Path,
     doc: &Table,
     sets: &[Set],
     values: &[Value],
-) -> Result<Scenario, Vec<String>> {
+) -> Result<(Scenario, String), Vec<String>> {
     let mut doc = doc.clone();
     for (s, v) in sets.iter().zip(values) {
         s.apply(&mut doc, v).map_err(|m| {
@@ -261,7 +261,7 @@ fn combination(
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
     match parse_scenario(&text, file, &stem) {
-        Ok(s) => Ok(s),
+        Ok(s) => Ok((s, text)),
         Err(LoadError::Invalid { problems }) => Err(problems
             .into_iter()
             .map(|p| {

@@ -4,7 +4,7 @@
 //! is run by `omniloop run --plan FILE --job N` (or [`planned_job`] from Rust, Python and Ray
 //! workers); `omniloop sweep --collect` builds the report from the runs' folders.
 
-use super::plan::{Job, Plan, Seeds, plan, with_values};
+use super::plan::{Job, Plan, Seeds, plan};
 use super::set::Set;
 use crate::experiments::parse_scenario;
 use crate::scenario::Scenario;
@@ -71,42 +71,19 @@ pub enum PlanFileError {
     },
 }
 
-/// The planned jobs of `plan` (its scenario's text with each combination's values in).
-pub fn planned_jobs(plan: &Plan) -> Result<Vec<PlannedJob>, PlanFileError> {
-    let text = std::fs::read_to_string(&plan.file).map_err(|source| PlanFileError::Io {
-        file: plan.file.clone(),
-        source,
-    })?;
-    let mut texts: Vec<Option<String>> = Vec::new();
-    let mut out = Vec::with_capacity(plan.jobs.len());
-    for job in &plan.jobs {
-        let values = job_values(&plan.sets, job);
-        if texts.len() <= job.combination {
-            texts.resize(job.combination + 1, None);
-        }
-        let scenario = match &texts[job.combination] {
-            Some(t) => t.clone(),
-            None => {
-                let (_, t) =
-                    with_values(&plan.file, &text, &values).map_err(|m| PlanFileError::Line {
-                        file: plan.file.clone(),
-                        line: 1,
-                        message: m.join("; "),
-                    })?;
-                texts[job.combination] = Some(t.clone());
-                t
-            }
-        };
-        out.push(PlannedJob {
+/// The planned jobs of `plan`.
+pub fn planned_jobs(plan: &Plan) -> Vec<PlannedJob> {
+    plan.jobs
+        .iter()
+        .map(|job| PlannedJob {
             index: job.index,
             combination: job.combination,
             name: job.dir_name(&plan.sets),
             seed: job.seed,
-            values,
-            scenario,
-        });
-    }
-    Ok(out)
+            values: job_values(&plan.sets, job),
+            scenario: job.toml.to_string(),
+        })
+        .collect()
 }
 
 /// Each `--set` key of `job` and its value.
@@ -131,7 +108,7 @@ pub fn write_plan(plan: &Plan, seeds: &Seeds, file: &Path) -> Result<(), PlanFil
         runs: plan.jobs.len(),
     };
     let mut text = json_line(&header);
-    for job in planned_jobs(plan)? {
+    for job in planned_jobs(plan) {
         text.push_str(&json_line(&job));
     }
     if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -210,7 +187,7 @@ pub fn read_plan(file: &Path) -> Result<(Plan, Vec<PlannedJob>), PlanFileError> 
         .collect::<Result<Vec<_>, _>>()?;
     let seeds: Seeds = header.seeds.parse().map_err(&bad)?;
     let plan = plan(&header.scenario_file, &sets, &seeds).map_err(|e| bad(e.to_string()))?;
-    let again = planned_jobs(&plan)?;
+    let again = planned_jobs(&plan);
     if again != lines {
         return Err(bad(format!(
             "its jobs are no longer what {} gives: the scenario changed since it was planned",

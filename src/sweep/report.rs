@@ -339,6 +339,7 @@ mod tests {
             values: set.values.clone(),
             seed: index as u64,
             scenario: scenario.clone(),
+            toml: "[robot]\n".into(),
         };
         let plan = Plan {
             file: "x.toml".into(),
