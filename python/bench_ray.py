@@ -34,7 +34,8 @@ SETS = {"experiment.corner.angle_deg": [40, 55, 70, 85], "robot.max_speed_mm_s":
 
 
 def one_sweep(nodes: int, seeds: int, batch_size) -> tuple:
-    """The sweep on a fresh cluster of `nodes` one-CPU nodes: (runs/s, overhead ms a job)."""
+    """The sweep on a fresh cluster of `nodes` one-CPU nodes: (runs/s, overhead ms a job, a
+    run's own mean wall time in s)."""
     cluster = Cluster(
         initialize_head=True, head_node_args={"num_cpus": 1, "include_dashboard": False},
     )
@@ -42,8 +43,10 @@ def one_sweep(nodes: int, seeds: int, batch_size) -> tuple:
         cluster.add_node(num_cpus=1)
     ray.init(address=cluster.address, include_dashboard=False, log_to_driver=False)
     try:
-        # Each worker imports omniloop once before the clock starts.
-        warm = ray.remote(num_cpus=1)(lambda: __import__("omniloop").__version__)
+        # A worker on every node imports omniloop before the clock starts.
+        warm = ray.remote(num_cpus=1, scheduling_strategy="SPREAD")(
+            lambda: __import__("omniloop").__version__
+        )
         ray.get([warm.remote() for _ in range(2 * nodes)])
         with tempfile.TemporaryDirectory() as out:
             r = omniloop.sweep(
@@ -60,7 +63,7 @@ def one_sweep(nodes: int, seeds: int, batch_size) -> tuple:
     assert not r.failed(), r.failed()
     runs = len(r.rows)
     own = sum(row["wall_time_s"] for row in r.rows)
-    return runs / r.wall_s, 1e3 * (r.wall_s - own / nodes) / runs
+    return runs / r.wall_s, 1e3 * (r.wall_s - own / nodes) / runs, own / runs
 
 
 def main() -> None:
@@ -69,14 +72,16 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--batch-size", type=int, default=None)
     a = ap.parse_args()
-    one, two, over1, over2 = [], [], [], []
+    one, two, over1, over2, own1, own2 = [], [], [], [], [], []
     for k in range(a.rounds):
-        t1, o1 = one_sweep(1, a.seeds, a.batch_size)
-        t2, o2 = one_sweep(2, a.seeds, a.batch_size)
+        t1, o1, r1 = one_sweep(1, a.seeds, a.batch_size)
+        t2, o2, r2 = one_sweep(2, a.seeds, a.batch_size)
         one.append(t1)
         two.append(t2)
         over1.append(o1)
         over2.append(o2)
+        own1.append(r1)
+        own2.append(r2)
         print(f"round {k + 1}: one node {t1:.2f} runs/s, two nodes {t2:.2f} runs/s ({t2 / t1:.2f}x)")
     m1, m2 = statistics.median(one), statistics.median(two)
     runs = 8 * a.seeds
@@ -85,6 +90,8 @@ def main() -> None:
     print(f"  two 1-CPU nodes   {m2:6.2f} runs/s   {m2 / m1:.2f}x")
     print(f"  driver overhead   {statistics.median(over1):6.1f} ms a job on one node, "
           f"{statistics.median(over2):.1f} ms on two")
+    print(f"  a run's own time  {1e3 * statistics.median(own1):6.0f} ms on one node, "
+          f"{1e3 * statistics.median(own2):.0f} ms on two (two runs at once)")
 
 
 if __name__ == "__main__":

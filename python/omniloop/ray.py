@@ -31,10 +31,12 @@ def _run_batch(header: str, jobs: Sequence[str], keep: Optional[str], renderer: 
 
 
 class RayExecutor:
-    """Runs a sweep's jobs as Ray tasks of ``batch_size`` jobs (default: about four tasks a CPU
-    of the cluster, so that a task's scheduling, some milliseconds, stays a small part of it),
-    each task asking for ``num_cpus`` CPUs and retried ``max_retries`` times when its worker
-    dies. ``address`` is given to ``ray.init`` when Ray is not initialized yet."""
+    """Runs a sweep's jobs as Ray tasks of ``batch_size`` jobs, each task asking for
+    ``num_cpus`` CPUs and retried ``max_retries`` times when its worker dies. By default there
+    are four tasks a CPU of the cluster (a task's scheduling costs milliseconds, more on a busy
+    cluster, so fewer and longer tasks go faster), each taking every n-th job of the plan, so
+    that every task holds a like share of the grid's slow and fast runs and the last tasks end
+    together. ``address`` is given to ``ray.init`` when Ray is not initialized yet."""
 
     name = "ray"
 
@@ -54,11 +56,12 @@ class RayExecutor:
 
     def batches(self, jobs: Sequence[str]) -> List[Sequence[str]]:
         """The jobs cut into the tasks' batches, in the plan's order."""
-        size = self.batch_size
-        if size is None:
-            cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
-            size = max(1, len(jobs) // (4 * cpus))
-        return [jobs[i : i + size] for i in range(0, len(jobs), size)]
+        if self.batch_size is not None:
+            size = self.batch_size
+            return [jobs[i : i + size] for i in range(0, len(jobs), size)]
+        cpus = max(1, int(ray.cluster_resources().get("CPU", 1) / self.num_cpus))
+        tasks = max(1, min(len(jobs), 4 * cpus))
+        return [jobs[k::tasks] for k in range(tasks)]
 
     def run(
         self,

@@ -82,9 +82,9 @@ impl Journal {
         resume: bool,
     ) -> Result<(Self, Vec<Option<Outcome>>), PlanFileError> {
         let file = dir.join(JOURNAL);
-        let io = |source| PlanFileError::Io {
+        let io = |reason| PlanFileError::Io {
             file: file.clone(),
-            source,
+            reason,
         };
         std::fs::create_dir_all(dir).map_err(io)?;
         let previous = if resume && file.exists() {
@@ -113,9 +113,9 @@ impl Journal {
         let mut out = self.out.lock().unwrap_or_else(|e| e.into_inner());
         out.write_all(record.line().as_bytes())
             .and_then(|()| out.flush())
-            .map_err(|source| PlanFileError::Io {
+            .map_err(|reason| PlanFileError::Io {
                 file: self.file.clone(),
-                source,
+                reason,
             })
     }
 }
@@ -124,9 +124,9 @@ impl Journal {
 /// a record of another plan's job is an error naming its line. A line cut short by a crash is
 /// left out (its job runs again).
 pub fn read_journal(file: &Path, plan: &Plan) -> Result<Vec<Option<Outcome>>, PlanFileError> {
-    let io = |source| PlanFileError::Io {
+    let io = |reason| PlanFileError::Io {
         file: file.to_path_buf(),
-        source,
+        reason,
     };
     let mut out: Vec<Option<Outcome>> = vec![None; plan.jobs.len()];
     let reader = BufReader::new(File::open(file).map_err(io)?);
@@ -163,9 +163,9 @@ pub fn collect_runs(runs: &Path, plan: &Plan) -> Result<Vec<Option<Outcome>>, Pl
         let summary = dir.join("summary.json");
         let error = dir.join(ERROR_FILE);
         let result = if summary.exists() {
-            let text = std::fs::read_to_string(&summary).map_err(|source| PlanFileError::Io {
+            let text = std::fs::read_to_string(&summary).map_err(|reason| PlanFileError::Io {
                 file: summary.clone(),
-                source,
+                reason,
             })?;
             Some(Ok(serde_json::from_str::<Summary>(&text).map_err(|e| {
                 PlanFileError::Line {

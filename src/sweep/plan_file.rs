@@ -52,12 +52,12 @@ pub struct PlannedJob {
 #[derive(Debug, thiserror::Error)]
 pub enum PlanFileError {
     /// A file cannot be read or written.
-    #[error("{}: {source}", file.display())]
+    #[error("{}: {reason}", file.display())]
     Io {
         /// The file.
         file: PathBuf,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// A line of the plan is not what it should be.
     #[error("{}:{line}: {message}", file.display())]
@@ -96,9 +96,9 @@ fn job_values(sets: &[Set], job: &Job) -> Vec<(String, toml::Value)> {
 
 /// Writes `plan` (asked with `seeds`) to `file` as JSON lines.
 pub fn write_plan(plan: &Plan, seeds: &Seeds, file: &Path) -> Result<(), PlanFileError> {
-    let io = |source| PlanFileError::Io {
+    let io = |reason| PlanFileError::Io {
         file: file.to_path_buf(),
-        source,
+        reason,
     };
     let header = PlanHeader {
         omniloop_sweep_plan: PLAN_VERSION,
@@ -126,9 +126,9 @@ fn json_line(value: &impl Serialize) -> String {
 
 /// The lines of the plan `file`: its header and its jobs.
 pub fn read_plan_lines(file: &Path) -> Result<(PlanHeader, Vec<PlannedJob>), PlanFileError> {
-    let io = |source| PlanFileError::Io {
+    let io = |reason| PlanFileError::Io {
         file: file.to_path_buf(),
-        source,
+        reason,
     };
     let bad = |line: usize, message: String| PlanFileError::Line {
         file: file.to_path_buf(),

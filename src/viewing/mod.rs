@@ -60,12 +60,12 @@ impl CycleObserver for Feed {
 #[derive(Debug, thiserror::Error)]
 pub enum ViewingError {
     /// The file cannot be written.
-    #[error("writing {}: {source}", file.display())]
+    #[error("writing {}: {reason}", file.display())]
     Io {
         /// The file.
         file: PathBuf,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// The Foxglove SDK refused (a channel, the writer).
     #[error("{what}: {message}")]
@@ -203,9 +203,9 @@ fn mcap_writer(
     ctx: &Arc<Context>,
     file: &std::path::Path,
 ) -> Result<McapWriterHandle<BufWriter<File>>, ViewingError> {
-    let io = |source| ViewingError::Io {
+    let io = |reason| ViewingError::Io {
         file: file.to_path_buf(),
-        source,
+        reason,
     };
     if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(io)?;

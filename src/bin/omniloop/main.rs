@@ -179,8 +179,8 @@ enum Command {
         /// --job N`, then report with --collect.
         #[arg(long, value_name = "FILE", num_args = 0..=1, conflicts_with = "resume")]
         plan: Option<Option<PathBuf>>,
-        /// Build sweep.csv, sweep.md and sweep.png of DIR/plan.jsonl from its runs' folders in
-        /// DIR/runs/ (as `omniloop run --plan` leaves them).
+        /// Build sweep.csv, sweep.md and sweep.png of DIR/plan.jsonl (or of the plan file DIR,
+        /// beside it) from its runs' folders in DIR/runs/ (as `omniloop run --plan` leaves them).
         #[arg(long, value_name = "DIR", conflicts_with_all = ["plan", "resume"])]
         collect: Option<PathBuf>,
         /// Go on with the sweep in OUT: the jobs OUT/rows.jsonl has are not run again.

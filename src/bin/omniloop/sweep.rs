@@ -193,9 +193,17 @@ fn report(
     Ok(())
 }
 
-/// `--collect DIR`: the report of `DIR/plan.jsonl`'s jobs from their folders in `DIR/runs/`.
-fn collect(dir: &std::path::Path, plot: &str) -> anyhow::Result<()> {
-    let (plan, _) = read_plan(&dir.join("plan.jsonl"))?;
+/// `--collect DIR`: the report of `DIR/plan.jsonl`'s jobs from their folders in `DIR/runs/`,
+/// into DIR (DIR may be the plan file itself, its folder then).
+fn collect(path: &std::path::Path, plot: &str) -> anyhow::Result<()> {
+    let (file, dir) = if path.is_file() {
+        let dir = path.parent().unwrap_or(std::path::Path::new("."));
+        (path.to_path_buf(), dir.to_path_buf())
+    } else {
+        (path.join("plan.jsonl"), path.to_path_buf())
+    };
+    let dir = dir.as_path();
+    let (plan, _) = read_plan(&file)?;
     let outcomes = collect_runs(&dir.join("runs"), &plan)?;
     let found = outcomes.iter().flatten().count();
     let failed = outcomes
