@@ -120,16 +120,16 @@ def sweep(
         if seeds.step != 1 or len(seeds) == 0:
             raise ValueError(f"seeds={seeds!r}: a range of step 1 with at least one seed")
         seeds = f"{seeds.start}..{seeds.stop - 1}"
-    out_dir, lines = _omniloop.sweep_plan(str(scenario), dict(sets or {}), str(seeds), out)
-    out_dir = Path(out_dir)
-    todo = _omniloop.sweep_open(str(out_dir), resume)
+    plan = _omniloop.sweep_plan(str(scenario), dict(sets or {}), str(seeds), out)
+    out_dir, lines = Path(plan.out), plan.lines
+    todo = plan.open(resume)
     total = len(lines) - 1
     bar = _Progress(total, total - len(todo), progress)
     start = time.perf_counter()
     interrupted = False
     try:
         if executor == "local":
-            _omniloop.sweep_local(str(out_dir), jobs, renderer, keep_runs, bar.update)
+            plan.run_local(jobs, renderer, keep_runs, bar.update)
         else:
             if executor == "ray":
                 from .ray import RayExecutor
@@ -158,7 +158,7 @@ def sweep(
         + (", stopped by Ctrl-C" if interrupted else "")
         + f", executor {name}: {wall_s:.1f} s, {ran / max(wall_s, 1e-9):.2f} runs/s."
     )
-    rows = json.loads(_omniloop.sweep_report(str(out_dir), plot, header))
+    rows = json.loads(plan.report(plot, header))
     if interrupted:
         raise KeyboardInterrupt(f"sweep stopped; what finished is in {out_dir}")
     return SweepResult(rows=rows, out=out_dir, wall_s=wall_s, ran=ran)

@@ -119,10 +119,8 @@ fn _omniloop(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(default_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep_plan, m)?)?;
-    m.add_function(wrap_pyfunction!(sweep::sweep_open, m)?)?;
-    m.add_function(wrap_pyfunction!(sweep::sweep_local, m)?)?;
+    m.add_class::<sweep::SweepPlan>()?;
     m.add_function(wrap_pyfunction!(sweep::run_planned_job, m)?)?;
-    m.add_function(wrap_pyfunction!(sweep::sweep_report, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

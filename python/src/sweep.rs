@@ -1,15 +1,15 @@
-//! Sweeps from Python (`omniloop.sweep`): the plan written and checked by the same code as
-//! `omniloop sweep`, the jobs run on the Rust pool (`executor="local"`) or one by one wherever a
-//! Ray task calls [`run_planned_job`], each finished job a line of the sweep's `rows.jsonl`, the
-//! report written by the same code as the command's.
+//! Sweeps from Python (`omniloop.sweep`): the plan written and checked once by the same code
+//! as `omniloop sweep` ([`SweepPlan`]), the jobs run on the Rust pool (`executor="local"`) or
+//! one by one wherever a Ray task calls [`run_planned_job`], each finished job a line of the
+//! sweep's `rows.jsonl`, the report written by the same code as the command's.
 
 use crate::convert::{ScenarioError, toml_value};
 use crate::simulation::renderer_choice;
 use omniloop::RunOptions;
 use omniloop::sweep::plan_file::scenario_of_lines;
 use omniloop::sweep::{
-    Journal, Outcome, PlanError, Record, Seeds, Set, SweepOptions, read_journal, read_plan,
-    row_json, run_job, run_remaining, write_plan, write_report,
+    Journal, Outcome, Plan, PlanError, Record, Seeds, Set, SweepOptions, read_journal, row_json,
+    run_job, run_remaining, write_plan, write_report,
 };
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -48,8 +48,8 @@ fn set_args(sets: &Bound<'_, PyDict>) -> PyResult<Vec<String>> {
 }
 
 /// Plans the sweep of `scenario` over `sets` x `seeds` into `out` (default
-/// `runs/<name>_sweep`), checking every job first: its folder and the lines of its
-/// `plan.jsonl` (the header first). Raises `ScenarioError` with every problem.
+/// `runs/<name>_sweep`), checking every job first and writing `plan.jsonl`. Raises
+/// `ScenarioError` with every problem.
 #[pyfunction]
 #[pyo3(signature = (scenario, sets, seeds = "1", out = None))]
 pub fn sweep_plan(
@@ -57,7 +57,7 @@ pub fn sweep_plan(
     sets: &Bound<'_, PyDict>,
     seeds: &str,
     out: Option<PathBuf>,
-) -> PyResult<(PathBuf, Vec<String>)> {
+) -> PyResult<SweepPlan> {
     let args = set_args(sets)?;
     let parsed = args
         .iter()
@@ -74,65 +74,98 @@ pub fn sweep_plan(
     let file = dir.join("plan.jsonl");
     write_plan(&plan, &seeds, &file).map_err(os_error)?;
     let text = std::fs::read_to_string(&file).map_err(os_error)?;
-    Ok((dir, text.lines().map(String::from).collect()))
+    Ok(SweepPlan {
+        plan,
+        out: dir,
+        lines: text.lines().map(String::from).collect(),
+    })
 }
 
-/// Opens the journal of the sweep planned in `out` (emptied unless `resume`): the indices of
-/// the jobs still to run.
-#[pyfunction]
-pub fn sweep_open(out: PathBuf, resume: bool) -> PyResult<Vec<usize>> {
-    let (plan, _) = read_plan(&out.join("plan.jsonl")).map_err(os_error)?;
-    let (_, previous) = Journal::open(&out, &plan, resume).map_err(os_error)?;
-    Ok((0..plan.jobs.len())
-        .filter(|&i| previous[i].is_none())
-        .collect())
-}
-
-/// Runs the jobs of the sweep in `out` that its journal lacks on the Rust pool (`jobs` at a
-/// time, 0: one a core), as `omniloop sweep` does, each one's record appended to the journal and
-/// handed to `done(record_json)` as it ends. Ctrl-C stops taking jobs (the finished are kept).
-#[pyfunction]
-#[pyo3(signature = (out, jobs = 0, renderer = "cpu", keep_runs = false, done = None))]
-pub fn sweep_local(
-    py: Python<'_>,
+/// A checked sweep and its folder: what `sweep_plan` gives and the sweep's steps take.
+#[pyclass(module = "omniloop", name = "SweepPlan", frozen)]
+pub struct SweepPlan {
+    plan: Plan,
+    /// The sweep's folder.
+    #[pyo3(get)]
     out: PathBuf,
-    jobs: usize,
-    renderer: &str,
-    keep_runs: bool,
-    done: Option<Py<PyAny>>,
-) -> PyResult<()> {
-    let choice = renderer_choice(renderer)?;
-    let (plan, _) = read_plan(&out.join("plan.jsonl")).map_err(os_error)?;
-    let (journal, previous) = Journal::open(&out, &plan, true).map_err(os_error)?;
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut options = SweepOptions::new(jobs, cores, choice);
-    options.keep_runs = keep_runs.then(|| out.join("runs"));
-    let stop = AtomicBool::new(false);
-    let problem: Mutex<Option<PyErr>> = Mutex::new(None);
-    py.detach(|| {
-        run_remaining(&plan, &options, &stop, previous, |o: &Outcome| {
-            let job = &plan.jobs[o.job];
-            let record = Record::new(o, &job.dir_name(&plan.sets), job.seed);
-            let written = journal.record(&record).map_err(os_error);
-            let called = Python::attach(|py| {
-                py.check_signals()?;
-                if let Some(f) = &done {
-                    f.call1(py, (record.line().trim_end(),))?;
+    /// The lines of `plan.jsonl`, the header first.
+    #[pyo3(get)]
+    lines: Vec<String>,
+}
+
+#[pymethods]
+impl SweepPlan {
+    /// Opens the sweep's journal (emptied unless `resume`): the indices of the jobs still to
+    /// run.
+    fn open(&self, resume: bool) -> PyResult<Vec<usize>> {
+        let (_, previous) = Journal::open(&self.out, &self.plan, resume).map_err(os_error)?;
+        Ok((0..self.plan.jobs.len())
+            .filter(|&i| previous[i].is_none())
+            .collect())
+    }
+
+    /// Runs the jobs the journal lacks on the Rust pool (`jobs` at a time, 0: one a core), as
+    /// `omniloop sweep` does, each one's record appended to the journal and handed to
+    /// `done(record_json)` as it ends. Ctrl-C stops taking jobs (the finished are kept).
+    #[pyo3(signature = (jobs = 0, renderer = "cpu", keep_runs = false, done = None))]
+    fn run_local(
+        &self,
+        py: Python<'_>,
+        jobs: usize,
+        renderer: &str,
+        keep_runs: bool,
+        done: Option<Py<PyAny>>,
+    ) -> PyResult<()> {
+        let choice = renderer_choice(renderer)?;
+        let plan = &self.plan;
+        let (journal, previous) = Journal::open(&self.out, plan, true).map_err(os_error)?;
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let mut options = SweepOptions::new(jobs, cores, choice);
+        options.keep_runs = keep_runs.then(|| self.out.join("runs"));
+        let stop = AtomicBool::new(false);
+        let problem: Mutex<Option<PyErr>> = Mutex::new(None);
+        py.detach(|| {
+            run_remaining(plan, &options, &stop, previous, |o: &Outcome| {
+                let job = &plan.jobs[o.job];
+                let record = Record::new(o, &job.dir_name(&plan.sets), job.seed);
+                let written = journal.record(&record).map_err(os_error);
+                let called = Python::attach(|py| {
+                    py.check_signals()?;
+                    if let Some(f) = &done {
+                        f.call1(py, (record.line().trim_end(),))?;
+                    }
+                    Ok::<(), PyErr>(())
+                });
+                if let Err(e) = written.and(called) {
+                    stop.store(true, Ordering::SeqCst);
+                    problem
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .get_or_insert(e);
                 }
-                Ok::<(), PyErr>(())
-            });
-            if let Err(e) = written.and(called) {
-                stop.store(true, Ordering::SeqCst);
-                problem
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .get_or_insert(e);
-            }
-        })
-    });
-    match problem.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        Some(e) => Err(e),
-        None => Ok(()),
+            })
+        });
+        match problem.into_inner().unwrap_or_else(|p| p.into_inner()) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// Writes `sweep.csv`, `sweep.md` (after `header`) and `sweep.png` (`plot`'s metric) from
+    /// the journal; the rows as JSON (the columns of `sweep.csv`).
+    #[pyo3(signature = (plot = "success_rate", header = ""))]
+    fn report(&self, plot: &str, header: &str) -> PyResult<String> {
+        let plan = &self.plan;
+        let journal = self.out.join(omniloop::sweep::journal::JOURNAL);
+        let outcomes = if journal.exists() {
+            read_journal(&journal, plan).map_err(os_error)?
+        } else {
+            vec![None; plan.jobs.len()]
+        };
+        let (_, rows) = write_report(&self.out, plan, &outcomes, plot, header)
+            .map_err(|e| os_error(format!("{e:#}")))?;
+        let json: Vec<serde_json::Value> = rows.iter().map(|r| row_json(plan, r)).collect();
+        serde_json::to_string(&json).map_err(|e| PyRuntimeError::new_err(e.to_string()))
     }
 }
 
@@ -169,22 +202,4 @@ pub fn run_planned_job(
         .line()
         .trim_end()
         .to_string())
-}
-
-/// Writes `sweep.csv`, `sweep.md` (after `header`) and `sweep.png` (`plot`'s metric) of the
-/// sweep in `out` from its journal; its rows as JSON (the columns of `sweep.csv`).
-#[pyfunction]
-#[pyo3(signature = (out, plot = "success_rate", header = ""))]
-pub fn sweep_report(out: PathBuf, plot: &str, header: &str) -> PyResult<String> {
-    let (plan, _) = read_plan(&out.join("plan.jsonl")).map_err(os_error)?;
-    let journal = out.join(omniloop::sweep::journal::JOURNAL);
-    let outcomes = if journal.exists() {
-        read_journal(&journal, &plan).map_err(os_error)?
-    } else {
-        vec![None; plan.jobs.len()]
-    };
-    let (_, rows) = write_report(&out, &plan, &outcomes, plot, header)
-        .map_err(|e| os_error(format!("{e:#}")))?;
-    let json: Vec<serde_json::Value> = rows.iter().map(|r| row_json(&plan, r)).collect();
-    serde_json::to_string(&json).map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
