@@ -30,7 +30,13 @@ fn main() {
             mcap: Some(file.clone()),
             live: None,
         };
-        let log = FoxgloveLog::create(&sinks, &["omni".to_string()]).unwrap();
+        let log = FoxgloveLog::create(
+            &sinks,
+            &[omniloop::viewing::RobotCameras {
+                robot: None,
+                sensors: vec!["omni".to_string()],
+            }],
+        ).unwrap();
         let options = RunOptions {
             observers: vec![log.observer()],
             ..options

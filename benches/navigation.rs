@@ -88,7 +88,7 @@ fn cycle_times(s: &Scenario) -> (Vec<f64>, omniloop::Summary) {
         .software(move |c: &RobotConfig| {
             Ok(Timed {
                 robot: Robot::new(c)?,
-                times_ms: shared,
+                times_ms: shared.clone(),
             })
         })
         .run()

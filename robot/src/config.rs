@@ -233,6 +233,8 @@ pub struct StereoRig {
 /// Everything the robot's software is built from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotConfig {
+    /// Its name (`robot` for the one robot of a scenario; a team's robots each their own).
+    pub name: String,
     /// The pose the robot is told it starts at (world frame): the origin of its dead reckoning.
     pub start: Isometry2<f64>,
     /// Its body.
@@ -267,6 +269,7 @@ impl RobotConfig {
     #[cfg(test)]
     pub(crate) fn for_tests() -> Self {
         Self {
+            name: "robot".to_string(),
             start: Isometry2::identity(),
             body: BodySpec {
                 radius_mm: 90.0,

@@ -91,6 +91,7 @@ mod tests {
 
     fn config() -> RobotConfig {
         RobotConfig {
+            name: "robot".to_string(),
             start: Isometry2::new(Vector2::new(100.0, -50.0), 0.0),
             cameras: vec!["cam".into()],
             ..RobotConfig::for_tests()

@@ -407,6 +407,7 @@ impl Layout {
                 base_mm: b.bottom_mm,
                 height_mm: b.top_mm,
                 rgb: b.rgb_a,
+                top_rgb: None,
                 board: Some(i),
             });
         }

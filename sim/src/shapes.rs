@@ -92,6 +92,8 @@ pub struct Solid {
     pub height_mm: f64,
     /// Colour.
     pub rgb: Rgb,
+    /// Colour of its top face when it differs (a robot's team marking).
+    pub top_rgb: Option<Rgb>,
     /// Index of the stripe board in [`crate::Layout::boards`] it carries, if any.
     pub board: Option<usize>,
 }
@@ -104,8 +106,15 @@ impl Solid {
             base_mm: 0.0,
             height_mm,
             rgb,
+            top_rgb: None,
             board: None,
         }
+    }
+
+    /// The same solid with its top face painted `top_rgb` (a robot's marking).
+    pub fn with_top(mut self, top_rgb: Option<Rgb>) -> Self {
+        self.top_rgb = top_rgb;
+        self
     }
 }
 

@@ -36,6 +36,9 @@ pub struct RobotBodySpec {
     pub angular_accel_limit_rad_s2: f64,
     /// Body colour (for rendering).
     pub rgb: Rgb,
+    /// Colour of its top face, a team's marking that other robots' cameras see (for
+    /// rendering; the body colour when `None`).
+    pub marking_rgb: Option<Rgb>,
     /// Its drive when it is a differential-drive robot (then it takes the forward part of its
     /// commands and their rotation rate; the acceleration limits above are not used).
     pub differential: Option<DifferentialDrive>,
@@ -57,12 +60,18 @@ pub struct RobotState {
 pub struct RobotStats {
     /// How many times it started touching a wall, cube, pillar or robot.
     pub contacts: u32,
+    /// Of those, how many were with a wall, cube, pillar or board.
+    pub solid_contacts: u32,
+    /// Of those, how many were with another robot.
+    pub robot_contacts: u32,
     /// Largest |dv| / dt between two physics steps.
     pub peak_accel_mm_s2: f64,
     /// Largest speed.
     pub peak_speed_mm_s: f64,
     /// Smallest distance from its edge to a solid or another robot.
     pub min_clearance_mm: f64,
+    /// Smallest distance from its edge to another robot's edge (infinite alone).
+    pub min_robot_clearance_mm: f64,
     /// Length of the path its centre travelled.
     pub path_length_mm: f64,
 }
@@ -71,9 +80,12 @@ impl RobotStats {
     fn new() -> Self {
         Self {
             contacts: 0,
+            solid_contacts: 0,
+            robot_contacts: 0,
             peak_accel_mm_s2: 0.0,
             peak_speed_mm_s: 0.0,
             min_clearance_mm: f64::INFINITY,
+            min_robot_clearance_mm: f64::INFINITY,
             path_length_mm: 0.0,
         }
     }
@@ -112,6 +124,8 @@ pub struct World {
     owners: Vec<(ColliderHandle, Owner)>,
     physics_step_s: f64,
     steps: u64,
+    /// Touches between two robots (their indices, the lower first), each once.
+    robot_touches: Vec<(usize, usize)>,
 }
 
 fn vec(v: Vector2<f64>) -> Vector {
@@ -202,6 +216,7 @@ impl World {
             owners,
             physics_step_s,
             steps: 0,
+            robot_touches: Vec::new(),
         })
     }
 
@@ -281,33 +296,52 @@ impl World {
         self.robots[i].stats
     }
 
+    /// Every time two robots started touching, once each: the two robots' indices, the
+    /// lower first.
+    pub fn robot_touches(&self) -> &[(usize, usize)] {
+        &self.robot_touches
+    }
+
     /// Distance from robot `i`'s edge to the nearest solid or other robot.
     pub fn clearance_mm(&self, i: usize) -> f64 {
+        let (solids, robots) = self.clearances_mm(i);
+        solids.min(robots)
+    }
+
+    /// Distances from robot `i`'s edge to the nearest solid and to the nearest other robot's
+    /// edge (infinite where there is none).
+    fn clearances_mm(&self, i: usize) -> (f64, f64) {
         let me = self.robot_state(i);
         let p = Point2::from(me.pose.translation.vector);
         let r = self.robots[i].spec.radius_mm;
-        let mut best = f64::INFINITY;
+        let mut solids = f64::INFINITY;
         for s in &self.solids {
-            best = best.min(s.shape.distance_mm(p) - r);
+            solids = solids.min(s.shape.distance_mm(p) - r);
         }
+        let mut robots = f64::INFINITY;
         for (j, other) in self.robots.iter().enumerate() {
             if j != i {
                 let q = self.robot_state(j).pose.translation.vector;
-                best = best.min((q - p.coords).norm() - other.spec.radius_mm - r);
+                robots = robots.min((q - p.coords).norm() - other.spec.radius_mm - r);
             }
         }
-        best
+        (solids, robots)
+    }
+
+    /// What collider `h` belongs to.
+    fn owner(&self, h: ColliderHandle) -> Option<Owner> {
+        self.owners.iter().find(|(o, _)| *o == h).map(|(_, owner)| *owner)
     }
 
     /// Gap between robot `i`'s disc and the collider `other`.
     fn gap_mm(&self, i: usize, other: ColliderHandle) -> f64 {
         let p = Point2::from(self.robot_state(i).pose.translation.vector);
         let r = self.robots[i].spec.radius_mm;
-        match self.owners.iter().find(|(h, _)| *h == other) {
-            Some((_, Owner::Solid(k))) => self.solids[*k].shape.distance_mm(p) - r,
-            Some((_, Owner::Robot(j))) => {
-                let q = self.robot_state(*j).pose.translation.vector;
-                (q - p.coords).norm() - r - self.robots[*j].spec.radius_mm
+        match self.owner(other) {
+            Some(Owner::Solid(k)) => self.solids[k].shape.distance_mm(p) - r,
+            Some(Owner::Robot(j)) => {
+                let q = self.robot_state(j).pose.translation.vector;
+                (q - p.coords).norm() - r - self.robots[j].spec.radius_mm
             }
             None => f64::INFINITY,
         }
@@ -327,6 +361,7 @@ impl World {
                     spec.height_mm,
                     spec.rgb,
                 )
+                .with_top(spec.marking_rgb)
             })
             .collect()
     }
@@ -391,13 +426,14 @@ impl World {
 
         for (i, (v0, p0)) in before.into_iter().enumerate() {
             let s = self.robot_state(i);
-            let clearance = self.clearance_mm(i);
+            let (to_solids, to_robots) = self.clearances_mm(i);
             let st = &mut self.robots[i].stats;
             let a = (s.velocity_mm_s - v0).norm() / dt;
             st.peak_accel_mm_s2 = st.peak_accel_mm_s2.max(a);
             st.peak_speed_mm_s = st.peak_speed_mm_s.max(s.velocity_mm_s.norm());
             st.path_length_mm += (s.pose.translation.vector - p0).norm();
-            st.min_clearance_mm = st.min_clearance_mm.min(clearance);
+            st.min_clearance_mm = st.min_clearance_mm.min(to_solids.min(to_robots));
+            st.min_robot_clearance_mm = st.min_robot_clearance_mm.min(to_robots);
         }
         while let Ok(event) = self.collisions.try_recv() {
             let (c1, c2, started) = match event {
@@ -429,7 +465,19 @@ impl World {
             for (other, touching) in pairs {
                 let now = self.gap_mm(i, other) <= TOUCH_TOLERANCE_MM;
                 if now && !touching {
-                    self.robots[i].stats.contacts += 1;
+                    let owner = self.owner(other);
+                    let st = &mut self.robots[i].stats;
+                    st.contacts += 1;
+                    match owner {
+                        Some(Owner::Robot(j)) => {
+                            st.robot_contacts += 1;
+                            // The other robot sees the same touch; count it from the lower index.
+                            if i < j {
+                                self.robot_touches.push((i, j));
+                            }
+                        }
+                        _ => st.solid_contacts += 1,
+                    }
                 }
                 checked.push((other, now));
             }
@@ -451,6 +499,7 @@ mod tests {
             accel_limit_mm_s2: 300.0,
             angular_accel_limit_rad_s2: 10.0,
             rgb: Rgb([20, 20, 20]),
+            marking_rgb: None,
             differential: None,
         }
     }

@@ -11,9 +11,9 @@ use omniloop_sim::RendererChoice;
 use std::path::Path;
 use std::time::Instant;
 
-/// Builds the robot's software from what the robot is told.
+/// Builds a robot's software from what the robot is told.
 type SoftwareFactory<'a> =
-    Box<dyn FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError> + 'a>;
+    Box<dyn FnMut(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError> + 'a>;
 
 /// A run of a scenario, set up step by step: the robot's software (the built-in stack unless
 /// told otherwise), the renderer, the seed, a progress callback.
@@ -51,6 +51,8 @@ pub struct Runner<'a> {
     scenario: Scenario,
     options: RunOptions,
     software: SoftwareFactory<'a>,
+    /// Software for robots of a team by name, over `software`.
+    named: Vec<(String, SoftwareFactory<'a>)>,
     progress: Box<dyn FnMut(u64, u64) + 'a>,
     notice: Box<dyn FnOnce(&str) + 'a>,
 }
@@ -63,20 +65,39 @@ impl<'a> Runner<'a> {
             scenario: scenario.clone(),
             options: RunOptions::default(),
             software: Box::new(builtin_software),
+            named: Vec::new(),
             progress: Box::new(|_, _| {}),
             notice: Box::new(|_| {}),
         }
     }
 
-    /// Runs the robot software that `build` makes from what the robot is told (its start,
-    /// body, cameras with their calibrations, goal and map; never the world).
+    /// Runs the robot software that `build` makes from what the robot is told (its name,
+    /// start, body, cameras with their calibrations, goal and map; never the world): on every
+    /// robot of a team that [`Runner::software_for`] does not name.
     pub fn software<R: RobotSoftware + 'static>(
         mut self,
-        build: impl FnOnce(&RobotConfig) -> Result<R, RobotError> + 'a,
+        mut build: impl FnMut(&RobotConfig) -> Result<R, RobotError> + 'a,
     ) -> Self {
         self.software = Box::new(move |config: &RobotConfig| {
             build(config).map(|r| Box::new(r) as Box<dyn RobotSoftware>)
         });
+        self
+    }
+
+    /// Runs the software `build` makes on the robot of the team called `robot` (the others
+    /// keep the built-in stack, or [`Runner::software`]'s); a name that is no robot's fails
+    /// the run before it starts.
+    pub fn software_for<R: RobotSoftware + 'static>(
+        mut self,
+        robot: &str,
+        mut build: impl FnMut(&RobotConfig) -> Result<R, RobotError> + 'a,
+    ) -> Self {
+        self.named.push((
+            robot.to_string(),
+            Box::new(move |config: &RobotConfig| {
+                build(config).map(|r| Box::new(r) as Box<dyn RobotSoftware>)
+            }),
+        ));
         self
     }
 
@@ -117,10 +138,26 @@ impl<'a> Runner<'a> {
 
     /// Runs the scenario to its end by its experiment's procedure.
     pub fn run(self) -> Result<RunOutput, RunError> {
+        let names = self.scenario.robot_names();
+        for (name, _) in &self.named {
+            if !names.contains(name) {
+                return Err(RunError::Team(format!(
+                    "software for robot {name:?}: scenario {:?} has no robot of that name (its \
+                     robots: {})",
+                    self.scenario.name,
+                    names.join(", ")
+                )));
+            }
+        }
+        let (mut software, mut named) = (self.software, self.named);
+        let build = move |config: &RobotConfig| match named.iter_mut().find(|(n, _)| *n == config.name) {
+            Some((_, f)) => f(config),
+            None => software(config),
+        };
         run_scenario_with(
             &self.scenario,
             &self.options,
-            self.software,
+            build,
             self.notice,
             self.progress,
         )
@@ -144,17 +181,11 @@ pub fn run_scenario(
 pub fn run_scenario_with(
     scenario: &Scenario,
     options: &RunOptions,
-    software: impl FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
+    software: impl FnMut(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
     notice: impl FnOnce(&str),
     mut progress: impl FnMut(u64, u64),
 ) -> Result<RunOutput, RunError> {
     let start = Instant::now();
-    if let Some(dir) = &options.frames_dir {
-        std::fs::create_dir_all(dir).map_err(|e| RunError::Frame {
-            path: dir.clone(),
-            source: image::ImageError::IoError(e),
-        })?;
-    }
     let setup = setup_of(scenario).map_err(|p| RunError::Scenario(p.to_string()))?;
     let mut options = options.clone();
     options.takes_frames |= setup.as_ref().is_some_and(|e| e.takes_frames());

@@ -31,7 +31,7 @@ impl Session {
     pub fn new(
         scenario: &Scenario,
         options: &RunOptions,
-        software: impl FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
+        software: impl FnMut(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
         notice: impl FnOnce(&str),
     ) -> Result<Self, RunError> {
         let started = Instant::now();

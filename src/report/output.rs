@@ -3,7 +3,7 @@
 
 use super::topview::{FigureError, Marker, Panel, PathLayer, render_panels};
 use crate::run::RunOutput;
-use crate::run::record::{write_estimates_jsonl, write_trajectory_csv};
+use crate::run::record::{write_estimates_jsonl, write_team_trajectory_csv, write_trajectory_csv};
 use crate::scenario::Scenario;
 use anyhow::Context;
 use nalgebra::Point2;
@@ -24,20 +24,52 @@ pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Re
     let text = serde_json::to_string_pretty(&out.summary)?;
     std::fs::write(&summary_path, text + "\n")
         .with_context(|| format!("writing {}", summary_path.display()))?;
-    let traj_path = dir.join("trajectory.csv");
-    let f = File::create(&traj_path).with_context(|| format!("writing {}", traj_path.display()))?;
-    write_trajectory_csv(&out.trajectory, BufWriter::new(f))
-        .with_context(|| format!("writing {}", traj_path.display()))?;
-    let est_path = dir.join("estimates.jsonl");
-    let f = File::create(&est_path).with_context(|| format!("writing {}", est_path.display()))?;
-    write_estimates_jsonl(&out.trajectory, &out.estimates, BufWriter::new(f))
-        .with_context(|| format!("writing {}", est_path.display()))?;
+    if out.robots.is_empty() {
+        write_records(dir, &out.trajectory, &out.estimates)?;
+    } else {
+        write_team_records(dir, out)?;
+    }
     draw_run_topview(&dir.join("topview.png"), scenario, out)?;
     for f in &out.files {
         let path = dir.join(&f.name);
         std::fs::write(&path, &f.bytes).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
+}
+
+/// Writes a robot's `trajectory.csv` and `estimates.jsonl` into `dir`.
+fn write_records(
+    dir: &Path,
+    trajectory: &[crate::run::TrajectoryRow],
+    estimates: &[omniloop_robot::Estimates],
+) -> anyhow::Result<()> {
+    let traj_path = dir.join("trajectory.csv");
+    let f = File::create(&traj_path).with_context(|| format!("writing {}", traj_path.display()))?;
+    write_trajectory_csv(trajectory, BufWriter::new(f))
+        .with_context(|| format!("writing {}", traj_path.display()))?;
+    let est_path = dir.join("estimates.jsonl");
+    let f = File::create(&est_path).with_context(|| format!("writing {}", est_path.display()))?;
+    write_estimates_jsonl(trajectory, estimates, BufWriter::new(f))
+        .with_context(|| format!("writing {}", est_path.display()))
+}
+
+/// A team's records: every robot's `robots/NAME/trajectory.csv` and `estimates.jsonl`, and
+/// all of them in one `trajectory.csv` with the robot's name in a first column `robot`.
+fn write_team_records(dir: &Path, out: &RunOutput) -> anyhow::Result<()> {
+    for r in &out.robots {
+        let own = dir.join("robots").join(&r.name);
+        std::fs::create_dir_all(&own).with_context(|| format!("creating {}", own.display()))?;
+        write_records(&own, &r.trajectory, &r.estimates)?;
+    }
+    let traj_path = dir.join("trajectory.csv");
+    let f = File::create(&traj_path).with_context(|| format!("writing {}", traj_path.display()))?;
+    let rows: Vec<(&str, &[crate::run::TrajectoryRow])> = out
+        .robots
+        .iter()
+        .map(|r| (r.name.as_str(), r.trajectory.as_slice()))
+        .collect();
+    write_team_trajectory_csv(&rows, BufWriter::new(f))
+        .with_context(|| format!("writing {}", traj_path.display()))
 }
 
 /// The top view of one run: world, true path, estimated path, other robots, start and goal.
@@ -55,6 +87,9 @@ pub fn run_topview_image(
     out: &RunOutput,
     width: u32,
 ) -> Result<image::RgbImage, FigureError> {
+    if !out.robots.is_empty() {
+        return team_topview_image(name, scenario, out, width);
+    }
     let truth: Vec<Point2<f64>> = out
         .trajectory
         .iter()
@@ -143,6 +178,96 @@ pub fn run_topview_image(
         markers,
         spots: Vec::new(),
         grid: out.map.as_ref(),
+    };
+    render_panels(name, &[panel], width)
+}
+
+/// The colours of a team's robots in figures, in the robots' order (then again).
+pub const ROBOT_COLOURS: [[u8; 3]; 12] = [
+    [31, 119, 180],
+    [255, 127, 14],
+    [44, 160, 44],
+    [214, 39, 40],
+    [148, 103, 189],
+    [140, 86, 75],
+    [227, 119, 194],
+    [127, 127, 127],
+    [188, 189, 34],
+    [23, 190, 207],
+    [0, 0, 128],
+    [128, 0, 0],
+];
+
+/// The top view of a team's run: each robot's true path in its colour, from its start (a
+/// circle of its size, named) to where it is (a filled one), its goal a circle of the goal's
+/// tolerance; the other robots' paths in magenta.
+fn team_topview_image(
+    name: &str,
+    scenario: &Scenario,
+    out: &RunOutput,
+    width: u32,
+) -> Result<image::RgbImage, FigureError> {
+    let paths: Vec<Vec<Point2<f64>>> = out
+        .robots
+        .iter()
+        .map(|r| r.trajectory.iter().map(|p| Point2::new(p.x_mm, p.y_mm)).collect())
+        .collect();
+    let mut layers = Vec::new();
+    for (k, p) in out.other_paths.iter().enumerate() {
+        layers.push(PathLayer {
+            label: format!("scripted {}", k + 1),
+            rgb: [200, 40, 160],
+            points: p,
+            dots: false,
+            discs: None,
+        });
+    }
+    let mut markers = Vec::new();
+    for (k, (robot, path)) in out.robots.iter().zip(&paths).enumerate() {
+        let rgb = ROBOT_COLOURS[k % ROBOT_COLOURS.len()];
+        let member = scenario.member(k);
+        let radius_mm = member.robot.radius_mm;
+        layers.push(PathLayer {
+            label: robot.name.clone(),
+            rgb,
+            points: path,
+            dots: false,
+            discs: None,
+        });
+        markers.push(Marker {
+            at: member.start().point(),
+            radius_mm,
+            rgb,
+            label: robot.name.clone(),
+        });
+        if let Some(g) = &member.goal {
+            markers.push(Marker {
+                at: g.point(),
+                radius_mm: g.tolerance_mm,
+                rgb,
+                label: String::new(),
+            });
+        }
+        if let Some(end) = path.last() {
+            markers.push(Marker {
+                at: *end,
+                radius_mm: 0.5 * radius_mm,
+                rgb,
+                label: String::new(),
+            });
+        }
+    }
+    let panel = Panel {
+        title: format!(
+            "{}  ({} robots: start named, goal circled, path to where each is)",
+            scenario.name,
+            out.robots.len()
+        ),
+        layout: &scenario.world,
+        paths: layers,
+        markers,
+        spots: Vec::new(),
+        grid: None,
     };
     render_panels(name, &[panel], width)
 }

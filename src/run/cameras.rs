@@ -9,7 +9,7 @@ use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
 use omniloop_sim::optics::Optics;
 use omniloop_sim::render::BatchHandle;
 use omniloop_sim::render::effects::{exposure_poses, pose_after};
-use omniloop_sim::{Renderer, RendererChoice, Scene, Sensor, SensorNoise, World};
+use omniloop_sim::{Renderer, RendererChoice, RobotState, Scene, Sensor, SensorNoise, World};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use std::collections::VecDeque;
@@ -193,27 +193,28 @@ impl Cameras {
         self.renderer.name()
     }
 
-    /// Renders every live camera at robot 0's true pose, with its noise.
-    pub fn capture(&mut self, world: &World) -> Result<(), RunError> {
-        self.capture_some(world, None)
+    /// Renders every live camera of robot `body` of `world` at its true pose, with its noise.
+    pub fn capture(&mut self, world: &World, body: usize) -> Result<(), RunError> {
+        let scene = Scene::of_world(world);
+        self.capture_some(&scene, world.robot_state(body), world.time_s(), None)
     }
 
-    /// Renders the live cameras named in `wanted` (all live ones with `None`) at robot 0's
-    /// true pose, with their noise; the others give no frame this cycle. With a frame
-    /// latency, the frames rendered now arrive that much later (taken `offset_s` into this
-    /// cycle, the robot moved on along its velocity and the pan units on toward their goals;
-    /// the rest of the world as at the cycle's start), and the capture that arrives now is the
-    /// one the software gets; a lost frame never arrives.
+    /// Renders the live cameras named in `wanted` (all live ones with `None`) in `scene` at
+    /// `now`, the robot that carries them in `state` (its true pose and velocity), with their
+    /// noise; the others give no frame this cycle. With a frame latency, the frames rendered
+    /// now arrive that much later (taken `offset_s` into this cycle, the robot moved on along
+    /// its velocity and the pan units on toward their goals; the rest of the world as at the
+    /// cycle's start), and the capture that arrives now is the one the software gets; a lost
+    /// frame never arrives.
     pub fn capture_some(
         &mut self,
-        world: &World,
+        scene: &Scene,
+        mut state: RobotState,
+        now: f64,
         wanted: Option<&[String]>,
     ) -> Result<(), RunError> {
-        let mut state = world.robot_state(0);
         let offset = self.delivery.offset_s;
         state.pose = pose_after(&state.pose, state.velocity_mm_s, state.omega_rad_s, offset);
-        let scene = Scene::of_world(world);
-        let now = world.time_s();
         let mut images = Vec::with_capacity(self.cameras.len());
         for c in &mut self.cameras {
             let take = c.live && wanted.is_none_or(|w| w.contains(&c.sensor.name));
@@ -231,7 +232,7 @@ impl Cameras {
                 let sensor = turned.as_ref().unwrap_or(&c.sensor);
                 Some(
                     self.renderer
-                        .render_exposed(&scene, sensor, &poses, Some(&mut c.noise))?,
+                        .render_exposed(scene, sensor, &poses, Some(&mut c.noise))?,
                 )
             } else {
                 None

@@ -39,6 +39,18 @@ pub enum RunError {
         /// The cycles it ran.
         cycles: u64,
     },
+    /// Something failed in one robot of a team.
+    #[error("robot {robot:?}: {message}")]
+    InRobot {
+        /// The robot's name.
+        robot: String,
+        /// What failed.
+        message: String,
+    },
+    /// A team's robots and the software asked for them do not match (a name that is no
+    /// robot's, a robot left without software).
+    #[error("{0}")]
+    Team(String),
     /// A frame could not be written.
     #[error("writing frame {path}: {source}")]
     Frame {

@@ -3,6 +3,7 @@
 //! the other robots ([`pilot`]), the truth-side scores ([`score`]) and the records of a run
 //! ([`record`]). It never calls up into an experiment: an experiment drives it.
 
+pub mod agent;
 pub mod cameras;
 pub mod column_calibration;
 pub mod error;
@@ -14,7 +15,9 @@ pub mod score;
 pub mod simulation;
 
 pub use error::RunError;
-pub use record::{Summary, TrajectoryRow};
+pub use agent::{Agent, Truth};
+pub use record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};
 pub use simulation::{
-    OutputFile, RunOptions, RunOutput, Simulation, Truth, builtin_software, render_snapshot,
+    OutputFile, RobotOutput, RunOptions, RunOutput, Simulation, builtin_software,
+    render_snapshot, straight_line_time_s,
 };

@@ -12,19 +12,28 @@ use std::sync::{Arc, Mutex};
 pub struct CycleView<'a> {
     /// The cycle's number, from 0.
     pub cycle: u64,
+    /// Every robot with software: the one robot, or a team's in the scenario's order.
+    pub robots: &'a [RobotCycle<'a>],
+}
+
+/// One robot's control cycle.
+pub struct RobotCycle<'a> {
+    /// Its name.
+    pub name: &'a str,
     /// Its row of `trajectory.csv`: time, true pose and velocity, command, estimated pose.
     pub row: &'a TrajectoryRow,
-    /// What the robot's software believed (its line of `estimates.jsonl`).
+    /// What its software believed (its line of `estimates.jsonl`).
     pub estimates: &'a Estimates,
     /// The frames it got this cycle, stamped with when they were taken.
-    pub frames: &'a [Frame<'a>],
+    pub frames: Vec<Frame<'a>>,
 }
 
 /// Something that watches a run: a log, a live view.
 pub trait CycleObserver: Send {
-    /// The world before the first cycle (its static scene).
-    fn start(&mut self, world: &World) {
-        let _ = world;
+    /// The world before the first cycle (its static scene) and the names of the robots with
+    /// software (their bodies are the world's first robots, in this order).
+    fn start(&mut self, world: &World, robots: &[String]) {
+        let _ = (world, robots);
     }
 
     /// One cycle, after it was recorded.

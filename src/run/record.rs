@@ -61,6 +61,24 @@ pub fn write_trajectory_csv(rows: &[TrajectoryRow], mut w: impl Write) -> std::i
     Ok(())
 }
 
+/// Writes a team's trajectories as one CSV: `robot` and then the columns of
+/// [`TRAJECTORY_HEADER`], each robot's rows in turn (in the robots' order).
+pub fn write_team_trajectory_csv(
+    robots: &[(&str, &[TrajectoryRow])],
+    mut w: impl Write,
+) -> std::io::Result<()> {
+    writeln!(w, "robot,{TRAJECTORY_HEADER}")?;
+    for (name, rows) in robots {
+        let mut one = Vec::new();
+        write_trajectory_csv(rows, &mut one)?;
+        let text = String::from_utf8_lossy(&one);
+        for line in text.lines().skip(1) {
+            writeln!(w, "{name},{line}")?;
+        }
+    }
+    Ok(())
+}
+
 /// Reads a number that JSON wrote as `null` because it was infinite.
 fn null_as_infinity<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
@@ -125,10 +143,98 @@ pub struct Summary {
     /// goal's `checkpoint_radius_mm` of a checkpoint), degrees.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub checkpoint_heading_error_deg: Option<Vec<f64>>,
+    /// A team's own figures (`[[robots]]`): arrivals, contacts by what was touched, the least
+    /// clearance between two robots, when the last arrived against the straight-line time.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub team: Option<TeamFigures>,
+    /// A team's robots, a row each, in the scenario's order.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub robots: Option<Vec<RobotSummary>>,
     /// The experiment's own metrics (`turn_onset_mm`, `overshoot_mm` of E1, `places` of E2,
     /// ...), written as keys of the summary beside the others.
     #[serde(flatten)]
     pub experiment: serde_json::Map<String, serde_json::Value>,
+}
+
+/// The figures of one robot of a team (a row of `summary.json`'s `robots`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RobotSummary {
+    /// Its name.
+    pub name: String,
+    /// What drove it.
+    pub controller: String,
+    /// Whether it reached its goal (false without one).
+    pub reached_goal: bool,
+    /// When it did.
+    pub time_to_goal_s: Option<f64>,
+    /// How many times it started touching anything.
+    pub contacts: u32,
+    /// Of those, walls, cubes, pillars and boards.
+    pub solid_contacts: u32,
+    /// Of those, other robots.
+    pub robot_contacts: u32,
+    /// Least distance from its edge to anything (`null`: no step ran).
+    #[serde(deserialize_with = "null_as_infinity")]
+    pub min_clearance_mm: f64,
+    /// Least distance from its edge to another robot's edge (`null`: none was there).
+    #[serde(deserialize_with = "null_as_infinity")]
+    pub min_robot_clearance_mm: f64,
+    /// Length of the path its centre travelled.
+    pub path_length_mm: f64,
+    /// Length of the straight lines from its start through its waypoints to its goal.
+    pub straight_mm: Option<f64>,
+    /// Its largest speed.
+    pub peak_speed_mm_s: f64,
+    /// Its largest acceleration between two physics steps.
+    pub peak_accel_mm_s2: f64,
+    /// Median error of its free distances (with the free-space stage).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub freespace_error_mm: Option<f64>,
+    /// Median error of its pose estimate.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub pose_error_mm: Option<f64>,
+    /// With waypoints: targets reached.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub targets_reached: Option<usize>,
+    /// With localization in the loop: fixes used.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub localization_fixes: Option<usize>,
+    /// With a planner: whether it found its goal unreachable.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub unreachable: Option<bool>,
+    /// With a planner: how often its progress watchdog fired.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub watchdog_fired: Option<usize>,
+}
+
+/// A team's figures (`summary.json`'s `team`; in a sweep's table as `team.KEY` columns).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TeamFigures {
+    /// Robots with software.
+    pub robots: usize,
+    /// Robots with a goal.
+    pub with_goal: usize,
+    /// Robots that reached their goal.
+    pub arrived: usize,
+    /// Whether every robot with a goal reached it.
+    pub all_arrived: bool,
+    /// When the last robot with a goal arrived (`null` while one has not).
+    pub last_arrival_s: Option<f64>,
+    /// The longest straight-line time of a robot with a goal: its straight lines at its top
+    /// speed, accelerating and braking at its limit, stopping at each target.
+    pub straight_line_time_s: Option<f64>,
+    /// `last_arrival_s / straight_line_time_s`.
+    pub time_ratio: Option<f64>,
+    /// Touches of a robot of the team with a wall, cube, pillar or board.
+    pub solid_contacts: u32,
+    /// Touches between two robots (one of the team at least), each counted once.
+    pub robot_contacts: u32,
+    /// Least distance between the edges of a robot of the team and any other robot
+    /// (`null`: never two).
+    #[serde(deserialize_with = "null_as_infinity")]
+    pub min_robot_clearance_mm: f64,
+    /// Total path of the robots with a goal over the total of their straight lines.
+    pub path_ratio: Option<f64>,
 }
 
 impl Summary {

@@ -102,11 +102,13 @@ impl TruthScore {
         (self.targets.len() > 1).then(|| self.reached.iter().filter(|&&r| r).count())
     }
 
-    /// Compares detected free distances with the world's, direction by direction, for a robot
-    /// at `pose` whose camera axis sits at `mount_mm` (truth clipped at the template's range).
+    /// Compares detected free distances with the world's, direction by direction, for robot
+    /// `body` at `pose` whose camera axis sits at `mount_mm` (truth clipped at the template's
+    /// range; every other robot is an obstacle).
     pub fn freespace(
         &mut self,
         world: &World,
+        body: usize,
         pose: &Isometry2<f64>,
         mount_mm: [f64; 2],
         fs: &FreeSpace,
@@ -116,7 +118,7 @@ impl TruthScore {
         for (a, free) in fs.direction_rad.iter().zip(&fs.free_mm) {
             let dir = Vector2::new((heading + a).cos(), (heading + a).sin());
             let truth = world
-                .ray_cast_mm(axis, dir, fs.range_mm, Some(0))
+                .ray_cast_mm(axis, dir, fs.range_mm, Some(body))
                 .unwrap_or(fs.range_mm);
             self.freespace_errors_mm.push((free - truth).abs());
         }

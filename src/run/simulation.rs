@@ -1,28 +1,29 @@
-//! The closed loop on the simulator's side: render the robot's cameras, hand its software what
-//! its sensors give, apply its commands, step the world, and record the truth beside what the
-//! robot believes.
+//! The closed loop on the simulator's side: render the robots' cameras, hand each robot's
+//! software what its own sensors give, apply their commands, step the world once, and record
+//! the truth beside what each robot believes. One robot ([`Agent`]) for a one-robot scenario,
+//! one for each robot of a team: their cameras are traced together (on the CPU in parallel
+//! across robots and pixels, on a GPU in one batch a cycle), their software runs in parallel,
+//! and the same scenario and seed give the same run whatever the number of threads.
 
-use super::cameras::{Cameras, sensor_noise_seed};
-use super::column_calibration::calibrate_columns;
+use super::agent::{Agent, CameraSetup, SoftwareBuilder, Truth, localization_fixes};
+use super::cameras::sensor_noise_seed;
 use super::error::RunError;
-use super::observer::{CycleView, ObserverHandle};
-use super::odometry::WheelOdometry;
+use super::observer::{CycleView, ObserverHandle, RobotCycle};
 use super::pilot::Pilot;
-use super::record::{Summary, TrajectoryRow};
-use super::score::TruthScore;
-use crate::scenario::calibrate::calibrate_sensor;
-use crate::scenario::{PilotChoice, Scenario};
-use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
-use omniloop_control::{AccelLimitedDrive, VelocityCommand};
+use super::record::{Summary, TeamFigures, TrajectoryRow};
+use crate::scenario::Scenario;
+use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_control::AccelLimitedDrive;
 use omniloop_robot::{
-    ActuatorState, Estimates, FixOutcome, Frame, Observation, OdometryReading, Robot, RobotConfig,
-    RobotError, RobotSoftware,
+    ActuatorState, Estimates, Frame, OdometryReading, Outputs, Robot, RobotConfig, RobotError,
+    RobotSoftware,
 };
-use omniloop_sim::render::BatchHandle;
+use omniloop_sim::render::{BatchHandle, BatchServer};
 use omniloop_sim::{Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
 use omniloop_vision::RadialCalibration;
-use omniloop_vision::resection::ColumnCalibration;
+use rayon::prelude::*;
 use std::path::PathBuf;
+use std::time::Duration;
 
 /// How to run a scenario (what the command line adds to the scenario file).
 #[derive(Debug, Clone, Default)]
@@ -57,6 +58,22 @@ pub struct RunOutput {
     pub files: Vec<OutputFile>,
     /// The map the robot's software built, when it builds one.
     pub map: Option<omniloop_robot::MapSnapshot>,
+    /// A team's robots, each with its records (empty for a one-robot scenario, whose records
+    /// are the fields above).
+    pub robots: Vec<RobotOutput>,
+}
+
+/// What one robot of a team left behind.
+#[derive(Debug, Clone)]
+pub struct RobotOutput {
+    /// Its name.
+    pub name: String,
+    /// One row a control cycle, and the final state.
+    pub trajectory: Vec<TrajectoryRow>,
+    /// What it believed, one record a control cycle.
+    pub estimates: Vec<Estimates>,
+    /// The map its software built, when it builds one.
+    pub map: Option<omniloop_robot::MapSnapshot>,
 }
 
 /// A file an experiment produced: its name in the output folder and its contents.
@@ -68,59 +85,22 @@ pub struct OutputFile {
     pub bytes: Vec<u8>,
 }
 
-/// The calibrations of the cameras the robot's vision uses: the scenario's file, or the
-/// camera's traced map.
-fn calibrations(
-    scenario: &Scenario,
-    takes_frames: bool,
-) -> Result<Vec<RadialCalibration>, RunError> {
-    if !(scenario.needs_calibration() || takes_frames) {
-        return Ok(Vec::new());
-    }
-    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
-    let spec = &scenario.robot.sensors[index];
-    let mut cal = match &scenario.vision.calibration_file {
-        Some(path) => RadialCalibration::load(path)?,
-        None => calibrate_sensor(spec)?,
-    };
-    // The file is this camera's calibration, whatever name it was written under.
-    cal.sensor = spec.name.clone();
-    Ok(vec![cal])
-}
-
-/// The column calibrations of the pinhole camera the robot resects with, measured from images
-/// of the calibration target.
-fn columns(scenario: &Scenario) -> Result<Vec<ColumnCalibration>, RunError> {
-    if !scenario.needs_columns() {
-        return Ok(Vec::new());
-    }
-    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
-    Ok(vec![calibrate_columns(
-        &scenario.robot.sensors[index],
-        scenario.seed,
-    )?])
-}
-
 /// A scenario being run, one control cycle at a time.
 pub struct Simulation {
     scenario: Scenario,
     world: World,
-    cameras: Option<Cameras>,
-    calibrations: Vec<RadialCalibration>,
-    odometry: WheelOdometry,
-    robot: Box<dyn RobotSoftware>,
-    pilot: Option<Pilot>,
+    agents: Vec<Agent>,
     others: Vec<Pilot>,
-    truth: TruthScore,
     cycle: u64,
-    trajectory: Vec<TrajectoryRow>,
-    estimates: Vec<Estimates>,
     other_paths: Vec<Vec<Point2<f64>>>,
     options: RunOptions,
-    last_odometry: Option<OdometryReading>,
-    /// Commands on their way to the drive: when each is due, and the command.
-    commands: std::collections::VecDeque<(f64, VelocityCommand)>,
+    /// A team's GPU, which traces every robot's frames of a cycle in one batch (dropped
+    /// after the agents, which hold its clients).
+    _gpu: Option<BatchServer>,
 }
+
+/// How long a team's GPU waits for the frames of a cycle before it traces those it has.
+const TEAM_BATCH_WAIT: Duration = Duration::from_millis(20);
 
 impl Simulation {
     /// Builds the world, the built-in robot software and the cameras of a validated scenario.
@@ -133,13 +113,13 @@ impl Simulation {
         Self::with_software(scenario, options, builtin_software, notice)
     }
 
-    /// Builds the world and the cameras of a validated scenario, with the robot's software
-    /// that `software` builds from what the robot is told ([`RobotConfig`]: its start, body,
-    /// cameras and their calibrations, goal, map; never the world).
+    /// Builds the world and the cameras of a validated scenario, with each robot's software
+    /// that `software` builds from what the robot is told ([`RobotConfig`]: its name, start,
+    /// body, cameras and their calibrations, goal, map; never the world).
     pub fn with_software(
         scenario: &Scenario,
         options: &RunOptions,
-        software: impl FnOnce(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
+        mut software: impl FnMut(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError>,
         notice: impl FnOnce(&str),
     ) -> Result<Self, RunError> {
         let world = World::new(
@@ -147,19 +127,31 @@ impl Simulation {
             &scenario.robot_bodies(),
             scenario.run.physics_step_s,
         )?;
-        let calibrations = calibrations(scenario, options.takes_frames)?;
-        let robot = software(&scenario.robot_config(calibrations.clone(), columns(scenario)?))?;
-        let r = &scenario.robot;
-        let pilot = match (&scenario.goal, scenario.run.pilot) {
-            (Some(g), PilotChoice::Truth) => Some(Pilot::new(
-                g.targets(),
-                g.tolerance_mm,
-                false,
-                r.max_speed_mm_s,
-                AccelLimitedDrive::new(r.accel_limit_mm_s2, r.angular_accel_limit_rad_s2)?,
-            )?),
-            _ => None,
+        let mut notice = Some(notice);
+        let mut say = |m: &str| {
+            if let Some(n) = notice.take() {
+                n(m);
+            }
         };
+        let members = scenario.members();
+        let names = scenario.robot_names();
+        if let Some(dir) = &options.frames_dir {
+            frame_folders(dir, scenario.is_team().then_some(names.as_slice()))?;
+        }
+        let (renderer, gpu) = team_renderer(members.len(), options, &mut say)?;
+        let shared = options.shared_gpu.clone().or(gpu.as_ref().map(BatchServer::handle));
+        let mut agents = Vec::with_capacity(members.len());
+        for (k, (member, name)) in members.iter().zip(&names).enumerate() {
+            let setup = CameraSetup {
+                renderer,
+                shared_gpu: shared.as_ref(),
+                all: options.save_frames_every.is_some(),
+            };
+            let build: &mut SoftwareBuilder<'_> = &mut software;
+            let agent = Agent::new(name, k, member, options.takes_frames, setup, build, &mut say)
+                .map_err(|e| in_robot(members.len(), name, e))?;
+            agents.push(agent);
+        }
         let mut others = Vec::new();
         for o in &scenario.other_robots {
             let waypoints = o.waypoints_mm.iter().map(|w| Point2::new(w[0], w[1]));
@@ -172,34 +164,18 @@ impl Simulation {
                 drive,
             )?);
         }
-        let cameras = Cameras::open(
-            scenario,
-            &robot.cameras(),
-            options.save_frames_every.is_some() || options.takes_frames,
-            options.renderer,
-            options.shared_gpu.as_ref(),
-            notice,
-        )?;
         for o in &options.observers {
-            o.with(|o| o.start(&world));
+            o.with(|o| o.start(&world, &names));
         }
         Ok(Self {
             scenario: scenario.clone(),
             world,
-            cameras,
-            calibrations,
-            odometry: WheelOdometry::new(&scenario.odometry, scenario.seed),
-            robot,
-            pilot,
             other_paths: vec![Vec::new(); others.len()],
             others,
-            truth: TruthScore::new(scenario.goal.as_ref()),
+            agents,
             cycle: 0,
-            trajectory: Vec::new(),
-            estimates: Vec::new(),
             options: options.clone(),
-            last_odometry: None,
-            commands: std::collections::VecDeque::new(),
+            _gpu: gpu,
         })
     }
 
@@ -213,9 +189,34 @@ impl Simulation {
         &self.scenario
     }
 
-    /// The robot's software.
+    /// The robots with software: the one robot, or a team's in the scenario's order.
+    pub fn robots(&self) -> &[Agent] {
+        &self.agents
+    }
+
+    /// The robots with software, to reach their software between cycles.
+    pub fn robots_mut(&mut self) -> &mut [Agent] {
+        &mut self.agents
+    }
+
+    /// The robot called `name`, if there is one.
+    pub fn robot_named(&self, name: &str) -> Option<&Agent> {
+        self.agents.iter().find(|a| a.name() == name)
+    }
+
+    /// The truth of robot `k` now (the simulator's side, for scoring and recording only).
+    pub fn truth_of(&self, k: usize) -> Option<Truth> {
+        self.agents.get(k).map(|a| a.truth(&self.world))
+    }
+
+    /// The first robot: the one robot of a one-robot scenario.
+    fn first(&self) -> &Agent {
+        &self.agents[0]
+    }
+
+    /// The robot's software (the first robot's in a team).
     pub fn robot_mut(&mut self) -> &mut dyn RobotSoftware {
-        self.robot.as_mut()
+        self.agents[0].software_mut()
     }
 
     /// Control cycles run so far.
@@ -225,46 +226,53 @@ impl Simulation {
 
     /// The trajectory recorded so far, a row a cycle (and the final state once recorded).
     pub fn trajectory(&self) -> &[TrajectoryRow] {
-        &self.trajectory
+        self.first().trajectory()
     }
 
     /// What the robot believed, a record a cycle so far.
     pub fn estimates(&self) -> &[Estimates] {
-        &self.estimates
+        self.first().estimates()
     }
 
     /// What the robot believed in the last cycle.
     pub fn last_estimates(&self) -> Option<&Estimates> {
-        self.estimates.last()
+        self.estimates().last()
     }
 
     /// The true pose of the robot under test when the last cycle's frames were taken.
     pub fn last_truth_pose(&self) -> Option<Isometry2<f64>> {
-        self.trajectory
+        self.trajectory()
             .last()
             .map(|r| Isometry2::new(Vector2::new(r.x_mm, r.y_mm), r.theta_rad))
     }
 
-    /// Whether the run is over: time is up, or the goal is reached and the run stops there.
+    /// Whether the run is over: time is up, or every robot with a goal reached it and the run
+    /// stops there.
     pub fn finished(&self) -> bool {
+        let with_goal = || self.agents.iter().filter(|a| a.has_goal());
         self.cycle >= self.scenario.max_cycles()
-            || (self.scenario.run.stop_at_goal && self.truth.time_to_goal_s().is_some())
+            || (self.scenario.run.stop_at_goal
+                && with_goal().count() > 0
+                && with_goal().all(Agent::reached_goal))
     }
 
     /// The calibration of the camera the robot's vision uses, when its software uses one.
     pub fn vision_calibration(&self) -> Option<&RadialCalibration> {
-        self.calibrations.first()
+        self.first().vision_calibration()
     }
 
     /// Renders the camera the robot's vision uses as it sees the world now, with its noise (a
     /// frame of its own, as an experimenter would take one): `None` when no camera is rendered.
     pub fn vision_frame(&mut self) -> Result<Option<&image::RgbaImage>, RunError> {
-        let index = self.scenario.vision_sensor_index().ok();
-        let name = index.map(|i| self.scenario.robot.sensors[i].name.as_str());
-        match (&mut self.cameras, name) {
+        let agent = &mut self.agents[0];
+        let scenario = agent.scenario();
+        let index = scenario.vision_sensor_index().ok();
+        let name = index.map(|i| scenario.robot.sensors[i].name.clone());
+        let body = agent.body();
+        match (agent.cameras_mut(), name) {
             (Some(c), Some(name)) => {
-                c.capture(&self.world)?;
-                Ok(c.image(name))
+                c.capture(&self.world, body)?;
+                Ok(c.image(&name))
             }
             _ => Ok(None),
         }
@@ -275,126 +283,124 @@ impl Simulation {
         self.world.place_robot(0, pose);
     }
 
-    /// One control cycle: the cameras see ([`Simulation::sense`]), then the robot's software
+    /// One control cycle: the cameras see ([`Simulation::sense`]), then the robots' software
     /// decides and the world moves on ([`Simulation::act`]).
     pub fn step(&mut self) -> Result<(), RunError> {
         self.sense()?;
         self.act()
     }
 
-    /// The first half of a control cycle: renders the cameras the robot's software reads now
+    /// The first half of a control cycle: renders the cameras each robot's software reads now
     /// (every camera when frames are saved) as the world is at the cycle's start, and saves
     /// them when asked. [`Simulation::frames`] gives them until the next sense.
     pub fn sense(&mut self) -> Result<(), RunError> {
-        let Some(c) = &mut self.cameras else {
-            return Ok(());
+        let scene = Scene::of_world(&self.world);
+        let now = self.world.time_s();
+        let all = self.options.save_frames_every.is_some();
+        let save_dir = match (self.options.save_frames_every, &self.options.frames_dir) {
+            (Some(every), Some(dir)) if every > 0 && self.cycle.is_multiple_of(every) => Some(dir),
+            _ => None,
         };
-        let wanted = self.robot.cameras_now();
-        let saving = self.options.save_frames_every.is_some();
-        c.capture_some(&self.world, (!saving).then_some(wanted.as_slice()))?;
-        if let (Some(every), Some(dir)) = (self.options.save_frames_every, &self.options.frames_dir)
-            && every > 0
-            && self.cycle.is_multiple_of(every)
-        {
-            c.save(dir, self.cycle)?;
+        let team = self.agents.len() > 1;
+        let cycle = self.cycle;
+        let states: Vec<_> = self
+            .agents
+            .iter()
+            .map(|a| self.world.robot_state(a.body()))
+            .collect();
+        let sense = |a: &mut Agent, state| -> Result<(), RunError> {
+            let dir = save_dir.map(|d| if team { d.join(a.name()) } else { d.clone() });
+            let save = dir.as_deref().map(|d| (d, cycle));
+            let name = a.name().to_string();
+            a.sense(&scene, state, now, all, save)
+                .map_err(|e| in_robot(usize::from(team) + 1, &name, e))
+        };
+        if !team {
+            return sense(&mut self.agents[0], states[0]);
         }
-        Ok(())
+        if self._gpu.is_some() || self.options.shared_gpu.is_some() {
+            // The robots' frames wait together for the GPU's batch: a thread each.
+            return std::thread::scope(|scope| {
+                let handles: Vec<_> = self
+                    .agents
+                    .iter_mut()
+                    .zip(states)
+                    .map(|(a, state)| scope.spawn(move || sense(a, state)))
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+                    .collect::<Result<(), RunError>>()
+            });
+        }
+        self.agents
+            .par_iter_mut()
+            .zip(states)
+            .try_for_each(|(a, state)| sense(a, state))
     }
 
-    /// The frames the software gets after the last [`Simulation::sense`], stamped with the
-    /// time they were taken (none without cameras).
+    /// The frames the robot's software gets after the last [`Simulation::sense`], stamped
+    /// with the time they were taken (none without cameras).
     pub fn frames(&self) -> Vec<Frame<'_>> {
-        self.cameras
-            .as_ref()
-            .map(|c| c.frames())
-            .unwrap_or_default()
+        self.first().frames()
     }
 
     /// The wheel odometry's reading at the end of the last cycle, as the robot's software got
     /// it (none before the first cycle).
     pub fn last_odometry(&self) -> Option<OdometryReading> {
-        self.last_odometry
+        self.first().last_odometry()
     }
 
     /// The state of the robot's actuators (its pan units) now.
     pub fn actuator_state(&self) -> Vec<ActuatorState> {
-        self.cameras
-            .as_ref()
-            .map(|c| c.actuator_state())
-            .unwrap_or_default()
+        self.first().actuator_state()
     }
 
-    /// The second half of a control cycle: the robot's software decides on the frames of the
-    /// last [`Simulation::sense`], its commands are applied and recorded, the world advances
-    /// one period, the wheels report.
+    /// The second half of a control cycle: each robot's software decides on the frames of
+    /// the last [`Simulation::sense`] (in parallel in a team), their commands are applied and
+    /// recorded, the world advances one period, the wheels report.
     pub fn act(&mut self) -> Result<(), RunError> {
         let t = self.world.time_s();
-        let cameras = self.cameras.as_ref();
-        let frames = cameras.map(|c| c.frames()).unwrap_or_default();
-        let actuators = cameras.map(|c| c.actuator_state()).unwrap_or_default();
-        let out = self.robot.cycle(&Observation {
-            t_s: t,
-            frames: &frames,
-            actuators: &actuators,
-        })?;
-        drop(frames);
-        let state = self.world.robot_state(0);
-        let (command, heading_for) = match &mut self.pilot {
-            Some(p) => (
-                p.command(Point2::from(state.pose.translation.vector)),
-                Some(p.index()),
-            ),
-            None => (
-                VelocityCommand {
-                    v_mm_s: Rotation2::new(state.pose.rotation.angle()) * out.command.v_mm_s,
-                    omega_rad_s: out.command.omega_rad_s,
-                },
-                out.estimates.target,
-            ),
+        let team = self.agents.len();
+        let outputs: Vec<Result<Outputs, RunError>> = if team == 1 {
+            vec![self.agents[0].decide(t)]
+        } else {
+            self.agents.par_iter_mut().map(|a| a.decide(t)).collect()
         };
-        let latency = self.scenario.robot.timing.command_latency_s;
-        self.commands.push_back((t + latency, command));
-        if let Some(c) = &mut self.cameras {
-            c.command(&out.actuators)?;
-        }
-        if let Some(fs) = &out.estimates.freespace {
-            let mount = self.vision_mount_mm();
-            self.truth.freespace(&self.world, &state.pose, mount, fs);
+        for (a, out) in self.agents.iter_mut().zip(outputs) {
+            let name = a.name().to_string();
+            out.and_then(|out| a.apply(&self.world, t, out))
+                .map_err(|e| in_robot(team, &name, e))?;
         }
         self.drive_others();
-        self.record(t, command, out.estimates);
         self.observe();
 
         let dt = self.scenario.run.control_period_s;
         self.advance_applying_commands(t + dt);
-        if let Some(c) = &mut self.cameras {
-            c.advance(dt);
-        }
         self.cycle += 1;
-        let after = self.world.robot_state(0);
-        let reading = self.odometry.read(&after, dt);
-        self.robot.odometry(&reading);
-        self.last_odometry = Some(reading);
-        let p = Point2::from(after.pose.translation.vector);
-        self.truth.targets(p, heading_for, self.world.time_s());
+        for a in &mut self.agents {
+            a.after_step(&self.world, dt);
+        }
         Ok(())
     }
 
-    /// Moves the world on to `end_s`, each queued command reaching the drive when it is due
-    /// (`[robot.timing] command_latency_s` after the software gave it; at once without one).
+    /// Moves the world on to `end_s`, each robot's queued commands reaching its drive when
+    /// they are due (`[robot.timing] command_latency_s` after the software gave them; at once
+    /// without one).
     fn advance_applying_commands(&mut self, end_s: f64) {
         let half_step = 0.5 * self.scenario.run.physics_step_s;
         loop {
             let now = self.world.time_s();
-            while let Some(&(due, command)) = self.commands.front() {
-                if due > now + half_step {
-                    break;
-                }
-                self.world.set_command(0, command);
-                self.commands.pop_front();
+            for a in &mut self.agents {
+                a.deliver_due(&mut self.world, now, half_step);
             }
-            match self.commands.front() {
-                Some(&(due, _)) if due < end_s - half_step => self.world.advance(due - now),
+            let next = self
+                .agents
+                .iter()
+                .filter_map(Agent::next_due_s)
+                .min_by(f64::total_cmp);
+            match next {
+                Some(due) if due < end_s - half_step => self.world.advance(due - now),
                 _ => {
                     self.world.advance(end_s - now);
                     return;
@@ -403,100 +409,56 @@ impl Simulation {
         }
     }
 
-    /// Where the axis of the camera vision uses sits on the robot.
-    fn vision_mount_mm(&self) -> [f64; 2] {
-        self.scenario
-            .vision_sensor_index()
-            .map_or([0.0, 0.0], |i| self.scenario.robot.sensors[i].mount_mm)
-    }
-
     /// The other robots drive on, each by its pilot on its true position.
     fn drive_others(&mut self) {
+        let first = self.agents.len();
         for (k, pilot) in self.others.iter_mut().enumerate() {
-            let p = Point2::from(self.world.robot_state(k + 1).pose.translation.vector);
+            let p = Point2::from(self.world.robot_state(first + k).pose.translation.vector);
             self.other_paths[k].push(p);
             let cmd = pilot.command(p);
-            self.world.set_command(k + 1, cmd);
+            self.world.set_command(first + k, cmd);
         }
-    }
-
-    /// Records the cycle: the trajectory row (truth, command, estimated pose) and the robot's
-    /// estimates, and scores the pose estimate.
-    fn record(&mut self, t: f64, command: VelocityCommand, estimates: Estimates) {
-        let row = self.row(t, command, estimates.pose);
-        if let Some(est) = &estimates.pose {
-            let truth = Isometry2::new(Vector2::new(row.x_mm, row.y_mm), row.theta_rad);
-            self.truth.checkpoint(est, &truth);
-        }
-        if let (Some(x), Some(y)) = (row.est_x_mm, row.est_y_mm) {
-            self.truth
-                .pose(Point2::new(x, y), Point2::new(row.x_mm, row.y_mm));
-        }
-        self.trajectory.push(row);
-        self.estimates.push(estimates);
     }
 
     /// Shows the cycle just recorded to the observers.
     fn observe(&self) {
-        let (Some(row), Some(estimates)) = (self.trajectory.last(), self.estimates.last()) else {
-            return;
-        };
         if self.options.observers.is_empty() {
             return;
         }
-        let frames = self.frames();
+        let mut robots = Vec::with_capacity(self.agents.len());
+        for a in &self.agents {
+            let (Some(row), Some(estimates)) = (a.trajectory().last(), a.estimates().last())
+            else {
+                return;
+            };
+            robots.push(RobotCycle {
+                name: a.name(),
+                row,
+                estimates,
+                frames: a.frames(),
+            });
+        }
         let view = CycleView {
             cycle: self.cycle,
-            row,
-            estimates,
-            frames: &frames,
+            robots: &robots,
         };
         for o in &self.options.observers {
             o.with(|o| o.cycle(&view));
         }
     }
 
-    /// Closes the trajectory with the final state (driving runs).
+    /// Closes every robot's trajectory with the final state (driving runs).
     pub fn record_final_state(&mut self) {
-        let row = self.row(
-            self.world.time_s(),
-            self.world.command(0),
-            self.robot.estimate(),
-        );
-        self.trajectory.push(row);
-    }
-
-    /// The trajectory row of the current state with `command` and the estimate.
-    fn row(&self, t: f64, command: VelocityCommand, est: Option<Isometry2<f64>>) -> TrajectoryRow {
-        let s = self.world.robot_state(0);
-        TrajectoryRow {
-            t_s: t,
-            x_mm: s.pose.translation.x,
-            y_mm: s.pose.translation.y,
-            theta_rad: s.pose.rotation.angle(),
-            vx_mm_s: s.velocity_mm_s.x,
-            vy_mm_s: s.velocity_mm_s.y,
-            cmd_vx_mm_s: command.v_mm_s.x,
-            cmd_vy_mm_s: command.v_mm_s.y,
-            est_x_mm: est.map(|e| e.translation.x),
-            est_y_mm: est.map(|e| e.translation.y),
-            est_theta_rad: est.map(|e| e.rotation.angle()),
+        for a in &mut self.agents {
+            a.record_final_state(&self.world);
         }
     }
 
     /// The truth now: the robot's true pose and velocity, its contacts so far and whether
-    /// it has reached the goal (the simulator's side, for scoring and recording only).
+    /// it has reached the goal (the first robot's in a team; [`Simulation::truth_of`] gives
+    /// any robot's).
     pub fn truth(&self) -> Truth {
-        let s = self.world.robot_state(0);
-        Truth {
-            t_s: self.world.time_s(),
-            pose: s.pose,
-            velocity_mm_s: s.velocity_mm_s,
-            omega_rad_s: s.omega_rad_s,
-            contacts: self.world.stats(0).contacts,
-            reached_goal: self.truth.time_to_goal_s().is_some(),
-            targets_reached: self.truth.targets_reached(),
-        }
+        self.first().truth(&self.world)
     }
 
     /// Ends the run: the summary of what the truth shows, and everything recorded.
@@ -505,14 +467,33 @@ impl Simulation {
         for (path, end) in self.other_paths.iter_mut().zip(ends) {
             path.push(end);
         }
-        RunOutput {
-            summary: self.summary(wall_time_s),
-            map: self.robot.map(),
-            trajectory: self.trajectory,
-            estimates: self.estimates,
+        let summary = self.summary(wall_time_s);
+        let team = self.scenario.is_team();
+        let mut out = RunOutput {
+            summary,
+            map: None,
+            trajectory: Vec::new(),
+            estimates: Vec::new(),
             other_paths: self.other_paths,
             files: Vec::new(),
+            robots: Vec::new(),
+        };
+        for a in self.agents {
+            let map = a.software().map();
+            let name = a.name().to_string();
+            let (trajectory, estimates) = a.into_records();
+            if team {
+                out.robots.push(RobotOutput {
+                    name,
+                    trajectory,
+                    estimates,
+                    map,
+                });
+            } else {
+                (out.trajectory, out.estimates, out.map) = (trajectory, estimates, map);
+            }
         }
+        out
     }
 
     /// What [`Simulation::finish`] would give now, the run going on (its records copied).
@@ -521,38 +502,54 @@ impl Simulation {
         for (path, end) in other_paths.iter_mut().zip(self.other_robot_ends()) {
             path.push(end);
         }
+        let team = self.scenario.is_team();
+        let first = self.first();
         RunOutput {
             summary: self.summary(wall_time_s),
-            map: self.robot.map(),
-            trajectory: self.trajectory.clone(),
-            estimates: self.estimates.clone(),
+            map: if team { None } else { first.software().map() },
+            trajectory: if team { Vec::new() } else { first.trajectory().to_vec() },
+            estimates: if team { Vec::new() } else { first.estimates().to_vec() },
             other_paths,
             files: Vec::new(),
+            robots: if team {
+                self.agents
+                    .iter()
+                    .map(|a| RobotOutput {
+                        name: a.name().to_string(),
+                        trajectory: a.trajectory().to_vec(),
+                        estimates: a.estimates().to_vec(),
+                        map: a.software().map(),
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            },
         }
     }
 
     /// Where the other robots are now.
     fn other_robot_ends(&self) -> Vec<Point2<f64>> {
+        let first = self.agents.len();
         (0..self.others.len())
-            .map(|k| Point2::from(self.world.robot_state(k + 1).pose.translation.vector))
+            .map(|k| Point2::from(self.world.robot_state(first + k).pose.translation.vector))
             .collect()
     }
 
-    /// The summary of what the truth shows so far.
+    /// The summary of what the truth shows so far: the robot's, or for a team the team's
+    /// (its keys over all robots, its own figures, and a row a robot).
     fn summary(&self, wall_time_s: f64) -> Summary {
-        let stats = self.world.stats(0);
-        let navigation = self
-            .estimates
+        let first = self.first();
+        let stats = self.world.stats(first.body());
+        let score = first.score();
+        let navigation = first
+            .estimates()
             .iter()
             .rev()
             .find_map(|e| e.navigation.as_ref());
-        Summary {
+        let summary = Summary {
             scenario: self.scenario.name.clone(),
             seed: self.scenario.seed,
-            controller: match self.pilot {
-                Some(_) => "truth_pilot".to_string(),
-                None => self.robot.name(),
-            },
+            controller: first.controller(),
             cycles: self.cycle,
             sim_time_s: self.world.time_s(),
             wall_time_s,
@@ -560,40 +557,178 @@ impl Simulation {
             wall_contacts: stats.contacts,
             peak_speed_mm_s: stats.peak_speed_mm_s,
             peak_accel_mm_s2: stats.peak_accel_mm_s2,
-            reached_goal: self.truth.time_to_goal_s().is_some(),
-            time_to_goal_s: self.truth.time_to_goal_s(),
+            reached_goal: first.reached_goal(),
+            time_to_goal_s: score.time_to_goal_s(),
             min_clearance_mm: stats.min_clearance_mm,
             path_length_mm: stats.path_length_mm,
-            renderer: self.cameras.as_ref().map(|c| c.renderer_name().to_string()),
-            freespace_error_mm: self.truth.freespace_error_mm(),
-            pose_error_mm: self.truth.pose_error_mm(),
-            targets_reached: self.truth.targets_reached(),
-            localization_fixes: localization_fixes(&self.estimates),
-            checkpoint_heading_error_deg: self.truth.checkpoint_heading_errors_deg(),
+            renderer: first.renderer_name().map(str::to_string),
+            freespace_error_mm: score.freespace_error_mm(),
+            pose_error_mm: score.pose_error_mm(),
+            targets_reached: score.targets_reached(),
+            localization_fixes: localization_fixes(first.estimates()),
+            checkpoint_heading_error_deg: score.checkpoint_heading_errors_deg(),
             unreachable: navigation.map(|n| n.unreachable),
             watchdog_fired: navigation.map(|n| n.watchdog),
+            team: None,
+            robots: None,
             experiment: serde_json::Map::new(),
+        };
+        if self.scenario.is_team() {
+            self.team_summary(summary)
+        } else {
+            summary
+        }
+    }
+
+    /// A team's summary: `base`'s keys over every robot (contacts of all, every goal reached
+    /// and when the last was, the least clearance, the total path, the largest speed and
+    /// acceleration), the team's figures and a row a robot.
+    fn team_summary(&self, base: Summary) -> Summary {
+        let rows: Vec<_> = self.agents.iter().map(|a| a.summary(&self.world)).collect();
+        let figures = team_figures(&self.world, &self.agents, &rows);
+        let controllers: Vec<&str> = rows.iter().map(|r| r.controller.as_str()).collect();
+        let mut names: Vec<&str> = controllers.clone();
+        names.dedup();
+        Summary {
+            controller: names.join("+"),
+            wall_contacts: figures.solid_contacts + figures.robot_contacts,
+            peak_speed_mm_s: rows.iter().map(|r| r.peak_speed_mm_s).fold(0.0, f64::max),
+            peak_accel_mm_s2: rows.iter().map(|r| r.peak_accel_mm_s2).fold(0.0, f64::max),
+            reached_goal: figures.with_goal > 0 && figures.all_arrived,
+            time_to_goal_s: figures.last_arrival_s,
+            min_clearance_mm: rows
+                .iter()
+                .map(|r| r.min_clearance_mm)
+                .fold(f64::INFINITY, f64::min),
+            path_length_mm: rows.iter().map(|r| r.path_length_mm).sum(),
+            freespace_error_mm: None,
+            pose_error_mm: None,
+            targets_reached: None,
+            localization_fixes: None,
+            checkpoint_heading_error_deg: None,
+            unreachable: rows
+                .iter()
+                .any(|r| r.unreachable.is_some())
+                .then(|| rows.iter().any(|r| r.unreachable == Some(true))),
+            watchdog_fired: None,
+            team: Some(figures),
+            robots: Some(rows),
+            ..base
         }
     }
 }
 
-/// The truth at a moment of a run: the simulator's side, never given to the robot's software.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Truth {
-    /// Simulated time, s.
-    pub t_s: f64,
-    /// The robot's true pose (mm, rad).
-    pub pose: Isometry2<f64>,
-    /// Its true velocity in the world frame.
-    pub velocity_mm_s: Vector2<f64>,
-    /// Its true rotation rate.
-    pub omega_rad_s: f64,
-    /// How many times it started touching a wall, cube, pillar or robot so far.
-    pub contacts: u32,
-    /// Whether it has reached the goal (within the tolerance, after every waypoint).
-    pub reached_goal: bool,
-    /// How many of the goal's targets (waypoints, then the goal) it has reached.
-    pub targets_reached: Option<usize>,
+/// A team's figures from its robots' rows and the world's record of touches.
+fn team_figures(world: &World, agents: &[Agent], rows: &[super::record::RobotSummary]) -> TeamFigures {
+    let with_goal: Vec<(&Agent, &super::record::RobotSummary)> = agents
+        .iter()
+        .zip(rows)
+        .filter(|(a, _)| a.has_goal())
+        .collect();
+    let arrived = with_goal.iter().filter(|(_, r)| r.reached_goal).count();
+    let all_arrived = arrived == with_goal.len();
+    let last_arrival_s = all_arrived
+        .then(|| with_goal.iter().filter_map(|(_, r)| r.time_to_goal_s).fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t)))))
+        .flatten();
+    let straight_line_time_s = with_goal
+        .iter()
+        .filter_map(|(a, _)| straight_line_time_s(a.scenario()))
+        .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t))));
+    let path: f64 = with_goal.iter().map(|(_, r)| r.path_length_mm).sum();
+    let straight: f64 = with_goal.iter().filter_map(|(_, r)| r.straight_mm).sum();
+    let team: Vec<usize> = agents.iter().map(Agent::body).collect();
+    TeamFigures {
+        robots: agents.len(),
+        with_goal: with_goal.len(),
+        arrived,
+        all_arrived,
+        last_arrival_s,
+        straight_line_time_s,
+        time_ratio: last_arrival_s
+            .zip(straight_line_time_s)
+            .filter(|(_, s)| *s > 0.0)
+            .map(|(t, s)| t / s),
+        solid_contacts: rows.iter().map(|r| r.solid_contacts).sum(),
+        robot_contacts: world
+            .robot_touches()
+            .iter()
+            .filter(|t| team.contains(&t.0) || team.contains(&t.1))
+            .count() as u32,
+        min_robot_clearance_mm: rows
+            .iter()
+            .map(|r| r.min_robot_clearance_mm)
+            .fold(f64::INFINITY, f64::min),
+        path_ratio: (straight > 0.0).then(|| path / straight),
+    }
+}
+
+/// The time a robot needs along the straight lines from its start through its targets at its
+/// top speed, accelerating and braking at its limit and stopping at each target: per leg of
+/// length `d`, `d / v + v / a` when it reaches `v`, else `2 sqrt(d / a)`.
+pub fn straight_line_time_s(s: &Scenario) -> Option<f64> {
+    let goal = s.goal.as_ref()?;
+    let (v, a) = (s.robot.max_speed_mm_s, s.robot.accel_limit_mm_s2);
+    let mut at = s.start().point();
+    let mut total = 0.0;
+    for t in goal.targets() {
+        let d = (t - at).norm();
+        total += if d > v * v / a {
+            d / v + v / a
+        } else {
+            2.0 * (d / a).sqrt()
+        };
+        at = t;
+    }
+    Some(total)
+}
+
+/// The renderer every robot of a run opens: the choice for one robot; for a team, the CPU
+/// renderer each, or one GPU that traces the team's frames in one batch a cycle (returned,
+/// to be shared).
+fn team_renderer(
+    robots: usize,
+    options: &RunOptions,
+    notice: &mut dyn FnMut(&str),
+) -> Result<(RendererChoice, Option<BatchServer>), RunError> {
+    if robots == 1 || options.shared_gpu.is_some() || options.renderer == RendererChoice::Cpu {
+        return Ok((options.renderer, None));
+    }
+    let renderer = Renderer::new(options.renderer, |m| notice(m))?;
+    Ok(match renderer.into_gpu() {
+        Some(gpu) => (
+            RendererChoice::Gpu,
+            Some(BatchServer::start(gpu, TEAM_BATCH_WAIT)),
+        ),
+        None => (RendererChoice::Cpu, None),
+    })
+}
+
+/// Makes the folder saved frames go to: `dir`, or with a team's `robots` a folder in it for
+/// each robot.
+fn frame_folders(dir: &std::path::Path, robots: Option<&[String]>) -> Result<(), RunError> {
+    let folders: Vec<PathBuf> = match robots {
+        Some(names) => names.iter().map(|n| dir.join(n)).collect(),
+        None => vec![dir.to_path_buf()],
+    };
+    for path in folders {
+        std::fs::create_dir_all(&path).map_err(|e| RunError::Frame {
+            path,
+            source: image::ImageError::IoError(e),
+        })?;
+    }
+    Ok(())
+}
+
+/// A robot's error, named by the robot when it is one of a team.
+fn in_robot(robots: usize, name: &str, e: RunError) -> RunError {
+    if robots > 1 {
+        RunError::InRobot {
+            robot: name.to_string(),
+            message: e.to_string(),
+        }
+    } else {
+        e
+    }
 }
 
 /// The built-in robot software of a configuration.
@@ -601,24 +736,9 @@ pub fn builtin_software(config: &RobotConfig) -> Result<Box<dyn RobotSoftware>, 
     Ok(Box::new(Robot::new(config)?))
 }
 
-/// The fixes the estimator used (set or pulled its estimate by), when the robot localizes on
-/// the floor region (its `floor_localization` stage reported a fix or why it found none).
-fn localization_fixes(records: &[Estimates]) -> Option<usize> {
-    const STAGE: &str = "floor_localization";
-    let localizes = records.iter().any(|e| {
-        e.fixes.iter().any(|f| f.source == STAGE) || e.not_found.iter().any(|n| n.source == STAGE)
-    });
-    let used = |e: &Estimates| {
-        e.fixes
-            .iter()
-            .filter(|f| matches!(f.outcome, FixOutcome::Anchored | FixOutcome::Used))
-            .count()
-    };
-    localizes.then(|| records.iter().map(used).sum())
-}
-
-/// Renders what sensor `sensor` of the robot under test sees when the robot stands at `pose`
-/// (the scenario's start when `None`) and every other robot at its start, with the sensor's
+/// Renders what sensor `sensor` of the robot under test (a team's first robot) sees when the
+/// robot stands at `pose` (the scenario's start when `None`) and every other robot at its
+/// start, with the sensor's
 /// noise drawn as the first frame of a run would be, or clean when `noise` is false.
 pub fn render_snapshot(
     scenario: &Scenario,
@@ -627,7 +747,8 @@ pub fn render_snapshot(
     pose: Option<Isometry2<f64>>,
     noise: bool,
 ) -> Result<image::RgbaImage, RunError> {
-    let index = scenario
+    let own = scenario.member(0);
+    let index = own
         .sensor_index(sensor)
         .map_err(|e| SimError::Invalid(format!("scenario {:?}: {e}", scenario.name)))?;
     let mut bodies = scenario.robot_bodies();
@@ -635,9 +756,9 @@ pub fn render_snapshot(
         bodies[0].start = p;
     }
     let world = World::new(&scenario.world, &bodies, scenario.run.physics_step_s)?;
-    let sensor = scenario.robot.sensors[index].build();
+    let sensor = own.robot.sensors[index].build();
     let scene = Scene::of_world(&world);
-    let mut noise_source = noise.then(|| SensorNoise::new(sensor_noise_seed(scenario.seed, index)));
+    let mut noise_source = noise.then(|| SensorNoise::new(sensor_noise_seed(own.seed, index)));
     Ok(renderer.render(
         &scene,
         &sensor,

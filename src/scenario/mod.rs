@@ -9,11 +9,12 @@ pub mod check;
 pub mod parse;
 pub mod rules;
 pub mod schema;
+pub mod team;
 
 pub use check::{Checker, FieldPath, PathSeg, Violation};
 pub use parse::{LoadError, Problem, load_scenario_with, parse_scenario_with};
 pub use rules::validate;
 pub use schema::{
-    DifferentialSpec, OdometrySpec, OtherRobotSpec, PilotChoice, PoseSpec, RobotSpec, RunSpec,
-    Scenario, TimingSpec,
+    DEFAULT_ROBOT_NAME, DifferentialSpec, OdometrySpec, OtherRobotSpec, PilotChoice, PoseSpec,
+    RobotSpec, RunSpec, Scenario, TeamMember, TimingSpec, member_seed,
 };

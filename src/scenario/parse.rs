@@ -3,8 +3,11 @@
 //! the layer that knows them ([`crate::experiments::parse_scenario`]).
 
 use super::check::{Checker, FieldPath, PathSeg};
+use super::check::Violation;
 use super::rules::validate;
-use super::schema::Scenario;
+use super::schema::{RobotSpec, Scenario};
+use super::team;
+use omniloop_robot::VisionSpec;
 use omniloop_sim::optics::Optics;
 use std::fmt;
 use std::ops::Range;
@@ -112,48 +115,63 @@ pub fn parse_scenario_with(
     if scenario.name.is_empty() {
         scenario.name = default_name.to_string();
     }
+    let located = |violations: Vec<Violation>| {
+        let mut problems: Vec<Problem> = violations
+            .into_iter()
+            .map(|v| {
+                let span = doc.as_ref().and_then(|d| span_of(d.get_ref(), &v.path));
+                let (line, column) = locate(span);
+                Problem {
+                    file: file.to_path_buf(),
+                    line,
+                    column,
+                    field: v.path.to_string(),
+                    message: v.message,
+                }
+            })
+            .collect();
+        problems.sort_by_key(|p| (p.line, p.column));
+        LoadError::Invalid { problems }
+    };
+    // A team's robots: each entry of [[robots]] over the shared tables.
+    if !scenario.robots.is_empty() {
+        let raw: toml::Table = toml::from_str(text).unwrap_or_default();
+        scenario.team = team::resolve(&raw).map_err(&located)?;
+    }
     // An experiment may build part of the world (the corner's corridor, start and goal).
     prepare(&mut scenario);
-    // Paths in a scenario are relative to its file.
-    if let Some(f) = scenario
-        .vision
-        .calibration_file
-        .as_ref()
-        .filter(|f| f.is_relative())
-    {
-        let dir = file.parent().unwrap_or(Path::new(""));
-        scenario.vision.calibration_file = Some(dir.join(f));
-    }
-    // Calibrated cameras read their files now; what fails is reported with the rules.
+    // Paths in a scenario are relative to its file; calibrated cameras read their files now
+    // (what fails is reported with the rules).
     let dir = file.parent().unwrap_or(Path::new(""));
-    for sensor in &mut scenario.robot.sensors {
-        if let Optics::Calibrated(cam) = &mut sensor.optics {
-            cam.load(dir).ok();
-        }
+    resolve_files(&mut scenario.vision, &mut scenario.robot, dir);
+    for m in &mut scenario.team {
+        resolve_files(&mut m.vision, &mut m.robot, dir);
     }
-    let mut violations = validate(&scenario);
+    let mut violations = if scenario.is_team() {
+        team::validate_team(&scenario)
+    } else {
+        validate(&scenario)
+    };
     let mut c = Checker::new();
     check(&scenario, &mut c);
     violations.extend(c.into_violations());
     if violations.is_empty() {
         return Ok(scenario);
     }
-    let mut problems: Vec<Problem> = violations
-        .into_iter()
-        .map(|v| {
-            let span = doc.as_ref().and_then(|d| span_of(d.get_ref(), &v.path));
-            let (line, column) = locate(span);
-            Problem {
-                file: file.to_path_buf(),
-                line,
-                column,
-                field: v.path.to_string(),
-                message: v.message,
-            }
-        })
-        .collect();
-    problems.sort_by_key(|p| (p.line, p.column));
-    Err(LoadError::Invalid { problems })
+    Err(located(violations))
+}
+
+/// Makes a robot's file paths relative to the scenario's folder `dir` (vision's calibration
+/// table) and reads its calibrated cameras' model files.
+fn resolve_files(vision: &mut VisionSpec, robot: &mut RobotSpec, dir: &Path) {
+    if let Some(f) = vision.calibration_file.as_ref().filter(|f| f.is_relative()) {
+        vision.calibration_file = Some(dir.join(f));
+    }
+    for sensor in &mut robot.sensors {
+        if let Optics::Calibrated(cam) = &mut sensor.optics {
+            cam.load(dir).ok();
+        }
+    }
 }
 
 /// 1-based line and column of a byte offset.

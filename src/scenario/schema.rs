@@ -36,8 +36,19 @@ pub struct Scenario {
     /// Floor, field, walls, cubes and pillars.
     #[serde(default)]
     pub world: Layout,
-    /// The robot under test.
+    /// The robot under test; with `[[robots]]`, the settings every robot of the team shares
+    /// (each robot's own keys are written over them).
+    #[serde(default)]
     pub robot: RobotSpec,
+    /// A team (`[[robots]]`): each robot named and written as the keys of `[robot]` (start,
+    /// body, sensors, timing, marking) and of its own `goal`, `vision`, `control` and
+    /// `odometry` tables, over the shared `[robot]`, `[goal]`, `[vision]`, `[control]` and
+    /// `[odometry]` (see [`super::team`]). Empty: the one robot of `[robot]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub robots: Vec<toml::Table>,
+    /// The team as resolved when the scenario was loaded: every robot complete.
+    #[serde(skip)]
+    pub team: Vec<TeamMember>,
     /// Further robots, moving obstacles driven between waypoints.
     #[serde(default)]
     pub other_robots: Vec<OtherRobotSpec>,
@@ -133,10 +144,14 @@ impl PoseSpec {
     }
 }
 
-/// The robot under test.
+/// The robot under test (or a robot of a team).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RobotSpec {
+    /// Its name (a team's robots each need one: letters, digits, `_` and `-`); the one
+    /// robot of `[robot]` is `robot` unless named.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
     /// Where it starts, at rest (required, unless the experiment places the robot).
     #[serde(default)]
     pub start: Option<PoseSpec>,
@@ -158,6 +173,10 @@ pub struct RobotSpec {
     /// Body colour.
     #[serde(default = "default_robot_rgb")]
     pub rgb: Rgb,
+    /// Colour of the top of its body, which the other robots' cameras see (a team's
+    /// marking); default: the body colour.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub marking_rgb: Option<Rgb>,
     /// Cameras on the robot (`[[robot.sensors]]`).
     #[serde(default)]
     pub sensors: Vec<SensorSpec>,
@@ -212,6 +231,57 @@ impl Default for DifferentialSpec {
         }
     }
 }
+
+impl Default for RobotSpec {
+    fn default() -> Self {
+        Self {
+            name: None,
+            start: None,
+            radius_mm: default_radius(),
+            height_mm: default_height(),
+            max_speed_mm_s: default_max_speed(),
+            accel_limit_mm_s2: default_accel(),
+            angular_accel_limit_rad_s2: default_angular_accel(),
+            rgb: default_robot_rgb(),
+            marking_rgb: None,
+            sensors: Vec::new(),
+            differential: None,
+            timing: TimingSpec::default(),
+        }
+    }
+}
+
+/// A robot of a team, complete: its entry of `[[robots]]` written over the shared tables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TeamMember {
+    /// Its name.
+    pub name: String,
+    /// Its start, body, sensors, timing and marking.
+    pub robot: RobotSpec,
+    /// Where it goes, if anywhere.
+    pub goal: Option<GoalSpec>,
+    /// Its image processing.
+    pub vision: VisionSpec,
+    /// Its controller and pose source.
+    pub control: ControlSpec,
+    /// The errors of its wheel odometry.
+    pub odometry: OdometrySpec,
+}
+
+/// The seed of robot `k` of a team: the scenario's for the first (a team of one runs as the
+/// one-robot form does, bit for bit), a SplitMix64 draw from it for the others.
+pub fn member_seed(seed: u64, k: usize) -> u64 {
+    if k == 0 {
+        return seed;
+    }
+    let mut z = seed.wrapping_add((k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The name of the one robot of `[robot]` when it names none.
+pub const DEFAULT_ROBOT_NAME: &str = "robot";
 
 fn default_radius() -> f64 {
     90.0
@@ -308,17 +378,11 @@ impl Scenario {
         toml::from_str(text)
     }
 
-    /// The robot bodies of the world: the robot under test first, then the others.
+    /// The robot bodies of the world: the robots with software first (the one robot, or
+    /// the team in its order), then the other robots.
     pub fn robot_bodies(&self) -> Vec<omniloop_sim::RobotBodySpec> {
-        let mut out = vec![omniloop_sim::RobotBodySpec {
-            start: self.start().isometry(),
-            radius_mm: self.robot.radius_mm,
-            height_mm: self.robot.height_mm,
-            accel_limit_mm_s2: self.robot.accel_limit_mm_s2,
-            angular_accel_limit_rad_s2: self.robot.angular_accel_limit_rad_s2,
-            rgb: self.robot.rgb,
-            differential: self.differential_drive(),
-        }];
+        let mut out: Vec<omniloop_sim::RobotBodySpec> =
+            self.members().iter().map(Self::own_body).collect();
         for o in &self.other_robots {
             out.push(omniloop_sim::RobotBodySpec {
                 start: o.start.isometry(),
@@ -327,10 +391,71 @@ impl Scenario {
                 accel_limit_mm_s2: o.accel_limit_mm_s2,
                 angular_accel_limit_rad_s2: default_angular_accel(),
                 rgb: o.rgb,
+                marking_rgb: None,
                 differential: None,
             });
         }
         out
+    }
+
+    /// The body of the one robot of a one-robot scenario (a member's view).
+    fn own_body(&self) -> omniloop_sim::RobotBodySpec {
+        omniloop_sim::RobotBodySpec {
+            start: self.start().isometry(),
+            radius_mm: self.robot.radius_mm,
+            height_mm: self.robot.height_mm,
+            accel_limit_mm_s2: self.robot.accel_limit_mm_s2,
+            angular_accel_limit_rad_s2: self.robot.angular_accel_limit_rad_s2,
+            rgb: self.robot.rgb,
+            marking_rgb: self.robot.marking_rgb,
+            differential: self.differential_drive(),
+        }
+    }
+
+    /// Whether the scenario has a team (`[[robots]]`).
+    pub fn is_team(&self) -> bool {
+        !self.team.is_empty()
+    }
+
+    /// The robots that run software, each as a one-robot scenario of its own: its robot,
+    /// goal, vision, control and odometry, its seed (the scenario's for the first robot, one
+    /// drawn from it for the others); the rest is the scenario's. One robot: the scenario.
+    pub fn members(&self) -> Vec<Scenario> {
+        if self.team.is_empty() {
+            return vec![self.clone()];
+        }
+        (0..self.team.len()).map(|k| self.member(k)).collect()
+    }
+
+    /// Robot `k` of the team as a one-robot scenario (see [`Scenario::members`]).
+    pub fn member(&self, k: usize) -> Scenario {
+        let Some(m) = self.team.get(k) else {
+            return self.clone();
+        };
+        Scenario {
+            seed: member_seed(self.seed, k),
+            robot: m.robot.clone(),
+            robots: Vec::new(),
+            team: Vec::new(),
+            goal: m.goal.clone(),
+            vision: m.vision.clone(),
+            control: m.control.clone(),
+            odometry: m.odometry.clone(),
+            ..self.clone()
+        }
+    }
+
+    /// The names of the robots that run software, in order.
+    pub fn robot_names(&self) -> Vec<String> {
+        if self.team.is_empty() {
+            return vec![self.robot_name().to_string()];
+        }
+        self.team.iter().map(|m| m.name.clone()).collect()
+    }
+
+    /// The name of the one robot (`robot.name`, default `robot`).
+    pub fn robot_name(&self) -> &str {
+        self.robot.name.as_deref().unwrap_or(DEFAULT_ROBOT_NAME)
     }
 
     /// The drive of a differential robot (validation makes sure its numbers are good).
@@ -389,6 +514,7 @@ impl Scenario {
     ) -> RobotConfig {
         let r = &self.robot;
         RobotConfig {
+            name: self.robot_name().to_string(),
             start: self.start().isometry(),
             body: BodySpec {
                 radius_mm: r.radius_mm,

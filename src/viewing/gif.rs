@@ -17,14 +17,18 @@ const TOP_VIEW_PX: u32 = 420;
 /// The frames an animation keeps while the run goes on.
 struct Kept {
     every: u64,
-    /// (cycle, each camera's image).
-    frames: Vec<(usize, Vec<RgbaImage>)>,
+    /// (cycle, each robot's cameras' images).
+    frames: Vec<(usize, Vec<Vec<RgbaImage>>)>,
 }
 
 impl CycleObserver for Kept {
     fn cycle(&mut self, v: &CycleView<'_>) {
         if v.cycle.is_multiple_of(self.every) {
-            let images = v.frames.iter().map(|f| f.image.clone()).collect();
+            let images = v
+                .robots
+                .iter()
+                .map(|r| r.frames.iter().map(|f| f.image.clone()).collect())
+                .collect();
             self.frames.push((v.cycle as usize, images));
         }
     }
@@ -53,7 +57,8 @@ impl GifLog {
         ObserverHandle(shared)
     }
 
-    /// Draws each kept cycle (its cameras left, the top view with the paths up to it right)
+    /// Draws each kept cycle (its cameras left, a robot a column in a team, the top view with
+    /// the paths up to it right)
     /// and writes the animation to `file`, each frame shown as long as the cycles it stands for
     /// took; returns how many frames it has.
     pub fn write(&self, file: &Path, s: &Scenario, out: &RunOutput) -> anyhow::Result<usize> {
@@ -88,19 +93,40 @@ fn up_to(out: &RunOutput, n: usize) -> RunOutput {
         other_paths: out.other_paths.iter().map(|p| head(p)).collect(),
         files: Vec::new(),
         map: out.map.clone(),
+        robots: out
+            .robots
+            .iter()
+            .map(|r| crate::run::RobotOutput {
+                name: r.name.clone(),
+                trajectory: r.trajectory[..n.min(r.trajectory.len())].to_vec(),
+                estimates: Vec::new(),
+                map: None,
+            })
+            .collect(),
     }
 }
 
-/// The camera images stacked on the left, the top view on the right, on white.
-fn side_by_side(images: &[RgbaImage], top: &image::RgbImage) -> RgbaImage {
-    let left_w = images.iter().map(RgbaImage::width).max().unwrap_or(0);
-    let left_h: u32 = images.iter().map(RgbaImage::height).sum();
-    let (w, h) = (left_w + top.width(), left_h.max(top.height()));
+/// Each robot's camera images stacked in a column of its own on the left (a team's robots in
+/// up to four columns, the rows below), the top view on the right, on white.
+fn side_by_side(robots: &[Vec<RgbaImage>], top: &image::RgbImage) -> RgbaImage {
+    let columns = robots.len().clamp(1, 4);
+    let cell_w = robots.iter().flatten().map(RgbaImage::width).max().unwrap_or(0);
+    let cell_h = robots
+        .iter()
+        .map(|images| images.iter().map(RgbaImage::height).sum::<u32>())
+        .max()
+        .unwrap_or(0);
+    let rows = robots.len().div_ceil(columns) as u32;
+    let left_w = cell_w * columns as u32;
+    let (w, h) = (left_w + top.width(), (cell_h * rows).max(top.height()));
     let mut canvas = RgbaImage::from_pixel(w, h, image::Rgba([255, 255, 255, 255]));
-    let mut y = 0;
-    for img in images {
-        imageops::overlay(&mut canvas, img, 0, i64::from(y));
-        y += img.height();
+    for (k, images) in robots.iter().enumerate() {
+        let x = cell_w * (k % columns) as u32;
+        let mut y = cell_h * (k / columns) as u32;
+        for img in images {
+            imageops::overlay(&mut canvas, img, i64::from(x), i64::from(y));
+            y += img.height();
+        }
     }
     let top = image::DynamicImage::ImageRgb8(top.clone()).into_rgba8();
     imageops::overlay(&mut canvas, &top, i64::from(left_w), 0);

@@ -18,7 +18,7 @@ pub mod scene;
 pub use gif::GifLog;
 pub use live::{LiveOptions, LiveServer};
 pub use pace::RealTime;
-pub use recorder::{Cycle, Recorder};
+pub use recorder::{Cycle, Recorder, RobotCameras};
 
 use crate::run::Summary;
 use crate::run::observer::{CycleObserver, CycleView, ObserverHandle};
@@ -46,7 +46,7 @@ enum Job {
 struct Feed(SyncSender<Job>);
 
 impl CycleObserver for Feed {
-    fn start(&mut self, world: &omniloop_sim::World) {
+    fn start(&mut self, world: &omniloop_sim::World, _robots: &[String]) {
         // The log's thread ends only on `Job::End`, so a send cannot fail before it.
         let _ = self.0.send(Job::World(world_update(world)));
     }
@@ -108,8 +108,8 @@ pub struct FoxgloveLog {
 
 impl FoxgloveLog {
     /// Creates (or replaces) the MCAP file, starts the live server and makes the channels
-    /// (`sensors`' cameras among them, so a viewer sees them before the first frame).
-    pub fn create(sinks: &Sinks, sensors: &[String]) -> Result<Self, ViewingError> {
+    /// (each robot's cameras among them, so a viewer sees them before the first frame).
+    pub fn create(sinks: &Sinks, robots: &[RobotCameras]) -> Result<Self, ViewingError> {
         let what = sinks.name();
         let fail = |message: String| ViewingError::Foxglove {
             what: what.clone(),
@@ -124,7 +124,7 @@ impl FoxgloveLog {
             Some(options) => Some(LiveServer::start(&ctx, options).map_err(&fail)?),
             None => None,
         };
-        let mut recorder = Recorder::new(&ctx, sensors).map_err(|e| fail(e.to_string()))?;
+        let mut recorder = Recorder::new(&ctx, robots).map_err(|e| fail(e.to_string()))?;
         let keeper = live.as_ref().map(LiveServer::world_keeper);
         let (tx, rx) = sync_channel::<Job>(QUEUE);
         let worker = std::thread::spawn(move || {

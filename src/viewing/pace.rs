@@ -14,7 +14,8 @@ pub struct RealTime {
 impl CycleObserver for RealTime {
     fn cycle(&mut self, view: &CycleView<'_>) {
         let start = *self.start.get_or_insert_with(Instant::now);
-        let due = start + Duration::from_secs_f64(view.row.t_s.max(0.0));
+        let t_s = view.robots.first().map_or(0.0, |r| r.row.t_s);
+        let due = start + Duration::from_secs_f64(t_s.max(0.0));
         let now = Instant::now();
         if due > now {
             std::thread::sleep(due - now);
@@ -48,11 +49,15 @@ mod tests {
         let begun = Instant::now();
         for (cycle, t_s) in [0.0, 0.04, 0.08].into_iter().enumerate() {
             let r = row(t_s);
-            let view = CycleView {
-                cycle: cycle as u64,
+            let robots = [crate::run::observer::RobotCycle {
+                name: "robot",
                 row: &r,
                 estimates: &estimates,
-                frames: &[],
+                frames: Vec::new(),
+            }];
+            let view = CycleView {
+                cycle: cycle as u64,
+                robots: &robots,
             };
             pace.cycle(&view);
         }

@@ -12,37 +12,56 @@ use omniloop_sim::World;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-/// The channels of a run: `/camera/NAME`, `/truth/pose`, `/truth/tf`, `/estimate/pose`,
-/// `/estimate/tf`, `/estimate/error`, `/world`, `/estimate/free_space`, `/estimate/path`,
-/// `/command`, `/estimate/record`, `/summary`.
+/// The channels of a run: for the one robot `/camera/NAME`, `/truth/pose`, `/truth/tf`,
+/// `/estimate/pose`, `/estimate/tf`, `/estimate/error`, `/estimate/free_space`,
+/// `/estimate/path`, `/command`, `/estimate/record` (a team's robots each under its name:
+/// `/ROBOT/camera/NAME`, `/ROBOT/truth/pose`, ..., in frames `ROBOT/truth/base_link`,
+/// `ROBOT/estimate/base_link`); and `/world`, `/summary`.
 pub struct Recorder {
     ctx: Arc<Context>,
-    cameras: BTreeMap<String, Channel<CompressedImage>>,
-    truth_pose: Channel<PoseInFrame>,
-    truth_tf: Channel<FrameTransform>,
-    estimate_pose: Channel<PoseInFrame>,
-    estimate_tf: Channel<FrameTransform>,
+    robots: Vec<RobotChannels>,
     world: Arc<Channel<SceneUpdate>>,
-    free_space: Channel<SceneUpdate>,
-    path: Channel<SceneUpdate>,
-    command: Arc<RawChannel>,
-    error: Arc<RawChannel>,
-    record: Arc<RawChannel>,
     summary: Arc<RawChannel>,
     /// Why a message could not be made, the first time (a frame that did not encode).
     pub problem: Option<String>,
 }
 
+/// The channels of one robot.
+struct RobotChannels {
+    /// The topics' and frames' prefix: empty for the one robot, `ROBOT/` in a team.
+    prefix: String,
+    cameras: BTreeMap<String, Channel<CompressedImage>>,
+    truth_pose: Channel<PoseInFrame>,
+    truth_tf: Channel<FrameTransform>,
+    estimate_pose: Channel<PoseInFrame>,
+    estimate_tf: Channel<FrameTransform>,
+    free_space: Channel<SceneUpdate>,
+    path: Channel<SceneUpdate>,
+    command: Arc<RawChannel>,
+    error: Arc<RawChannel>,
+    record: Arc<RawChannel>,
+}
+
 /// The frames of the tree: the world, the true robot, the robot as it believes it is.
 pub const WORLD: &str = "world";
-/// The true robot's frame.
+/// The true robot's frame (a team's robot's: `ROBOT/truth/base_link`).
 pub const TRUTH: &str = "truth/base_link";
-/// The estimated robot's frame.
+/// The estimated robot's frame (a team's robot's: `ROBOT/estimate/base_link`).
 pub const ESTIMATE: &str = "estimate/base_link";
 
-/// The channel of `sensor`'s frames, `/camera/NAME`.
-fn camera_channel(ctx: &Arc<Context>, sensor: &str) -> Channel<CompressedImage> {
-    ChannelBuilder::new(format!("/camera/{sensor}"))
+/// A robot's cameras as the log names them: its name in a team (`None` for the one robot) and
+/// its cameras.
+#[derive(Debug, Clone)]
+pub struct RobotCameras {
+    /// The robot's name in a team; `None` for the one robot of a scenario.
+    pub robot: Option<String>,
+    /// Its cameras' names.
+    pub sensors: Vec<String>,
+}
+
+/// The channel of a camera's frames, `/PREFIXcamera/NAME`.
+fn camera_channel(ctx: &Arc<Context>, prefix: &str, sensor: &str) -> Channel<CompressedImage> {
+    ChannelBuilder::new(format!("/{prefix}camera/{sensor}"))
         .context(ctx)
         .build()
 }
@@ -55,27 +74,46 @@ fn json(ctx: &Arc<Context>, topic: &str) -> Result<Arc<RawChannel>, foxglove::Fo
         .build_raw()
 }
 
+impl RobotChannels {
+    /// One robot's channels on `ctx`.
+    fn new(ctx: &Arc<Context>, robot: &RobotCameras) -> Result<Self, foxglove::FoxgloveError> {
+        let prefix = robot.robot.as_ref().map_or(String::new(), |r| format!("{r}/"));
+        let topic = |t: &str| format!("/{prefix}{t}");
+        let typed = |t: &str| ChannelBuilder::new(topic(t)).context(ctx);
+        Ok(Self {
+            cameras: robot
+                .sensors
+                .iter()
+                .map(|s| (s.clone(), camera_channel(ctx, &prefix, s)))
+                .collect(),
+            truth_pose: typed("truth/pose").build(),
+            truth_tf: typed("truth/tf").build(),
+            estimate_pose: typed("estimate/pose").build(),
+            estimate_tf: typed("estimate/tf").build(),
+            free_space: typed("estimate/free_space").build(),
+            path: typed("estimate/path").build(),
+            command: json(ctx, &topic("command"))?,
+            error: json(ctx, &topic("estimate/error"))?,
+            record: json(ctx, &topic("estimate/record"))?,
+            prefix,
+        })
+    }
+}
+
 impl Recorder {
-    /// The channels, on `ctx`, with a camera channel for each of `sensors` (another camera's
-    /// is made at its first frame).
-    pub fn new(ctx: &Arc<Context>, sensors: &[String]) -> Result<Self, foxglove::FoxgloveError> {
-        let typed = |topic: &str| ChannelBuilder::new(topic).context(ctx);
+    /// The channels, on `ctx`, for `robots` with a camera channel for each of their cameras
+    /// (another camera's is made at its first frame).
+    pub fn new(
+        ctx: &Arc<Context>,
+        robots: &[RobotCameras],
+    ) -> Result<Self, foxglove::FoxgloveError> {
         Ok(Self {
             ctx: ctx.clone(),
-            cameras: sensors
+            robots: robots
                 .iter()
-                .map(|s| (s.clone(), camera_channel(ctx, s)))
-                .collect(),
-            truth_pose: typed("/truth/pose").build(),
-            truth_tf: typed("/truth/tf").build(),
-            estimate_pose: typed("/estimate/pose").build(),
-            estimate_tf: typed("/estimate/tf").build(),
-            world: Arc::new(typed("/world").build()),
-            free_space: typed("/estimate/free_space").build(),
-            path: typed("/estimate/path").build(),
-            command: json(ctx, "/command")?,
-            error: json(ctx, "/estimate/error")?,
-            record: json(ctx, "/estimate/record")?,
+                .map(|r| RobotChannels::new(ctx, r))
+                .collect::<Result<_, _>>()?,
+            world: Arc::new(ChannelBuilder::new("/world").context(ctx).build()),
             summary: json(ctx, "/summary")?,
             problem: None,
         })
@@ -94,14 +132,17 @@ impl Recorder {
             .log_with_meta(json.to_string().as_bytes(), at(t_s));
     }
 
-    /// A camera's frame as a PNG on `/camera/NAME`: RGB, stored without deflate or filters
-    /// (the sensor noise leaves a quarter of it to compress, for most of a core; see
-    /// `docs/viewing.md`).
-    fn frame(&mut self, t_s: f64, f: &OwnedFrame) {
-        let channel = self
+    /// A camera's frame as a PNG on robot `k`'s `/camera/NAME`: RGB, stored without deflate
+    /// or filters (the sensor noise leaves a quarter of it to compress, for most of a core;
+    /// see `docs/viewing.md`).
+    fn frame(&mut self, k: usize, t_s: f64, f: &OwnedFrame) {
+        let ctx = &self.ctx;
+        let robot = &mut self.robots[k];
+        let prefix = robot.prefix.clone();
+        let channel = robot
             .cameras
             .entry(f.sensor.clone())
-            .or_insert_with(|| camera_channel(&self.ctx, &f.sensor));
+            .or_insert_with(|| camera_channel(ctx, &prefix, &f.sensor));
         let mut png = Vec::new();
         let encoder = image::codecs::png::PngEncoder::new_with_quality(
             &mut png,
@@ -111,13 +152,13 @@ impl Recorder {
         let rgb: image::RgbImage = image::buffer::ConvertBuffer::convert(&f.image);
         if let Err(e) = rgb.write_with_encoder(encoder) {
             self.problem
-                .get_or_insert(format!("camera {}: {e}", f.sensor));
+                .get_or_insert(format!("camera {prefix}{}: {e}", f.sensor));
             return;
         }
         channel.log_with_meta(
             &CompressedImage {
                 timestamp: Some(stamp(f.t_s)),
-                frame_id: format!("camera/{}", f.sensor),
+                frame_id: format!("{prefix}camera/{}", f.sensor),
                 data: png.into(),
                 format: "png".into(),
             },
@@ -137,21 +178,34 @@ impl Recorder {
 
     /// One cycle on every channel.
     pub fn cycle(&mut self, c: &Cycle) {
+        for (k, robot) in c.robots.iter().enumerate().take(self.robots.len()) {
+            for f in &robot.frames {
+                self.frame(k, robot.row.t_s, f);
+            }
+            self.robots[k].log(robot);
+        }
+    }
+}
+
+impl RobotChannels {
+    /// One robot's cycle on its channels (its frames aside).
+    fn log(&self, c: &RobotCycleOwned) {
         let r = &c.row;
         let t = r.t_s;
-        for f in &c.frames {
-            self.frame(t, f);
-        }
+        let (truth_frame, estimate_frame) = (
+            format!("{}{TRUTH}", self.prefix),
+            format!("{}{ESTIMATE}", self.prefix),
+        );
         let truth = Isometry2::new(Vector2::new(r.x_mm, r.y_mm), r.theta_rad);
         self.truth_pose
             .log_with_meta(&pose_in(t, WORLD, &truth), at(t));
         self.truth_tf
-            .log_with_meta(&transform(t, WORLD, TRUTH, &truth), at(t));
+            .log_with_meta(&transform(t, WORLD, &truth_frame, &truth), at(t));
         if let Some(est) = &c.estimate {
             self.estimate_pose
                 .log_with_meta(&pose_in(t, WORLD, est), at(t));
             self.estimate_tf
-                .log_with_meta(&transform(t, WORLD, ESTIMATE, est), at(t));
+                .log_with_meta(&transform(t, WORLD, &estimate_frame, est), at(t));
             let off = est.inverse() * truth;
             let error = serde_json::json!({
                 "t_s": t,
@@ -163,7 +217,7 @@ impl Recorder {
         }
         if let Some(fs) = &c.freespace {
             self.free_space
-                .log_with_meta(&free_space(t, TRUTH, fs), at(t));
+                .log_with_meta(&free_space(t, &truth_frame, fs), at(t));
         }
         if let Some(p) = &c.path {
             self.path.log_with_meta(&path(t, p), at(t));
@@ -189,8 +243,14 @@ pub struct OwnedFrame {
     pub image: image::RgbaImage,
 }
 
-/// One cycle as the recorder keeps it (the loop goes on while it is written).
+/// One cycle as the recorder keeps it (the loop goes on while it is written): every robot's.
 pub struct Cycle {
+    /// Each robot's part, in the robots' order.
+    pub robots: Vec<RobotCycleOwned>,
+}
+
+/// One robot's part of a cycle as the recorder keeps it.
+pub struct RobotCycleOwned {
     /// Its row of `trajectory.csv`.
     pub row: crate::run::TrajectoryRow,
     /// The frames the software got.
@@ -208,22 +268,27 @@ pub struct Cycle {
 impl Cycle {
     /// What the recorder keeps of a cycle.
     pub fn of(v: &CycleView<'_>) -> Self {
-        Self {
-            row: *v.row,
-            frames: v
-                .frames
-                .iter()
-                .map(|f: &Frame<'_>| OwnedFrame {
-                    sensor: f.sensor.to_string(),
-                    t_s: f.t_s,
-                    image: f.image.clone(),
-                })
-                .collect(),
-            estimate: v.estimates.pose,
-            freespace: v.estimates.freespace.clone(),
-            path: v.estimates.navigation.as_ref().map(|n| n.path_mm.clone()),
-            record: crate::run::record::estimates_line(v.row, v.estimates),
-        }
+        let robots = v
+            .robots
+            .iter()
+            .map(|r| RobotCycleOwned {
+                row: *r.row,
+                frames: r
+                    .frames
+                    .iter()
+                    .map(|f: &Frame<'_>| OwnedFrame {
+                        sensor: f.sensor.to_string(),
+                        t_s: f.t_s,
+                        image: f.image.clone(),
+                    })
+                    .collect(),
+                estimate: r.estimates.pose,
+                freespace: r.estimates.freespace.clone(),
+                path: r.estimates.navigation.as_ref().map(|n| n.path_mm.clone()),
+                record: crate::run::record::estimates_line(r.row, r.estimates),
+            })
+            .collect();
+        Self { robots }
     }
 }
 

@@ -217,6 +217,7 @@ mod tests {
             half_thickness_mm: 50.0,
         };
         RobotConfig {
+            name: "robot".to_string(),
             start: Isometry2::identity(),
             body: BodySpec {
                 radius_mm: 150.0,

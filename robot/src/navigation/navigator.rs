@@ -539,6 +539,7 @@ mod tests {
 
     fn robot(map: WorldMap, goal: [f64; 2]) -> RobotConfig {
         RobotConfig {
+            name: "robot".to_string(),
             start: Isometry2::new(Vector2::new(-1000.0, 0.0), 0.0),
             goal: Some(GoalSpec::to(goal, 100.0)),
             map,

@@ -768,6 +768,7 @@ mod tests {
         let pillar = CylinderPrim {
             geom: [600.0, 0.0, 60.0, 150.0],
             color: [0.5, 0.5, 0.5, 0.0],
+            top: [0.5, 0.5, 0.5, 0.0],
         };
         let rho = 20.0;
         let item = Item {
@@ -855,6 +856,7 @@ mod tests {
         let body = CylinderPrim {
             geom: [0.0, 0.0, 90.0, 110.0],
             color: [0.5, 0.5, 0.5, 0.0],
+            top: [0.5, 0.5, 0.5, 0.0],
         };
         let (mut hits, mut spared) = (0, 0);
         for k in 0..20_000u32 {

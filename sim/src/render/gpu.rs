@@ -402,7 +402,7 @@ impl GpuRenderer {
             STORAGE_RW,
         );
         let boxes = Storage::new(&device, "boxes", 64 * 48, STORAGE_RW);
-        let cylinders = Storage::new(&device, "cylinders", 16 * 32, STORAGE_RW);
+        let cylinders = Storage::new(&device, "cylinders", 16 * 48, STORAGE_RW);
         let boards = Storage::new(&device, "boards", 4 * 48, STORAGE_RW);
         let stripes = Storage::new(&device, "stripes", 64 * 4, STORAGE_RW);
         let rects = Storage::new(&device, "rects", 8 * 48, STORAGE_RW);

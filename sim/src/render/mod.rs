@@ -131,6 +131,14 @@ impl Renderer {
         &self.name
     }
 
+    /// The GPU renderer it opened, to share (`None` for the CPU or a shared GPU).
+    pub fn into_gpu(self) -> Option<GpuRenderer> {
+        match self.backend {
+            Backend::Gpu(g) => Some(*g),
+            Backend::Cpu(_) | Backend::Shared(_) => None,
+        }
+    }
+
     /// Whether frames are traced on a GPU adapter.
     pub fn is_gpu(&self) -> bool {
         matches!(self.backend, Backend::Gpu(_) | Backend::Shared(_))

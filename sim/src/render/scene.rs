@@ -29,8 +29,10 @@ pub struct BoxPrim {
 pub struct CylinderPrim {
     /// centre x, centre y, radius, top height (mm).
     pub geom: [f32; 4],
-    /// r, g, b (0..1), unused.
+    /// r, g, b (0..1) of the side, unused.
     pub color: [f32; 4],
+    /// r, g, b (0..1) of the top face (a robot's marking; the side's colour otherwise), unused.
+    pub top: [f32; 4],
 }
 
 /// An upright prism on a convex quadrilateral (corners counter-clockwise; a triangle repeats a
@@ -202,6 +204,7 @@ impl Scene {
                         s.height_mm as f32,
                     ],
                     color: rgb4(s.rgb, 0.0),
+                    top: rgb4(s.top_rgb.unwrap_or(s.rgb), 0.0),
                 }),
                 SolidShape::Quad { corners_mm: c } => quads.push(QuadPrim {
                     c01: [c[0].x, c[0].y, c[1].x, c[1].y].map(|v| v as f32),

@@ -416,7 +416,7 @@ pub fn hit_cylinder(cy: &CylinderPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> 
             best = Some(Hit {
                 t,
                 n: [0.0, 0.0, 1.0],
-                rgb: [cy.color[0], cy.color[1], cy.color[2]],
+                rgb: [cy.top[0], cy.top[1], cy.top[2]],
             });
         }
     }

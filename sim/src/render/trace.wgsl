@@ -30,7 +30,7 @@ struct SensorParams {
 };
 
 struct BoxPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
-struct CylinderPrim { geom: vec4<f32>, color: vec4<f32> };
+struct CylinderPrim { geom: vec4<f32>, color: vec4<f32>, top: vec4<f32> };
 struct BoardPrim { range: vec4<u32>, color_a: vec4<f32>, color_b: vec4<f32> };
 struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
 struct QuadPrim { c01: vec4<f32>, c23: vec4<f32>, z: vec4<f32>, color: vec4<f32> };
@@ -471,7 +471,7 @@ fn hit_cylinder(cy: CylinderPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit
         let px = mx + t * d.x;
         let py = my + t * d.y;
         if (t > T_EPS && t < t_lim && px * px + py * py <= r * r) {
-            best = Hit(t, vec3<f32>(0.0, 0.0, 1.0), cy.color.xyz, true);
+            best = Hit(t, vec3<f32>(0.0, 0.0, 1.0), cy.top.xyz, true);
         }
     }
     return best;

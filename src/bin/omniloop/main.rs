@@ -13,7 +13,7 @@ use omniloop::run::{RunOptions, render_snapshot};
 use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
 use omniloop::sweep::Seeds;
-use omniloop::viewing::{FoxgloveLog, GifLog, LiveOptions, RealTime, Sinks};
+use omniloop::viewing::{FoxgloveLog, GifLog, LiveOptions, RealTime, RobotCameras, Sinks};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
 use omniloop_sim::{Renderer, RendererChoice, SensorSpec};
 use std::io::IsTerminal;
@@ -336,8 +336,17 @@ fn start_log(s: &Scenario, sinks: &Sinks) -> anyhow::Result<Option<FoxgloveLog>>
     if sinks.mcap.is_none() && sinks.live.is_none() {
         return Ok(None);
     }
-    let sensors: Vec<String> = s.robot.sensors.iter().map(|c| c.name.clone()).collect();
-    let log = FoxgloveLog::create(sinks, &sensors)?;
+    let team = s.is_team();
+    let robots: Vec<RobotCameras> = s
+        .members()
+        .iter()
+        .zip(s.robot_names())
+        .map(|(m, name)| RobotCameras {
+            robot: team.then_some(name),
+            sensors: m.robot.sensors.iter().map(|c| c.name.clone()).collect(),
+        })
+        .collect();
+    let log = FoxgloveLog::create(sinks, &robots)?;
     if let Some(live) = log.live() {
         eprintln!(
             "serving the run live on ws://{}:{} (Foxglove: Open connection)",

@@ -1,0 +1,492 @@
+//! One robot with software in the loop, on the simulator's side: its cameras, wheel odometry
+//! and software, the commands on their way to its drive, and what was recorded of it (the
+//! truth beside what it believed). The [`super::Simulation`] holds one for the robot of a
+//! one-robot scenario and one for each robot of a team, and steps them together.
+
+use super::cameras::Cameras;
+use super::column_calibration::calibrate_columns;
+use super::error::RunError;
+use super::odometry::WheelOdometry;
+use super::pilot::Pilot;
+use super::record::{RobotSummary, TrajectoryRow};
+use super::score::TruthScore;
+use crate::scenario::calibrate::calibrate_sensor;
+use crate::scenario::{PilotChoice, Scenario};
+use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
+use omniloop_control::{AccelLimitedDrive, VelocityCommand};
+use omniloop_robot::{
+    ActuatorState, Estimates, FixOutcome, Frame, Observation, OdometryReading, Outputs,
+    RobotConfig, RobotError, RobotSoftware,
+};
+use omniloop_sim::render::BatchHandle;
+use omniloop_sim::{RendererChoice, RobotState, Scene, SimError, World};
+use omniloop_vision::RadialCalibration;
+use omniloop_vision::resection::ColumnCalibration;
+use std::collections::VecDeque;
+use std::path::Path;
+
+/// Builds a robot's software from what the robot is told.
+pub type SoftwareBuilder<'a> =
+    dyn FnMut(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError> + 'a;
+
+/// How a robot's cameras are rendered: the renderer chosen, or a GPU shared through a batch
+/// server; whether every camera is rendered (frames saved, an experimenter's).
+pub struct CameraSetup<'a> {
+    /// The renderer when no GPU is shared.
+    pub renderer: RendererChoice,
+    /// A shared GPU, its frames traced in batches.
+    pub shared_gpu: Option<&'a BatchHandle>,
+    /// Render every camera, whatever the software reads.
+    pub all: bool,
+}
+
+/// A robot with software in the loop (see the module's documentation).
+pub struct Agent {
+    name: String,
+    body: usize,
+    scenario: Scenario,
+    cameras: Option<Cameras>,
+    calibrations: Vec<RadialCalibration>,
+    odometry: WheelOdometry,
+    software: Box<dyn RobotSoftware>,
+    pilot: Option<Pilot>,
+    truth: TruthScore,
+    trajectory: Vec<TrajectoryRow>,
+    estimates: Vec<Estimates>,
+    last_odometry: Option<OdometryReading>,
+    /// Commands on their way to the drive: when each is due, and the command.
+    commands: VecDeque<(f64, VelocityCommand)>,
+    /// The target it headed for in the cycle being applied (its software's word, or the
+    /// pilot's), checked on the truth once the world moved on.
+    heading_for: Option<usize>,
+}
+
+impl Agent {
+    /// Robot `body` of the world, named `name`, as `scenario` (its one-robot form) describes
+    /// it, with the software `software` builds from what the robot is told.
+    pub fn new(
+        name: &str,
+        body: usize,
+        scenario: &Scenario,
+        takes_frames: bool,
+        cameras: CameraSetup<'_>,
+        software: &mut SoftwareBuilder<'_>,
+        notice: &mut dyn FnMut(&str),
+    ) -> Result<Self, RunError> {
+        let calibrations = calibrations(scenario, takes_frames)?;
+        let mut config = scenario.robot_config(calibrations.clone(), columns(scenario)?);
+        config.name = name.to_string();
+        let software = software(&config)?;
+        let r = &scenario.robot;
+        let pilot = match (&scenario.goal, scenario.run.pilot) {
+            (Some(g), PilotChoice::Truth) => Some(Pilot::new(
+                g.targets(),
+                g.tolerance_mm,
+                false,
+                r.max_speed_mm_s,
+                AccelLimitedDrive::new(r.accel_limit_mm_s2, r.angular_accel_limit_rad_s2)?,
+            )?),
+            _ => None,
+        };
+        let cameras = Cameras::open(
+            scenario,
+            &software.cameras(),
+            cameras.all || takes_frames,
+            cameras.renderer,
+            cameras.shared_gpu,
+            |m| notice(m),
+        )?;
+        Ok(Self {
+            name: name.to_string(),
+            body,
+            scenario: scenario.clone(),
+            cameras,
+            calibrations,
+            odometry: WheelOdometry::new(&scenario.odometry, scenario.seed),
+            software,
+            pilot,
+            truth: TruthScore::new(scenario.goal.as_ref()),
+            trajectory: Vec::new(),
+            estimates: Vec::new(),
+            last_odometry: None,
+            commands: VecDeque::new(),
+            heading_for: None,
+        })
+    }
+
+    /// Its name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Its index among the world's robot bodies.
+    pub fn body(&self) -> usize {
+        self.body
+    }
+
+    /// The robot as a one-robot scenario (its robot, goal, vision, control, odometry, seed).
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// Its software.
+    pub fn software(&self) -> &dyn RobotSoftware {
+        self.software.as_ref()
+    }
+
+    /// Its software, to reach it between cycles.
+    pub fn software_mut(&mut self) -> &mut dyn RobotSoftware {
+        self.software.as_mut()
+    }
+
+    /// Its trajectory so far, a row a cycle (and the final state once recorded).
+    pub fn trajectory(&self) -> &[TrajectoryRow] {
+        &self.trajectory
+    }
+
+    /// What it believed, a record a cycle so far.
+    pub fn estimates(&self) -> &[Estimates] {
+        &self.estimates
+    }
+
+    /// The calibration of the camera its vision uses, when its software uses one.
+    pub fn vision_calibration(&self) -> Option<&RadialCalibration> {
+        self.calibrations.first()
+    }
+
+    /// Its cameras, when any is rendered.
+    pub(crate) fn cameras_mut(&mut self) -> Option<&mut Cameras> {
+        self.cameras.as_mut()
+    }
+
+    /// The renderer's name, when it has cameras.
+    pub fn renderer_name(&self) -> Option<&str> {
+        self.cameras.as_ref().map(Cameras::renderer_name)
+    }
+
+    /// The frames its software gets after the last sense, stamped with when they were taken.
+    pub fn frames(&self) -> Vec<Frame<'_>> {
+        self.cameras
+            .as_ref()
+            .map(|c| c.frames())
+            .unwrap_or_default()
+    }
+
+    /// Its wheel odometry's reading at the end of the last cycle (none before the first).
+    pub fn last_odometry(&self) -> Option<OdometryReading> {
+        self.last_odometry
+    }
+
+    /// The state of its pan units now.
+    pub fn actuator_state(&self) -> Vec<ActuatorState> {
+        self.cameras
+            .as_ref()
+            .map(|c| c.actuator_state())
+            .unwrap_or_default()
+    }
+
+    /// Whether its goal is reached (on the truth).
+    pub fn reached_goal(&self) -> bool {
+        self.truth.time_to_goal_s().is_some()
+    }
+
+    /// Whether it has a goal.
+    pub fn has_goal(&self) -> bool {
+        self.scenario.goal.is_some()
+    }
+
+    /// Renders the cameras its software reads now (every camera with `all`) in `scene` at
+    /// `now`, the robot in `state`; saves them to `save` (a folder and the cycle) when given.
+    pub(crate) fn sense(
+        &mut self,
+        scene: &Scene,
+        state: RobotState,
+        now: f64,
+        all: bool,
+        save: Option<(&Path, u64)>,
+    ) -> Result<(), RunError> {
+        let Some(c) = &mut self.cameras else {
+            return Ok(());
+        };
+        let wanted = self.software.cameras_now();
+        c.capture_some(scene, state, now, (!all).then_some(wanted.as_slice()))?;
+        if let Some((dir, cycle)) = save {
+            c.save(dir, cycle)?;
+        }
+        Ok(())
+    }
+
+    /// Its software decides on the frames of the last sense, at time `t_s`.
+    pub(crate) fn decide(&mut self, t_s: f64) -> Result<Outputs, RunError> {
+        let cameras = self.cameras.as_ref();
+        let frames = cameras.map(|c| c.frames()).unwrap_or_default();
+        let actuators = cameras.map(|c| c.actuator_state()).unwrap_or_default();
+        Ok(self.software.cycle(&Observation {
+            t_s,
+            frames: &frames,
+            actuators: &actuators,
+        })?)
+    }
+
+    /// Applies what its software decided at `t_s`: the command (turned into the world frame
+    /// by the true heading, or the pilot's with `run.pilot = "truth"`) queued for the drive,
+    /// the actuator commands to its pan units; scores the free space against `world` and
+    /// records the cycle.
+    pub(crate) fn apply(&mut self, world: &World, t_s: f64, out: Outputs) -> Result<(), RunError> {
+        let state = world.robot_state(self.body);
+        let (command, heading_for) = match &mut self.pilot {
+            Some(p) => (
+                p.command(Point2::from(state.pose.translation.vector)),
+                Some(p.index()),
+            ),
+            None => (
+                VelocityCommand {
+                    v_mm_s: Rotation2::new(state.pose.rotation.angle()) * out.command.v_mm_s,
+                    omega_rad_s: out.command.omega_rad_s,
+                },
+                out.estimates.target,
+            ),
+        };
+        let latency = self.scenario.robot.timing.command_latency_s;
+        self.commands.push_back((t_s + latency, command));
+        if let Some(c) = &mut self.cameras {
+            c.command(&out.actuators)?;
+        }
+        if let Some(fs) = &out.estimates.freespace {
+            let mount = self.vision_mount_mm();
+            self.truth
+                .freespace(world, self.body, &state.pose, mount, fs);
+        }
+        self.heading_for = heading_for;
+        self.record(world, t_s, command, out.estimates);
+        Ok(())
+    }
+
+    /// When its next queued command is due, if one is.
+    pub(crate) fn next_due_s(&self) -> Option<f64> {
+        self.commands.front().map(|&(due, _)| due)
+    }
+
+    /// Hands the drive every queued command due by `now_s` (within half a physics step).
+    pub(crate) fn deliver_due(&mut self, world: &mut World, now_s: f64, half_step_s: f64) {
+        while let Some(&(due, command)) = self.commands.front() {
+            if due > now_s + half_step_s {
+                break;
+            }
+            world.set_command(self.body, command);
+            self.commands.pop_front();
+        }
+    }
+
+    /// After the world moved on `dt_s`: its pan units turn, its wheels report to its software,
+    /// and the truth side checks the target it headed for.
+    pub(crate) fn after_step(&mut self, world: &World, dt_s: f64) {
+        if let Some(c) = &mut self.cameras {
+            c.advance(dt_s);
+        }
+        let after = world.robot_state(self.body);
+        let reading = self.odometry.read(&after, dt_s);
+        self.software.odometry(&reading);
+        self.last_odometry = Some(reading);
+        let p = Point2::from(after.pose.translation.vector);
+        self.truth.targets(p, self.heading_for, world.time_s());
+    }
+
+    /// Where the axis of the camera vision uses sits on the robot.
+    fn vision_mount_mm(&self) -> [f64; 2] {
+        self.scenario
+            .vision_sensor_index()
+            .map_or([0.0, 0.0], |i| self.scenario.robot.sensors[i].mount_mm)
+    }
+
+    /// Records the cycle: the trajectory row (truth, command, estimated pose) and the robot's
+    /// estimates, and scores the pose estimate.
+    fn record(&mut self, world: &World, t: f64, command: VelocityCommand, estimates: Estimates) {
+        let row = self.row(world, t, command, estimates.pose);
+        if let Some(est) = &estimates.pose {
+            let truth = Isometry2::new(Vector2::new(row.x_mm, row.y_mm), row.theta_rad);
+            self.truth.checkpoint(est, &truth);
+        }
+        if let (Some(x), Some(y)) = (row.est_x_mm, row.est_y_mm) {
+            self.truth
+                .pose(Point2::new(x, y), Point2::new(row.x_mm, row.y_mm));
+        }
+        self.trajectory.push(row);
+        self.estimates.push(estimates);
+    }
+
+    /// Closes its trajectory with the final state (driving runs).
+    pub(crate) fn record_final_state(&mut self, world: &World) {
+        let row = self.row(
+            world,
+            world.time_s(),
+            world.command(self.body),
+            self.software.estimate(),
+        );
+        self.trajectory.push(row);
+    }
+
+    /// The trajectory row of the current state with `command` and the estimate.
+    fn row(
+        &self,
+        world: &World,
+        t: f64,
+        command: VelocityCommand,
+        est: Option<Isometry2<f64>>,
+    ) -> TrajectoryRow {
+        let s = world.robot_state(self.body);
+        TrajectoryRow {
+            t_s: t,
+            x_mm: s.pose.translation.x,
+            y_mm: s.pose.translation.y,
+            theta_rad: s.pose.rotation.angle(),
+            vx_mm_s: s.velocity_mm_s.x,
+            vy_mm_s: s.velocity_mm_s.y,
+            cmd_vx_mm_s: command.v_mm_s.x,
+            cmd_vy_mm_s: command.v_mm_s.y,
+            est_x_mm: est.map(|e| e.translation.x),
+            est_y_mm: est.map(|e| e.translation.y),
+            est_theta_rad: est.map(|e| e.rotation.angle()),
+        }
+    }
+
+    /// The truth now (the simulator's side, for scoring and recording only).
+    pub fn truth(&self, world: &World) -> Truth {
+        let s = world.robot_state(self.body);
+        Truth {
+            t_s: world.time_s(),
+            pose: s.pose,
+            velocity_mm_s: s.velocity_mm_s,
+            omega_rad_s: s.omega_rad_s,
+            contacts: world.stats(self.body).contacts,
+            reached_goal: self.reached_goal(),
+            targets_reached: self.truth.targets_reached(),
+        }
+    }
+
+    /// The name of what drove it: its software's, or the simulator's pilot.
+    pub fn controller(&self) -> String {
+        match self.pilot {
+            Some(_) => "truth_pilot".to_string(),
+            None => self.software.name(),
+        }
+    }
+
+    /// The truth-side score of its run so far.
+    pub(crate) fn score(&self) -> &TruthScore {
+        &self.truth
+    }
+
+    /// Its figures of the run so far (a row of a team's `robots` table).
+    pub fn summary(&self, world: &World) -> RobotSummary {
+        let stats = world.stats(self.body);
+        let navigation = self
+            .estimates
+            .iter()
+            .rev()
+            .find_map(|e| e.navigation.as_ref());
+        let start = self.scenario.start().point();
+        RobotSummary {
+            name: self.name.clone(),
+            controller: self.controller(),
+            reached_goal: self.reached_goal(),
+            time_to_goal_s: self.truth.time_to_goal_s(),
+            contacts: stats.contacts,
+            solid_contacts: stats.solid_contacts,
+            robot_contacts: stats.robot_contacts,
+            min_clearance_mm: stats.min_clearance_mm,
+            min_robot_clearance_mm: stats.min_robot_clearance_mm,
+            path_length_mm: stats.path_length_mm,
+            straight_mm: self.scenario.goal.as_ref().map(|g| {
+                let mut at = start;
+                let mut total = 0.0;
+                for t in g.targets() {
+                    total += (t - at).norm();
+                    at = t;
+                }
+                total
+            }),
+            peak_speed_mm_s: stats.peak_speed_mm_s,
+            peak_accel_mm_s2: stats.peak_accel_mm_s2,
+            freespace_error_mm: self.truth.freespace_error_mm(),
+            pose_error_mm: self.truth.pose_error_mm(),
+            targets_reached: self.truth.targets_reached(),
+            localization_fixes: localization_fixes(&self.estimates),
+            unreachable: navigation.map(|n| n.unreachable),
+            watchdog_fired: navigation.map(|n| n.watchdog),
+        }
+    }
+
+    /// Ends its run: its trajectory and estimates.
+    pub(crate) fn into_records(self) -> (Vec<TrajectoryRow>, Vec<Estimates>) {
+        (self.trajectory, self.estimates)
+    }
+}
+
+/// The truth at a moment of a run: the simulator's side, never given to the robot's software.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Truth {
+    /// Simulated time, s.
+    pub t_s: f64,
+    /// The robot's true pose (mm, rad).
+    pub pose: Isometry2<f64>,
+    /// Its true velocity in the world frame.
+    pub velocity_mm_s: Vector2<f64>,
+    /// Its true rotation rate.
+    pub omega_rad_s: f64,
+    /// How many times it started touching a wall, cube, pillar or robot so far.
+    pub contacts: u32,
+    /// Whether it has reached the goal (within the tolerance, after every waypoint).
+    pub reached_goal: bool,
+    /// How many of the goal's targets (waypoints, then the goal) it has reached.
+    pub targets_reached: Option<usize>,
+}
+
+/// The calibrations of the cameras the robot's vision uses: the scenario's file, or the
+/// camera's traced map.
+fn calibrations(
+    scenario: &Scenario,
+    takes_frames: bool,
+) -> Result<Vec<RadialCalibration>, RunError> {
+    if !(scenario.needs_calibration() || takes_frames) {
+        return Ok(Vec::new());
+    }
+    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
+    let spec = &scenario.robot.sensors[index];
+    let mut cal = match &scenario.vision.calibration_file {
+        Some(path) => RadialCalibration::load(path)?,
+        None => calibrate_sensor(spec)?,
+    };
+    // The file is this camera's calibration, whatever name it was written under.
+    cal.sensor = spec.name.clone();
+    Ok(vec![cal])
+}
+
+/// The column calibrations of the pinhole camera the robot resects with, measured from images
+/// of the calibration target.
+fn columns(scenario: &Scenario) -> Result<Vec<ColumnCalibration>, RunError> {
+    if !scenario.needs_columns() {
+        return Ok(Vec::new());
+    }
+    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
+    Ok(vec![calibrate_columns(
+        &scenario.robot.sensors[index],
+        scenario.seed,
+    )?])
+}
+
+/// The fixes the estimator used (set or pulled its estimate by), when the robot localizes on
+/// the floor region (its `floor_localization` stage reported a fix or why it found none).
+pub fn localization_fixes(records: &[Estimates]) -> Option<usize> {
+    const STAGE: &str = "floor_localization";
+    let localizes = records.iter().any(|e| {
+        e.fixes.iter().any(|f| f.source == STAGE) || e.not_found.iter().any(|n| n.source == STAGE)
+    });
+    let used = |e: &Estimates| {
+        e.fixes
+            .iter()
+            .filter(|f| matches!(f.outcome, FixOutcome::Anchored | FixOutcome::Used))
+            .count()
+    };
+    localizes.then(|| records.iter().map(used).sum())
+}
