@@ -106,6 +106,8 @@ fn main() {
                     obstacle_points: &obstacles,
                     clear_points: &clear,
                     blind_points: &[],
+                    moving_points: &[],
+                    horizon_points: &[],
                 };
                 for v in velocities {
                     let t0 = Instant::now();

@@ -11,6 +11,7 @@
 //! - [`crate::VelocityAware`] (Sect. 3.2, and its extension to chosen speeds): see its module.
 
 use crate::angle::angle_diff;
+use crate::traffic::TrafficConfig;
 use crate::{AccelLimitedDrive, ControlError, Vec2, require_positive};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
@@ -34,6 +35,12 @@ pub struct Surroundings<'a> {
     /// remembers it): points at the body's edge, mm. The robot may pass them at a slant but
     /// never head into them (see [`crate::VelocityAware`]).
     pub blind_points: &'a [Vec2],
+    /// Points on obstacles that may move (another robot: what the robot's map does not
+    /// explain), mm; used by the traffic rule ([`crate::traffic`]).
+    pub moving_points: &'a [Vec2],
+    /// Where the unknown begins beyond the template in the directions free throughout, mm;
+    /// another robot may come from there (the traffic rule's horizon).
+    pub horizon_points: &'a [Vec2],
 }
 
 /// How the velocity-aware controller sets the speed of its command.
@@ -75,6 +82,9 @@ pub struct AvoidanceConfig {
     /// Velocity aware, chosen speeds: the speeds tried in each direction, `v k / speeds` for
     /// `k = speeds ... 1` of the approach speed `v`.
     pub speeds: usize,
+    /// Velocity aware, chosen speeds: the rule for other robots that avoid too
+    /// (`[control.avoidance.traffic]`, [`crate::traffic`]).
+    pub traffic: TrafficConfig,
 }
 
 impl Default for AvoidanceConfig {
@@ -88,6 +98,7 @@ impl Default for AvoidanceConfig {
             check_period_brake: false,
             speed: SpeedChoice::Chosen,
             speeds: 16,
+            traffic: TrafficConfig::default(),
         }
     }
 }
@@ -144,6 +155,40 @@ pub(crate) fn check_config(c: &AvoidanceConfig) -> Result<(), ControlError> {
             name: "extra_horizon_s",
             value: c.extra_horizon_s,
             rule: "must be finite and >= 0",
+        });
+    }
+    let t = &c.traffic;
+    for (name, value) in [
+        ("traffic.gap_mm", t.gap_mm),
+        ("traffic.keep_right_deg", t.keep_right_deg),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(ControlError::InvalidParameter {
+                name,
+                value,
+                rule: "must be finite and >= 0",
+            });
+        }
+    }
+    if t.keep_right_deg > 90.0 {
+        return Err(ControlError::InvalidParameter {
+            name: "traffic.keep_right_deg",
+            value: t.keep_right_deg,
+            rule: "must be at most 90",
+        });
+    }
+    if !(t.look_ahead_mm.is_finite() && t.look_ahead_mm > t.gap_mm) {
+        return Err(ControlError::InvalidParameter {
+            name: "traffic.look_ahead_mm",
+            value: t.look_ahead_mm,
+            rule: "must be finite and > traffic.gap_mm",
+        });
+    }
+    if t.reciprocal() && c.speed != SpeedChoice::Chosen {
+        return Err(ControlError::InvalidParameter {
+            name: "traffic.rule",
+            value: 1.0,
+            rule: "the reciprocal rule needs speed = \"chosen\" (it bounds the chosen speeds)",
         });
     }
     Ok(())

@@ -13,6 +13,7 @@ pub mod go_to_goal;
 pub mod odometry;
 #[cfg(test)]
 mod testing;
+pub mod traffic;
 pub mod velocity_aware;
 
 pub use angle::{angle_diff, wrap_pi};
@@ -21,6 +22,7 @@ pub use differential::DifferentialDrive;
 pub use drive::{AccelLimitedDrive, VelocityCommand};
 pub use go_to_goal::GoToGoal;
 pub use odometry::DeadReckoning;
+pub use traffic::{HalfPlane, TrafficConfig, TrafficRule};
 pub use velocity_aware::{GoalKind, VelocityAware};
 
 /// A 2-D vector in millimetres (positions) or millimetres per second (velocities).

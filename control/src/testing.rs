@@ -26,6 +26,8 @@ pub fn surroundings(seen: &Seen) -> Surroundings<'_> {
         obstacle_points: &seen.obstacles,
         clear_points: &seen.clear,
         blind_points: &[],
+        moving_points: &[],
+        horizon_points: &[],
     }
 }
 

@@ -30,6 +30,7 @@ use crate::angle::angle_diff;
 use crate::avoidance::{
     AvoidanceConfig, Decision, SpeedChoice, Surroundings, approach_speed, check_config,
 };
+use crate::traffic::HalfPlane;
 use crate::{AccelLimitedDrive, ControlError, Vec2, require_positive};
 use std::f64::consts::TAU;
 
@@ -86,6 +87,14 @@ struct Obstacle {
     c2: f64,
 }
 
+/// What every predicted path must keep to: away from the obstacle points, and inside the
+/// traffic rule's half-planes.
+#[derive(Debug, Clone, Default)]
+struct Keep {
+    obstacles: Vec<Obstacle>,
+    planes: Vec<HalfPlane>,
+}
+
 const STOP: Decision = Decision {
     v_mm_s: Vec2::new(0.0, 0.0),
     heading_rad: None,
@@ -118,16 +127,16 @@ impl VelocityAware {
     /// robot takes if the next cycle finds nothing admissible. Each is sampled every
     /// `prediction_step_s`, and every obstacle must keep the clearance from each segment between
     /// samples.
-    fn clear_among(&self, v_now: Vec2, v_b: Vec2, obstacles: &[Obstacle]) -> bool {
+    fn clear_among(&self, v_now: Vec2, v_b: Vec2, keep: &Keep) -> bool {
         let t_a = self.drive.settle_time_s(v_now, v_b);
         let period_brake =
             self.config.check_period_brake || self.config.speed == SpeedChoice::Chosen;
-        self.phases_clear(v_now, v_b, t_a, obstacles)
-            && (!period_brake || self.phases_clear(v_now, v_b, self.period_s, obstacles))
+        self.phases_clear(v_now, v_b, t_a, keep)
+            && (!period_brake || self.phases_clear(v_now, v_b, self.period_s, keep))
     }
 
     /// Toward `v_b` for `t1`, then toward rest until stopped (plus `extra_horizon_s`).
-    fn phases_clear(&self, v_now: Vec2, v_b: Vec2, t1: f64, obstacles: &[Obstacle]) -> bool {
+    fn phases_clear(&self, v_now: Vec2, v_b: Vec2, t1: f64, keep: &Keep) -> bool {
         let alpha = self.drive.accel_limit_mm_s2();
         let p1 = self.drive.displacement(v_now, v_b, t1);
         let v1 = self.drive.velocity_at(v_now, v_b, t1);
@@ -145,6 +154,15 @@ impl VelocityAware {
         let path: Vec<Vec2> = (0..=steps)
             .map(|k| at((k as f64 * dt).min(horizon)))
             .collect();
+        // A half-plane is convex: the samples in it, the segments between them are too.
+        if !keep
+            .planes
+            .iter()
+            .all(|h| path.iter().all(|p| h.holds(*p)))
+        {
+            return false;
+        }
+        let obstacles = &keep.obstacles;
         // Only obstacles within reach of the path's bounding box can come too near.
         let (mut lo, mut hi) = (path[0], path[0]);
         for p in &path {
@@ -183,13 +201,7 @@ impl VelocityAware {
         clearance: f64,
         hold_nearer: bool,
     ) -> Vec<Obstacle> {
-        let alpha = self.drive.accel_limit_mm_s2();
-        let top = v_now.norm().max(speed);
-        let longest = (v_now.norm() + speed) / alpha
-            + self.period_s
-            + top / alpha
-            + self.config.extra_horizon_s;
-        let reach = top * longest + clearance;
+        let reach = self.longest_path_mm(v_now, speed) + clearance;
         let c2 = clearance * clearance;
         points
             .iter()
@@ -204,6 +216,18 @@ impl VelocityAware {
                 },
             })
             .collect()
+    }
+
+    /// The longest path any candidate of at most `speed` can take from `v_now`, mm (an upper
+    /// bound: the top speed over the longest time to settle, hold a period and brake).
+    fn longest_path_mm(&self, v_now: Vec2, speed: f64) -> f64 {
+        let alpha = self.drive.accel_limit_mm_s2();
+        let top = v_now.norm().max(speed);
+        let longest = (v_now.norm() + speed) / alpha
+            + self.period_s
+            + top / alpha
+            + self.config.extra_horizon_s;
+        top * longest
     }
 
     /// Candidate directions, the goal direction among them, nearest the goal direction first.
@@ -236,10 +260,15 @@ impl VelocityAware {
         }
         let goal_rad = goal.y.atan2(goal.x);
         let speed = approach_speed(self.max_speed_mm_s, &self.drive, d_goal);
-        let arriving = kind == GoalKind::InSight && speed < self.max_speed_mm_s;
+        // With the traffic rule, a target in the free space is in sight: the robot stops on
+        // it and holds there while the others pass, instead of circling it.
+        let seen = self.config.traffic.reciprocal() && in_free_space(s, goal_rad, d_goal);
+        let in_sight = kind == GoalKind::InSight || seen;
+        let arriving = in_sight && speed < self.max_speed_mm_s;
+        let holding = seen && speed < self.max_speed_mm_s;
         match self.config.speed {
             SpeedChoice::Fixed => self.decide_fixed(s, goal_rad, speed, v_now),
-            SpeedChoice::Chosen => self.decide_chosen(s, goal_rad, speed, arriving, v_now),
+            SpeedChoice::Chosen => self.decide_chosen(s, goal, speed, (arriving, holding), v_now),
         }
     }
 
@@ -252,7 +281,10 @@ impl VelocityAware {
         v_now: Vec2,
     ) -> Decision {
         let clearance = self.radius_mm + self.config.margin_mm;
-        let near = self.reachable(&[s.obstacle_points], v_now, speed, clearance, false);
+        let near = Keep {
+            obstacles: self.reachable(&[s.obstacle_points], v_now, speed, clearance, false),
+            planes: Vec::new(),
+        };
         self.headings(goal_rad)
             .into_iter()
             .find_map(|h| {
@@ -270,24 +302,39 @@ impl VelocityAware {
     fn decide_chosen(
         &self,
         s: &Surroundings<'_>,
-        goal_rad: f64,
+        goal: Vec2,
         speed: f64,
-        arriving: bool,
+        (arriving, holding): (bool, bool),
         v_now: Vec2,
     ) -> Decision {
+        let goal_rad = goal.y.atan2(goal.x);
         // An obstacle already nearer than the clearance (the robot was pushed, or vision put it
         // at the robot's edge for want of knowing better) need only get no nearer, so the robot
         // can always move away.
         let clearance = self.radius_mm + self.config.margin_mm;
         let points = [s.clear_points];
-        let mut near = self.reachable(&points, v_now, speed, clearance, true);
+        let mut obstacles = self.reachable(&points, v_now, speed, clearance, true);
         // A blind point at the body's edge may be passed at a slant; one already nearer than
         // that allows (a remembered one the robot came nearer to) need only get no nearer.
         let slant = self.radius_mm * BLIND_SLANT_RAD.cos();
-        near.extend(s.blind_points.iter().map(|&p| Obstacle {
+        obstacles.extend(s.blind_points.iter().map(|&p| Obstacle {
             p,
             c2: (clearance * clearance).min(p.norm_squared().min(slant * slant)),
         }));
+        let traffic = &self.config.traffic;
+        let planes = if traffic.reciprocal() {
+            let reach = self.longest_path_mm(v_now, speed);
+            let mut planes = traffic.half_planes(s.moving_points, self.radius_mm, reach);
+            planes.extend(traffic.half_planes(s.horizon_points, self.radius_mm, reach));
+            planes
+        } else {
+            Vec::new()
+        };
+        let near = Keep { obstacles, planes };
+        // With the traffic rule, headings are scored against the goal direction turned right
+        // while another robot stands ahead (the rule of the road).
+        let scored_rad =
+            traffic.heading_rad(goal_rad, goal.norm(), s.moving_points, self.radius_mm);
         // Arriving (within braking distance of a target in sight, where the approach speed
         // caps the speed) and moving away from it, the score is the signed speed made good,
         // `v cos(delta)`: a robot that overshot the target brakes and comes back rather than
@@ -297,7 +344,9 @@ impl VelocityAware {
         // behind a wall: the way there may lead away from it.)
         let receding = v_now.norm() > COURSE_MIN_SPEED_MM_S
             && v_now.dot(&Vec2::new(goal_rad.cos(), goal_rad.sin())) < 0.0;
-        if arriving && receding {
+        // Holding on a target in sight with the traffic rule, the robot scores so whatever its
+        // course: the course bonus would keep it circling the target.
+        if arriving && (receding || holding) {
             if let Some(d) = self.best_heading(&near, goal_rad, speed, v_now, Score::MadeGood) {
                 return d;
             }
@@ -312,14 +361,14 @@ impl VelocityAware {
             true => Score::Course(v_now.y.atan2(v_now.x)),
             false => Score::Toward,
         };
-        self.best_heading(&near, goal_rad, speed, v_now, score)
+        self.best_heading(&near, scored_rad, speed, v_now, score)
             .unwrap_or(STOP)
     }
 
     /// The admissible heading and speed with the best score, headings nearest the goal first.
     fn best_heading(
         &self,
-        near: &[Obstacle],
+        near: &Keep,
         goal_rad: f64,
         speed: f64,
         v_now: Vec2,
@@ -370,7 +419,7 @@ impl VelocityAware {
         u: Vec2,
         speed: f64,
         slowest: f64,
-        near: &[Obstacle],
+        near: &Keep,
     ) -> Option<f64> {
         let n = self.config.speeds;
         let at = |k: usize| speed * k as f64 / n as f64;
@@ -393,6 +442,17 @@ impl VelocityAware {
         }
         found.map(at)
     }
+}
+
+/// Whether the point `d_mm` away at `bearing_rad` lies in the free space (nearer than the free
+/// distance of the direction whose sector holds it).
+fn in_free_space(s: &Surroundings<'_>, bearing_rad: f64, d_mm: f64) -> bool {
+    (0..s.direction_rad.len())
+        .min_by(|&a, &b| {
+            angle_diff(s.direction_rad[a], bearing_rad)
+                .total_cmp(&angle_diff(s.direction_rad[b], bearing_rad))
+        })
+        .is_some_and(|j| d_mm < s.free_mm[j])
 }
 
 #[cfg(test)]
@@ -484,6 +544,8 @@ mod tests {
             obstacle_points: &pts,
             clear_points: &pts,
             blind_points: &[],
+            moving_points: &[],
+            horizon_points: &[],
         };
         for speed in [SpeedChoice::Fixed, SpeedChoice::Chosen] {
             let d = controller(speed, false, 400.0).decide(
@@ -510,6 +572,8 @@ mod tests {
             obstacle_points: &[],
             clear_points: clear,
             blind_points: blind,
+            moving_points: &[],
+            horizon_points: &[],
         }
     }
 

@@ -9,6 +9,7 @@ use crate::estimates::GroundReading;
 use crate::navigation::{MapSnapshot, NavigationReport};
 use crate::near_field::NearSpace;
 use crate::tables::ConfigProblem;
+use crate::traffic::TrafficPoints;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::Surroundings;
 use omniloop_vision::FreeSpace;
@@ -117,10 +118,12 @@ pub fn settings<T: serde::de::DeserializeOwned + Default>(
 }
 
 /// Runs `f` on the surroundings vision reported (with `near` as the surely free boundary, when
-/// given, else the free space's own) and the target, or stops without either.
+/// given, else the free space's own; with `traffic`'s moving obstacles and horizon for the
+/// traffic rule) and the target, or stops without either.
 pub fn with_surroundings(
     s: &Situation<'_>,
     near: Option<NearSpace>,
+    traffic: Option<&TrafficPoints>,
     f: impl FnOnce(&Surroundings<'_>, Vector2<f64>) -> Vector2<f64>,
 ) -> BodyCommand {
     let (Some(fs), Some(target)) = (s.freespace, s.target_body_mm) else {
@@ -133,6 +136,8 @@ pub fn with_surroundings(
         clear: coords(&fs.clear_points),
         blind: Vec::new(),
     });
+    let none = TrafficPoints::default();
+    let traffic = traffic.unwrap_or(&none);
     let surroundings = Surroundings {
         direction_rad: &fs.direction_rad,
         free_mm: &fs.free_mm,
@@ -140,6 +145,8 @@ pub fn with_surroundings(
         obstacle_points: &obstacles,
         clear_points: &near.clear,
         blind_points: &near.blind,
+        moving_points: &traffic.moving,
+        horizon_points: &traffic.horizon,
     };
     BodyCommand::translate(f(&surroundings, target))
 }

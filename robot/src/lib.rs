@@ -29,6 +29,7 @@ pub mod perception;
 pub mod remote;
 pub mod robot;
 pub mod tables;
+pub mod traffic;
 
 pub use boundary::{
     ActuatorCommand, ActuatorState, BodyCommand, Frame, Observation, OdometryReading, Outputs,

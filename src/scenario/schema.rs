@@ -453,6 +453,14 @@ impl Scenario {
         self.team.iter().map(|m| m.name.clone()).collect()
     }
 
+    /// Whether a robot has a goal (the one robot's `[goal]`, or any of a team's).
+    pub fn has_goal(&self) -> bool {
+        match self.team.is_empty() {
+            true => self.goal.is_some(),
+            false => self.team.iter().any(|m| m.goal.is_some()),
+        }
+    }
+
     /// The name of the one robot (`robot.name`, default `robot`).
     pub fn robot_name(&self) -> &str {
         self.robot.name.as_deref().unwrap_or(DEFAULT_ROBOT_NAME)

@@ -65,7 +65,7 @@ pub fn rows(plan: &Plan, outcomes: &[Option<Outcome>]) -> Vec<Row> {
                 error,
                 success: false,
             };
-            let has_goal = job.scenario.goal.is_some();
+            let has_goal = job.scenario.has_goal();
             row.success = row.error.is_none()
                 && row.number("wall_contacts") == Some(0.0)
                 && (!has_goal || row.number("reached_goal") == Some(1.0));

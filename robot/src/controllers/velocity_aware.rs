@@ -12,6 +12,7 @@ use crate::navigation::{
     self, MapSnapshot, NavigationReport, Navigator, PlannerConfig, PlannerKind,
 };
 use crate::near_field::NearField;
+use crate::traffic::StaticMap;
 use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, GoalKind, SpeedChoice, VelocityAware};
 
 /// The registry's entry.
@@ -43,6 +44,10 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         };
         Ok(Box::new(VelocityAwareStack {
             near: (avoid.speed == SpeedChoice::Chosen).then(|| NearField::new(b.radius_mm)),
+            traffic: avoid
+                .traffic
+                .reciprocal()
+                .then(|| StaticMap::new(&c.map)),
             controller: VelocityAware::new(
                 avoid,
                 drive,
@@ -61,6 +66,8 @@ pub struct VelocityAwareStack {
     controller: VelocityAware,
     near: Option<NearField>,
     navigator: Option<Navigator>,
+    /// With the traffic rule: the map that tells walls from what may move.
+    traffic: Option<StaticMap>,
 }
 
 impl Controller for VelocityAwareStack {
@@ -81,13 +88,17 @@ impl Controller for VelocityAwareStack {
             }
             _ => (s.target_body_mm, GoalKind::Ahead),
         };
+        let traffic = match (&self.traffic, s.freespace) {
+            (Some(map), Some(fs)) => Some(map.split(fs, s.pose.as_ref())),
+            _ => None,
+        };
         let s = Situation {
             target_body_mm,
             ..*s
         };
         let v = s.velocity_body_mm_s;
         let c = &self.controller;
-        with_surroundings(&s, clear, |sur, target| {
+        with_surroundings(&s, clear, traffic.as_ref(), |sur, target| {
             c.decide_toward(sur, target, kind, v).v_mm_s
         })
     }
