@@ -36,7 +36,8 @@ fn main() {
                 robot: None,
                 sensors: vec!["omni".to_string()],
             }],
-        ).unwrap();
+        )
+        .unwrap();
         let options = RunOptions {
             observers: vec![log.observer()],
             ..options

@@ -192,10 +192,19 @@ mod tests {
         assert!(mid < 0.0 && mid > near, "{mid} {near}");
         assert!((near + t.keep_right_deg.to_radians()).abs() < 1e-12);
         // Behind the robot or beyond the goal, nothing turns it.
-        assert_eq!(t.heading_rad(0.0, 3000.0, &[Vec2::new(-300.0, 0.0)], 90.0), 0.0);
-        assert_eq!(t.heading_rad(0.0, 250.0, &[Vec2::new(300.0, 0.0)], 90.0), 0.0);
+        assert_eq!(
+            t.heading_rad(0.0, 3000.0, &[Vec2::new(-300.0, 0.0)], 90.0),
+            0.0
+        );
+        assert_eq!(
+            t.heading_rad(0.0, 250.0, &[Vec2::new(300.0, 0.0)], 90.0),
+            0.0
+        );
         // Off: the goal direction.
         let off = TrafficConfig::default();
-        assert_eq!(off.heading_rad(0.0, 3000.0, &[Vec2::new(200.0, 0.0)], 90.0), 0.0);
+        assert_eq!(
+            off.heading_rad(0.0, 3000.0, &[Vec2::new(200.0, 0.0)], 90.0),
+            0.0
+        );
     }
 }

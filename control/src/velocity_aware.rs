@@ -155,11 +155,7 @@ impl VelocityAware {
             .map(|k| at((k as f64 * dt).min(horizon)))
             .collect();
         // A half-plane is convex: the samples in it, the segments between them are too.
-        if !keep
-            .planes
-            .iter()
-            .all(|h| path.iter().all(|p| h.holds(*p)))
-        {
+        if !keep.planes.iter().all(|h| path.iter().all(|p| h.holds(*p))) {
             return false;
         }
         let obstacles = &keep.obstacles;
@@ -413,14 +409,7 @@ impl VelocityAware {
 
     /// The fastest admissible of the speeds `speed k / n` (k = n ... 1) along `u` that is faster
     /// than `slowest`, by bisection.
-    fn fastest(
-        &self,
-        v_now: Vec2,
-        u: Vec2,
-        speed: f64,
-        slowest: f64,
-        near: &Keep,
-    ) -> Option<f64> {
+    fn fastest(&self, v_now: Vec2, u: Vec2, speed: f64, slowest: f64, near: &Keep) -> Option<f64> {
         let n = self.config.speeds;
         let at = |k: usize| speed * k as f64 / n as f64;
         let ok = |k: usize| self.clear_among(v_now, u * at(k), near);

@@ -68,18 +68,27 @@ def _scenario(scenario: ScenarioLike) -> Scenario:
     )
 
 
+def _one_robot(scenario: Scenario) -> Scenario:
+    if scenario.is_team:
+        raise ValueError(
+            f"scenario {scenario.name!r} has a team ([[robots]]): its robots are agents of "
+            "omniloop.pettingzoo.parallel_env, not one Gymnasium environment"
+        )
+    return scenario
+
+
 class _Task:
-    """What the single and the vector environment share: spaces, observation, reward."""
+    """What the single and the vector environment (and each agent of the PettingZoo
+    environment) share: spaces, observation, reward, for one robot (``Scenario.robot``)."""
 
     def __init__(
         self,
-        scenario: Scenario,
+        robot: dict[str, Any],
         contact_penalty: float,
         max_omega_rad_s: Optional[float],
     ) -> None:
         if not (math.isfinite(contact_penalty) and contact_penalty >= 0.0):
             raise ValueError(f"contact_penalty={contact_penalty}: a finite number >= 0")
-        robot = scenario.robot
         self.sensors = [(s["name"], s["height_px"], s["width_px"]) for s in robot["sensors"]]
         goal = robot["goal"]
         self.goal = None if goal is None else (goal["x_mm"], goal["y_mm"])
@@ -152,8 +161,8 @@ class OmniloopEnv(gymnasium.Env):
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
-        self.scenario = _scenario(scenario)
-        self._task = _Task(self.scenario, contact_penalty, max_omega_rad_s)
+        self.scenario = _one_robot(_scenario(scenario))
+        self._task = _Task(self.scenario.robot, contact_penalty, max_omega_rad_s)
         self.observation_space = self._task.observation_space
         self.action_space = self._task.action_space
         self.render_mode = render_mode
@@ -212,8 +221,8 @@ class OmniloopVectorEnv(VectorEnv):
         contact_penalty: float = 1.0,
         max_omega_rad_s: Optional[float] = None,
     ) -> None:
-        self.scenario = _scenario(scenario)
-        self._task = _Task(self.scenario, contact_penalty, max_omega_rad_s)
+        self.scenario = _one_robot(_scenario(scenario))
+        self._task = _Task(self.scenario.robot, contact_penalty, max_omega_rad_s)
         self.num_envs = int(num_envs)
         self.single_observation_space = self._task.observation_space
         self.single_action_space = self._task.action_space

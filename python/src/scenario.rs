@@ -128,57 +128,40 @@ impl PyScenario {
         self.scenario.max_cycles()
     }
 
-    /// What the robot knows of itself: `start` (x_mm, y_mm, theta_rad), `radius_mm`,
+    /// What the robot knows of itself: `name`, `start` (x_mm, y_mm, theta_rad), `radius_mm`,
     /// `max_speed_mm_s`, `accel_limit_mm_s2`, `angular_accel_limit_rad_s2`, `differential`
     /// (`None`, or `track_mm` and `max_turn_rate_rad_s`), `sensors` (name, width_px,
     /// height_px, kind, pan unit), and `goal` (`None`, or `x_mm`, `y_mm`, `tolerance_mm`,
-    /// `waypoints_mm`).
+    /// `waypoints_mm`); of a team, its first robot.
     #[getter]
     fn robot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = &self.scenario;
-        let r = &s.robot;
+        robot_dict(
+            py,
+            &self.scenario.member(0),
+            &self.scenario.robot_names()[0],
+        )
+    }
+
+    /// Every robot as `robot` describes it, by name, in the scenario's order (one entry for
+    /// a one-robot scenario).
+    #[getter]
+    fn robots<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        let start = s.start();
-        d.set_item(
-            "start",
-            (start.x_mm, start.y_mm, start.heading_deg.to_radians()),
-        )?;
-        d.set_item("radius_mm", r.radius_mm)?;
-        d.set_item("max_speed_mm_s", r.max_speed_mm_s)?;
-        d.set_item("accel_limit_mm_s2", r.accel_limit_mm_s2)?;
-        d.set_item("angular_accel_limit_rad_s2", r.angular_accel_limit_rad_s2)?;
-        match &r.differential {
-            Some(diff) => {
-                let dd = PyDict::new(py);
-                dd.set_item("track_mm", diff.track_mm)?;
-                dd.set_item("max_turn_rate_rad_s", diff.max_turn_rate_deg_s.to_radians())?;
-                d.set_item("differential", dd)?;
-            }
-            None => d.set_item("differential", py.None())?,
-        }
-        let sensors = PyList::empty(py);
-        for spec in &r.sensors {
-            let sd = PyDict::new(py);
-            sd.set_item("name", &spec.name)?;
-            sd.set_item("width_px", spec.width_px)?;
-            sd.set_item("height_px", spec.height_px)?;
-            sd.set_item("kind", spec.optics.kind())?;
-            sd.set_item("pan_unit", spec.optics.pinhole().is_some())?;
-            sensors.append(sd)?;
-        }
-        d.set_item("sensors", sensors)?;
-        match &s.goal {
-            Some(g) => {
-                let gd = PyDict::new(py);
-                gd.set_item("x_mm", g.x_mm)?;
-                gd.set_item("y_mm", g.y_mm)?;
-                gd.set_item("tolerance_mm", g.tolerance_mm)?;
-                gd.set_item("waypoints_mm", g.waypoints_mm.clone())?;
-                d.set_item("goal", gd)?;
-            }
-            None => d.set_item("goal", py.None())?,
+        for (m, name) in self
+            .scenario
+            .members()
+            .iter()
+            .zip(self.scenario.robot_names())
+        {
+            d.set_item(&name, robot_dict(py, m, &name)?)?;
         }
         Ok(d)
+    }
+
+    /// Whether the scenario has a team (`[[robots]]`).
+    #[getter]
+    fn is_team(&self) -> bool {
+        self.scenario.is_team()
     }
 
     fn __repr__(&self) -> String {
@@ -187,4 +170,52 @@ impl PyScenario {
             self.scenario.name, self.scenario.seed
         )
     }
+}
+
+/// What robot `name` of a one-robot scenario `s` knows of itself (see `Scenario.robot`).
+fn robot_dict<'py>(py: Python<'py>, s: &Scenario, name: &str) -> PyResult<Bound<'py, PyDict>> {
+    let r = &s.robot;
+    let d = PyDict::new(py);
+    d.set_item("name", name)?;
+    let start = s.start();
+    d.set_item(
+        "start",
+        (start.x_mm, start.y_mm, start.heading_deg.to_radians()),
+    )?;
+    d.set_item("radius_mm", r.radius_mm)?;
+    d.set_item("max_speed_mm_s", r.max_speed_mm_s)?;
+    d.set_item("accel_limit_mm_s2", r.accel_limit_mm_s2)?;
+    d.set_item("angular_accel_limit_rad_s2", r.angular_accel_limit_rad_s2)?;
+    match &r.differential {
+        Some(diff) => {
+            let dd = PyDict::new(py);
+            dd.set_item("track_mm", diff.track_mm)?;
+            dd.set_item("max_turn_rate_rad_s", diff.max_turn_rate_deg_s.to_radians())?;
+            d.set_item("differential", dd)?;
+        }
+        None => d.set_item("differential", py.None())?,
+    }
+    let sensors = PyList::empty(py);
+    for spec in &r.sensors {
+        let sd = PyDict::new(py);
+        sd.set_item("name", &spec.name)?;
+        sd.set_item("width_px", spec.width_px)?;
+        sd.set_item("height_px", spec.height_px)?;
+        sd.set_item("kind", spec.optics.kind())?;
+        sd.set_item("pan_unit", spec.optics.pinhole().is_some())?;
+        sensors.append(sd)?;
+    }
+    d.set_item("sensors", sensors)?;
+    match &s.goal {
+        Some(g) => {
+            let gd = PyDict::new(py);
+            gd.set_item("x_mm", g.x_mm)?;
+            gd.set_item("y_mm", g.y_mm)?;
+            gd.set_item("tolerance_mm", g.tolerance_mm)?;
+            gd.set_item("waypoints_mm", g.waypoints_mm.clone())?;
+            d.set_item("goal", gd)?;
+        }
+        None => d.set_item("goal", py.None())?,
+    }
+    Ok(d)
 }

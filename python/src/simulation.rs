@@ -45,6 +45,75 @@ impl Driver {
     }
 }
 
+/// Who drives each robot, as Python names it: one word for every robot (`robot="python"`),
+/// or a dict naming every robot of a team (`robot={"blue1": "python", "blue2": "builtin"}`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Drivers {
+    /// The same software on every robot.
+    All(Driver),
+    /// Each robot's, by name.
+    Named(Vec<(String, Driver)>),
+}
+
+impl Drivers {
+    /// Reads `robot=`: a word or a dict of words.
+    pub fn parse(robot: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if let Ok(word) = robot.extract::<String>() {
+            return Ok(Self::All(Driver::parse(&word)?));
+        }
+        let dict = robot.cast::<PyDict>().map_err(|_| {
+            PyValueError::new_err(
+                "robot= is \"python\", \"builtin\" or a dict {robot name: \"python\" or \
+                 \"builtin\"} naming every robot of the team",
+            )
+        })?;
+        let mut named = Vec::with_capacity(dict.len());
+        for (k, v) in dict.iter() {
+            let name: String = k
+                .extract()
+                .map_err(|_| PyValueError::new_err("robot=: every key is a robot's name (str)"))?;
+            let word: String = v.extract().map_err(|_| {
+                PyValueError::new_err(format!(
+                    "robot={{{name:?}: ...}}: \"python\" or \"builtin\""
+                ))
+            })?;
+            named.push((name, Driver::parse(&word)?));
+        }
+        Ok(Self::Named(named))
+    }
+
+    /// Each robot's driver, in the order of `names`; a name that is no robot's, or a robot
+    /// left without software, is refused.
+    pub fn resolve(&self, scenario: &str, names: &[String]) -> PyResult<Vec<Driver>> {
+        let named = match self {
+            Self::All(d) => return Ok(vec![*d; names.len()]),
+            Self::Named(named) => named,
+        };
+        if let Some((stranger, _)) = named.iter().find(|(n, _)| !names.contains(n)) {
+            return Err(PyValueError::new_err(format!(
+                "robot={{{stranger:?}: ...}}: scenario {scenario:?} has no robot of that name \
+                 (its robots: {})",
+                names.join(", ")
+            )));
+        }
+        names
+            .iter()
+            .map(|name| {
+                named
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, d)| *d)
+                    .ok_or_else(|| {
+                        PyValueError::new_err(format!(
+                            "robot {name:?} has no software: name it in robot={{...}} with \
+                             \"python\" (your commands) or \"builtin\" (the scenario's stack)"
+                        ))
+                    })
+            })
+            .collect()
+    }
+}
+
 /// The renderer named in Python.
 pub fn renderer_choice(name: &str) -> PyResult<RendererChoice> {
     name.parse()
@@ -59,30 +128,39 @@ pub struct Command {
     estimate: Option<Isometry2<f64>>,
 }
 
-/// One run being stepped, with what the robot's side keeps between steps.
-pub struct State {
-    session: Session,
+/// What the robot's side keeps of one robot between steps.
+struct Member {
+    name: String,
+    /// Where Python's commands go, when Python drives it.
     remote: Option<RemoteHandle>,
     dead_reckoning: DeadReckoning,
     start: Isometry2<f64>,
     differential: bool,
     pan_sensors: Vec<String>,
     sensors: Vec<String>,
+}
+
+/// One run being stepped, with what the robots' side keeps between steps.
+pub struct State {
+    session: Session,
+    members: Vec<Member>,
+    team: bool,
     seed: u64,
 }
 
 impl State {
-    /// Builds the run of `scenario` with `seed` and senses its first frames.
+    /// Builds the run of `scenario` with `seed`, each robot driven by its entry of `drivers`
+    /// (in the scenario's order of robots), and senses its first frames.
     pub fn new(
         scenario: &Scenario,
         seed: u64,
         renderer: RendererChoice,
-        driver: Driver,
+        drivers: &[Driver],
         shared_gpu: Option<BatchHandle>,
     ) -> Result<Self, RunError> {
         let mut scenario = scenario.clone();
         scenario.seed = seed;
-        if driver == Driver::Python {
+        if drivers.contains(&Driver::Python) {
             // Python is the robot's software: it drives, whatever pilot the file names.
             scenario.run.pilot = PilotChoice::Robot;
         }
@@ -91,52 +169,76 @@ impl State {
             shared_gpu,
             ..RunOptions::default()
         };
-        let mut remote = None;
-        let session = match driver {
-            Driver::Python => Session::new(
-                &scenario,
-                &options,
-                |config| {
-                    let (software, handle) = Remote::new(config, "python");
-                    remote = Some(handle);
-                    Ok(Box::new(software))
-                },
-                |_| {},
-            )?,
-            Driver::Builtin => {
-                Session::new(&scenario, &options, omniloop::run::builtin_software, |_| {})?
-            }
-        };
-        let r = &scenario.robot;
+        let names = scenario.robot_names();
+        let mut remotes: Vec<Option<RemoteHandle>> = vec![None; names.len()];
+        let session = Session::new(
+            &scenario,
+            &options,
+            |config| {
+                let k = names.iter().position(|n| *n == config.name).unwrap_or(0);
+                match drivers.get(k).copied().unwrap_or(Driver::Builtin) {
+                    Driver::Python => {
+                        let (software, handle) = Remote::new(config, "python");
+                        remotes[k] = Some(handle);
+                        Ok(Box::new(software))
+                    }
+                    Driver::Builtin => omniloop::run::builtin_software(config),
+                }
+            },
+            |_| {},
+        )?;
+        let members = scenario
+            .members()
+            .iter()
+            .zip(names)
+            .zip(remotes)
+            .map(|((m, name), remote)| Member {
+                name,
+                remote,
+                dead_reckoning: DeadReckoning::new(),
+                start: m.start().isometry(),
+                differential: m.robot.differential.is_some(),
+                pan_sensors: m
+                    .robot
+                    .sensors
+                    .iter()
+                    .filter(|s| s.optics.pinhole().is_some())
+                    .map(|s| s.name.clone())
+                    .collect(),
+                sensors: m.robot.sensors.iter().map(|s| s.name.clone()).collect(),
+            })
+            .collect();
         Ok(Self {
             session,
-            remote,
-            dead_reckoning: DeadReckoning::new(),
-            start: scenario.start().isometry(),
-            differential: r.differential.is_some(),
-            pan_sensors: r
-                .sensors
-                .iter()
-                .filter(|s| s.optics.pinhole().is_some())
-                .map(|s| s.name.clone())
-                .collect(),
-            sensors: r.sensors.iter().map(|s| s.name.clone()).collect(),
+            members,
+            team: scenario.is_team(),
             seed,
         })
     }
 
-    /// One control cycle with `command` (the Python robot's) and the odometry it brings.
+    /// One control cycle with `command` (the one robot's, when Python drives it).
     pub fn step(&mut self, command: Option<Command>) -> Result<(), RunError> {
-        if let (Some(remote), Some(c)) = (&self.remote, command) {
-            let mut m = remote.lock();
-            m.command = c.body;
-            m.actuators = c.actuators;
-            m.estimate = c.estimate;
+        self.step_all(vec![command])
+    }
+
+    /// One control cycle with each robot's command (in the robots' order; `None` for a robot
+    /// the built-in software drives), and the odometry it brings.
+    pub fn step_all(&mut self, commands: Vec<Option<Command>>) -> Result<(), RunError> {
+        for (m, c) in self.members.iter().zip(commands) {
+            if let (Some(remote), Some(c)) = (&m.remote, c) {
+                let mut mail = remote.lock();
+                mail.command = c.body;
+                mail.actuators = c.actuators;
+                mail.estimate = c.estimate;
+            }
         }
         self.session.step()?;
-        if let Some(r) = self.session.simulation().last_odometry() {
-            self.dead_reckoning
-                .update(r.v_body_mm_s, r.omega_rad_s, r.dt_s);
+        let sim = self.session.simulation();
+        for (m, a) in self.members.iter_mut().zip(sim.robots()) {
+            if let Some(r) = a.last_odometry() {
+                m.dead_reckoning
+                    .update(r.v_body_mm_s, r.omega_rad_s, r.dt_s);
+            }
         }
         Ok(())
     }
@@ -146,9 +248,14 @@ impl State {
         self.session.finished()
     }
 
-    /// The truth now.
+    /// The truth now (the first robot's).
     pub fn truth(&self) -> Truth {
         self.session.simulation().truth()
+    }
+
+    /// Robot `k`'s truth now.
+    fn truth_of(&self, k: usize) -> Option<Truth> {
+        self.session.simulation().truth_of(k)
     }
 
     /// The session.
@@ -161,21 +268,43 @@ impl State {
         self.seed
     }
 
-    /// Where dead reckoning puts the robot (world frame, from the start it is told).
-    pub fn odometry_pose(&self) -> Isometry2<f64> {
-        self.start * self.dead_reckoning.pose()
+    /// Whether the scenario is a team's.
+    pub fn is_team(&self) -> bool {
+        self.team
     }
 
-    /// The Python robot's command, checked against this robot: `(vx_mm_s, vy_mm_s,
-    /// omega_rad_s)`, or `(v_mm_s, omega_rad_s)` for a differential drive; pan commands for
-    /// cameras on pan units; an estimate `(x_mm, y_mm, theta_rad)`.
+    /// The robots' names, in order.
+    pub fn names(&self) -> Vec<String> {
+        self.members.iter().map(|m| m.name.clone()).collect()
+    }
+
+    /// Where dead reckoning puts robot `k` (world frame, from the start it is told).
+    fn odometry_pose(&self, k: usize) -> Isometry2<f64> {
+        let m = &self.members[k];
+        m.start * m.dead_reckoning.pose()
+    }
+
+    /// The one robot's command (see [`State::command_of`]).
     pub fn command(
         &self,
         command: &Bound<'_, PyAny>,
         actuators: Option<&Bound<'_, PyAny>>,
         estimate: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Command> {
-        let body = if self.differential {
+        self.command_of(0, command, actuators, estimate)
+    }
+
+    /// Robot `k`'s command from Python, checked against that robot: `(vx_mm_s, vy_mm_s,
+    /// omega_rad_s)`, or `(v_mm_s, omega_rad_s)` for a differential drive; pan commands for
+    /// cameras on pan units; an estimate `(x_mm, y_mm, theta_rad)`.
+    fn command_of(
+        &self,
+        k: usize,
+        command: &Bound<'_, PyAny>,
+        actuators: Option<&Bound<'_, PyAny>>,
+        estimate: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Command> {
+        let body = if self.members[k].differential {
             let v = finite_numbers("command", command, "v_mm_s, omega_rad_s")?;
             let [speed, omega] = v[..] else {
                 return Err(PyValueError::new_err(format!(
@@ -202,7 +331,7 @@ impl State {
             }
         };
         let actuators = match actuators {
-            Some(a) if !a.is_none() => self.actuator_commands(a)?,
+            Some(a) if !a.is_none() => self.actuator_commands(k, a)?,
             _ => Vec::new(),
         };
         let estimate = match estimate {
@@ -226,7 +355,12 @@ impl State {
 
     /// Pan commands: a list of dicts `{"sensor": NAME, "pan_rad": A}` (pan toward A) or
     /// `{"sensor": NAME, "rate_rad_s": W}` (pan at W until told otherwise).
-    fn actuator_commands(&self, list: &Bound<'_, PyAny>) -> PyResult<Vec<ActuatorCommand>> {
+    fn actuator_commands(
+        &self,
+        k: usize,
+        list: &Bound<'_, PyAny>,
+    ) -> PyResult<Vec<ActuatorCommand>> {
+        let member = &self.members[k];
         let shape = "actuators must be a list of dicts {\"sensor\": NAME, \"pan_rad\": A} or \
                      {\"sensor\": NAME, \"rate_rad_s\": W}";
         let items: Vec<Bound<'_, PyDict>> =
@@ -238,11 +372,11 @@ impl State {
                 .ok_or_else(|| PyValueError::new_err(shape))?
                 .extract()
                 .map_err(|_| PyValueError::new_err(shape))?;
-            if !self.pan_sensors.contains(&sensor) {
+            if !member.pan_sensors.contains(&sensor) {
                 return Err(PyValueError::new_err(format!(
                     "actuators: no pan unit carries camera {sensor:?} (cameras: {:?}; only \
                      pinhole cameras are on pan units: {:?})",
-                    self.sensors, self.pan_sensors
+                    member.sensors, member.pan_sensors
                 )));
             }
             let number = |key: &str| -> PyResult<Option<f64>> {
@@ -352,14 +486,20 @@ impl Observation {
     }
 }
 
-/// The observation of `state` now.
+/// The observation of `state` now (its first robot's).
 pub fn observation(py: Python<'_>, state: &State) -> PyResult<Observation> {
+    observation_of(py, state, 0)
+}
+
+/// Robot `k`'s observation of `state` now.
+fn observation_of(py: Python<'_>, state: &State, k: usize) -> PyResult<Observation> {
     let sim = state.session().simulation();
+    let agent = &sim.robots()[k];
     let frames = PyDict::new(py);
-    for f in sim.frames() {
+    for f in agent.frames() {
         frames.set_item(f.sensor, rgb_array(py, f.image))?;
     }
-    let odometry = match sim.last_odometry() {
+    let odometry = match agent.last_odometry() {
         Some(r) => Odometry {
             vx_mm_s: r.v_body_mm_s.x,
             vy_mm_s: r.v_body_mm_s.y,
@@ -374,17 +514,17 @@ pub fn observation(py: Python<'_>, state: &State) -> PyResult<Observation> {
         },
     };
     let actuators = PyDict::new(py);
-    for a in sim.actuator_state() {
+    for a in agent.actuator_state() {
         let ActuatorState::Pan { sensor, pan_rad } = a;
         actuators.set_item(sensor, pan_rad)?;
     }
-    let record = match state.remote {
+    let record = match state.members[k].remote {
         Some(_) => None,
-        None => last_line(state),
+        None => last_line(state, k),
     };
-    let p = state.odometry_pose();
+    let p = state.odometry_pose(k);
     Ok(Observation {
-        t_s: sim.truth().t_s,
+        t_s: sim.world().time_s(),
         cycle: sim.cycle(),
         frames: frames.unbind(),
         odometry: Py::new(py, odometry)?,
@@ -395,19 +535,69 @@ pub fn observation(py: Python<'_>, state: &State) -> PyResult<Observation> {
     })
 }
 
-/// The last cycle's `estimates.jsonl` line (truth included), if a cycle ran.
-fn last_line(state: &State) -> Option<String> {
-    let sim = state.session().simulation();
-    let estimates = sim.estimates();
-    let k = estimates.len().checked_sub(1)?;
-    Some(estimates_line(&sim.trajectory()[k], &estimates[k]))
+/// Every robot's observation by name, for a team; the one robot's observation otherwise.
+fn observations(py: Python<'_>, state: &State) -> PyResult<Py<PyAny>> {
+    if !state.is_team() {
+        return Ok(Py::new(py, observation_of(py, state, 0)?)?.into_any());
+    }
+    let d = PyDict::new(py);
+    for (k, name) in state.names().iter().enumerate() {
+        d.set_item(name, Py::new(py, observation_of(py, state, k)?)?)?;
+    }
+    Ok(d.into_any().unbind())
 }
 
-/// The last cycle's `estimates.jsonl` record as a dict (truth included), if a cycle ran.
-fn last_record<'py>(py: Python<'py>, state: &State) -> PyResult<Option<Bound<'py, PyAny>>> {
-    last_line(state)
+/// Robot `k`'s last `estimates.jsonl` line (truth included), if a cycle ran.
+fn last_line(state: &State, k: usize) -> Option<String> {
+    let agent = &state.session().simulation().robots()[k];
+    let estimates = agent.estimates();
+    let i = estimates.len().checked_sub(1)?;
+    Some(estimates_line(&agent.trajectory()[i], &estimates[i]))
+}
+
+/// Robot `k`'s last `estimates.jsonl` record as a dict (truth included), if a cycle ran.
+fn last_record<'py>(
+    py: Python<'py>,
+    state: &State,
+    k: usize,
+) -> PyResult<Option<Bound<'py, PyAny>>> {
+    last_line(state, k)
         .map(|line| json_to_py(py, &line))
         .transpose()
+}
+
+/// `f` of every robot by name, for a team; of the one robot otherwise.
+fn per_robot<'py>(
+    py: Python<'py>,
+    state: &State,
+    f: impl Fn(usize) -> PyResult<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    if !state.is_team() {
+        return f(0);
+    }
+    let d = PyDict::new(py);
+    for (k, name) in state.names().iter().enumerate() {
+        d.set_item(name, f(k)?)?;
+    }
+    Ok(d.into_any())
+}
+
+/// A team's `what` argument of `step()`: a dict by robot name (or nothing); `python` names
+/// the robots Python drives, for the message.
+fn team_dict<'py>(
+    what: &str,
+    v: Option<&Bound<'py, PyAny>>,
+    python: &[String],
+) -> PyResult<Option<Bound<'py, PyDict>>> {
+    match v {
+        Some(v) if !v.is_none() => v.cast::<PyDict>().map(|d| Some(d.clone())).map_err(|_| {
+            PyValueError::new_err(format!(
+                "a team's step() takes {what} as a dict {{robot name: ...}} (Python drives: {})",
+                python.join(", ")
+            ))
+        }),
+        _ => Ok(None),
+    }
 }
 
 /// The truth as a dict.
@@ -431,7 +621,8 @@ pub fn truth_dict<'py>(py: Python<'py>, t: &Truth) -> PyResult<Bound<'py, PyDict
 pub struct PySimulation {
     scenario: PyScenario,
     renderer: RendererChoice,
-    driver: Driver,
+    /// Who drives each robot, in the robots' order.
+    drivers: Vec<Driver>,
     state: Mutex<State>,
 }
 
@@ -439,41 +630,152 @@ impl PySimulation {
     fn lock(&self) -> MutexGuard<'_, State> {
         self.state.lock().unwrap_or_else(PoisonError::into_inner)
     }
+
+    /// The robots Python drives, by name.
+    fn driven_by_python(&self, state: &State) -> Vec<String> {
+        state
+            .names()
+            .into_iter()
+            .zip(&self.drivers)
+            .filter(|(_, d)| **d == Driver::Python)
+            .map(|(n, _)| n)
+            .collect()
+    }
+
+    /// The one robot's checked command for a step.
+    fn one_command(
+        &self,
+        state: &State,
+        command: Option<&Bound<'_, PyAny>>,
+        actuators: Option<&Bound<'_, PyAny>>,
+        estimate: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Vec<Option<Command>>> {
+        Ok(vec![match (self.drivers[0], command) {
+            (Driver::Python, Some(c)) if !c.is_none() => {
+                Some(state.command(c, actuators, estimate)?)
+            }
+            (Driver::Python, _) => {
+                return Err(PyValueError::new_err(
+                    "step() needs a command: (vx_mm_s, vy_mm_s, omega_rad_s), or (v_mm_s, \
+                     omega_rad_s) for a differential robot",
+                ));
+            }
+            (Driver::Builtin, Some(c)) if !c.is_none() => {
+                return Err(PyValueError::new_err(
+                    "robot=\"builtin\" decides its own commands: call step() without one",
+                ));
+            }
+            (Driver::Builtin, _) => None,
+        }])
+    }
+
+    /// A team's checked commands for a step: `command` (and `actuators`, `estimate`) are
+    /// dicts by robot name, holding every robot Python drives and no other.
+    fn team_commands(
+        &self,
+        state: &State,
+        command: Option<&Bound<'_, PyAny>>,
+        actuators: Option<&Bound<'_, PyAny>>,
+        estimate: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Vec<Option<Command>>> {
+        let names = state.names();
+        let python = self.driven_by_python(state);
+        let dict = |what: &str, v| team_dict(what, v, &python);
+        let (commands, actuators, estimates) = (
+            dict("command", command)?,
+            dict("actuators", actuators)?,
+            dict("estimate", estimate)?,
+        );
+        for d in [&commands, &actuators, &estimates].into_iter().flatten() {
+            for key in d.keys() {
+                let name: String = key.extract().map_err(|_| {
+                    PyValueError::new_err("step(): every key is a robot's name (str)")
+                })?;
+                if !names.contains(&name) {
+                    return Err(PyValueError::new_err(format!(
+                        "step(): no robot {name:?} (the robots: {})",
+                        names.join(", ")
+                    )));
+                }
+                if !python.contains(&name) {
+                    return Err(PyValueError::new_err(format!(
+                        "step(): robot {name:?} runs the built-in software: give it no command"
+                    )));
+                }
+            }
+        }
+        let mut out = Vec::with_capacity(names.len());
+        for (k, name) in names.iter().enumerate() {
+            if self.drivers[k] == Driver::Builtin {
+                out.push(None);
+                continue;
+            }
+            let c = commands
+                .as_ref()
+                .and_then(|d| d.get_item(name).ok().flatten());
+            let Some(c) = c else {
+                return Err(PyValueError::new_err(format!(
+                    "step(): no command for robot {name:?} (Python drives: {})",
+                    python.join(", ")
+                )));
+            };
+            let a = actuators
+                .as_ref()
+                .and_then(|d| d.get_item(name).ok().flatten());
+            let e = estimates
+                .as_ref()
+                .and_then(|d| d.get_item(name).ok().flatten());
+            let cmd = state
+                .command_of(k, &c, a.as_ref(), e.as_ref())
+                .map_err(|err| {
+                    let why = err.value(c.py()).to_string();
+                    PyValueError::new_err(format!("robot {name:?}: {why}"))
+                })?;
+            out.push(Some(cmd));
+        }
+        Ok(out)
+    }
 }
 
 #[pymethods]
 impl PySimulation {
     /// A run of `scenario` with `seed` (default: the scenario's), the `renderer` (`"cpu"`,
     /// `"gpu"` or `"auto"`) and `robot`: `"python"` (you step it with commands) or
-    /// `"builtin"` (the scenario's own robot software decides).
+    /// `"builtin"` (the scenario's own robot software decides); for a team, one of these for
+    /// every robot or a dict naming each robot's (`{"blue1": "python", "blue2": "builtin"}`).
     #[new]
-    #[pyo3(signature = (scenario, seed = None, renderer = "cpu", robot = "python"))]
+    #[pyo3(signature = (scenario, seed = None, renderer = "cpu", robot = None))]
     fn new(
         py: Python<'_>,
         scenario: PyRef<'_, PyScenario>,
         seed: Option<u64>,
         renderer: &str,
-        robot: &str,
+        robot: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let renderer = renderer_choice(renderer)?;
-        let driver = Driver::parse(robot)?;
+        let drivers = match robot {
+            Some(r) if !r.is_none() => Drivers::parse(r)?,
+            _ => Drivers::All(Driver::Python),
+        };
         let scenario = scenario.clone();
-        let seed = seed.unwrap_or(scenario.scenario.seed);
+        let s = &scenario.scenario;
+        let drivers = drivers.resolve(&s.name, &s.robot_names())?;
+        let seed = seed.unwrap_or(s.seed);
         let state = py
-            .detach(|| State::new(&scenario.scenario, seed, renderer, driver, None))
+            .detach(|| State::new(s, seed, renderer, &drivers, None))
             .map_err(run_error)?;
         Ok(Self {
             scenario,
             renderer,
-            driver,
+            drivers,
             state: Mutex::new(state),
         })
     }
 
     /// Starts the run again from its start with `seed` (default: this simulation's seed) and
-    /// returns the first observation.
+    /// returns the first observation (a team's: a dict of observations by robot name).
     #[pyo3(signature = (seed = None))]
-    fn reset(&self, py: Python<'_>, seed: Option<u64>) -> PyResult<Observation> {
+    fn reset(&self, py: Python<'_>, seed: Option<u64>) -> PyResult<Py<PyAny>> {
         let seed = seed.unwrap_or_else(|| self.lock().seed());
         let fresh = py
             .detach(|| {
@@ -481,27 +783,28 @@ impl PySimulation {
                     &self.scenario.scenario,
                     seed,
                     self.renderer,
-                    self.driver,
+                    &self.drivers,
                     None,
                 )
             })
             .map_err(run_error)?;
         let mut state = self.lock();
         *state = fresh;
-        observation(py, &state)
+        observations(py, &state)
     }
 
     /// The observation now (what the last `reset` or `step` returned).
-    fn observe(&self, py: Python<'_>) -> PyResult<Observation> {
-        observation(py, &self.lock())
+    fn observe(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        observations(py, &self.lock())
     }
 
-    /// One control cycle. With `robot="python"`, `command` is `(vx_mm_s, vy_mm_s,
-    /// omega_rad_s)` in the body frame (x forward, y left; a differential robot takes
-    /// `(v_mm_s, omega_rad_s)`), `actuators` an optional list of pan commands
-    /// (`{"sensor": NAME, "pan_rad": A}` or `{"sensor": NAME, "rate_rad_s": W}`), and
-    /// `estimate` an optional `(x_mm, y_mm, theta_rad)` recorded as the robot's own estimate.
-    /// With `robot="builtin"` no command is given. Returns the next observation.
+    /// One control cycle. The one robot driven by Python takes `command`: `(vx_mm_s,
+    /// vy_mm_s, omega_rad_s)` in the body frame (x forward, y left; a differential robot takes
+    /// `(v_mm_s, omega_rad_s)`), `actuators` an optional list of pan commands (`{"sensor":
+    /// NAME, "pan_rad": A}` or `{"sensor": NAME, "rate_rad_s": W}`), and `estimate` an
+    /// optional `(x_mm, y_mm, theta_rad)` recorded as the robot's own estimate; with
+    /// `robot="builtin"` no command is given. A team takes each as a dict by robot name,
+    /// holding every robot Python drives. Returns the next observation (a team's: a dict).
     #[pyo3(signature = (command = None, actuators = None, estimate = None))]
     fn step(
         &self,
@@ -509,8 +812,8 @@ impl PySimulation {
         command: Option<&Bound<'_, PyAny>>,
         actuators: Option<&Bound<'_, PyAny>>,
         estimate: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Observation> {
-        let cmd = {
+    ) -> PyResult<Py<PyAny>> {
+        let cmds = {
             let state = self.lock();
             if state.done() {
                 return Err(PyRuntimeError::new_err(format!(
@@ -519,39 +822,35 @@ impl PySimulation {
                     state.session().simulation().cycle()
                 )));
             }
-            match (self.driver, command) {
-                (Driver::Python, Some(c)) if !c.is_none() => {
-                    Some(state.command(c, actuators, estimate)?)
-                }
-                (Driver::Python, _) => {
-                    return Err(PyValueError::new_err(
-                        "step() needs a command: (vx_mm_s, vy_mm_s, omega_rad_s), or (v_mm_s, \
-                         omega_rad_s) for a differential robot",
-                    ));
-                }
-                (Driver::Builtin, Some(c)) if !c.is_none() => {
-                    return Err(PyValueError::new_err(
-                        "robot=\"builtin\" decides its own commands: call step() without one",
-                    ));
-                }
-                (Driver::Builtin, _) => None,
+            match state.is_team() {
+                true => self.team_commands(&state, command, actuators, estimate)?,
+                false => self.one_command(&state, command, actuators, estimate)?,
             }
         };
-        py.detach(|| self.lock().step(cmd)).map_err(run_error)?;
-        observation(py, &self.lock())
+        py.detach(|| self.lock().step_all(cmds))
+            .map_err(run_error)?;
+        observations(py, &self.lock())
     }
 
     /// The truth now (the simulator's side, never part of an observation): `t_s`, `x_mm`,
     /// `y_mm`, `theta_rad`, `vx_mm_s`, `vy_mm_s` (world frame), `omega_rad_s`, `contacts` so
-    /// far, `reached_goal`, `targets_reached` (with waypoints).
-    fn truth<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        truth_dict(py, &self.lock().truth())
+    /// far, `reached_goal`, `targets_reached` (with waypoints); a team's: a dict of these by
+    /// robot name.
+    fn truth<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let state = self.lock();
+        per_robot(py, &state, |k| {
+            let t = state.truth_of(k).unwrap_or_else(|| state.truth());
+            Ok(truth_dict(py, &t)?.into_any())
+        })
     }
 
     /// The last cycle's `estimates.jsonl` record (truth beside belief) as a dict; `None`
-    /// before the first step.
-    fn record<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        last_record(py, &self.lock())
+    /// before the first step (a team's: a dict of these by robot name).
+    fn record<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let state = self.lock();
+        per_robot(py, &state, |k| {
+            Ok(last_record(py, &state, k)?.unwrap_or_else(|| py.None().into_bound(py)))
+        })
     }
 
     /// The run's `summary.json` so far, as a dict.
@@ -562,14 +861,19 @@ impl PySimulation {
         json_to_py(py, &text)
     }
 
-    /// The trajectory so far: a dict of NumPy columns named as `trajectory.csv`'s header.
-    fn trajectory<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    /// The trajectory so far: a dict of NumPy columns named as `trajectory.csv`'s header (a
+    /// team's: a dict of these by robot name).
+    fn trajectory<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let state = self.lock();
-        crate::convert::trajectory_columns(py, state.session().simulation().trajectory())
+        let robots = state.session().simulation().robots();
+        per_robot(py, &state, |k| {
+            Ok(crate::convert::trajectory_columns(py, robots[k].trajectory())?.into_any())
+        })
     }
 
     /// Writes what `omniloop run` writes for the run so far (`summary.json`,
-    /// `trajectory.csv`, `estimates.jsonl`, `topview.png`, the experiment's files) into `dir`.
+    /// `trajectory.csv`, `estimates.jsonl`, `topview.png`, the experiment's files; a team's
+    /// records under `robots/NAME/`) into `dir`.
     fn write(&self, py: Python<'_>, dir: PathBuf) -> PyResult<()> {
         let state = self.lock();
         let out = state.session().output_with_files().map_err(run_error)?;
@@ -579,8 +883,8 @@ impl PySimulation {
             .map_err(|e| PyOSError::new_err(format!("{e:#}")))
     }
 
-    /// A top view of the moment (world, paths so far, start and goal) as an `H x W x 3`
-    /// `uint8` array `width` pixels wide.
+    /// A top view of the moment (world, paths so far, start and goal; every robot of a team)
+    /// as an `H x W x 3` `uint8` array `width` pixels wide.
     #[pyo3(signature = (width = 640))]
     fn topview<'py>(&self, py: Python<'py>, width: u32) -> PyResult<Bound<'py, PyAny>> {
         if !(200..=4000).contains(&width) {
@@ -620,23 +924,53 @@ impl PySimulation {
         self.lock().done()
     }
 
-    /// The cameras, in the scenario's order.
+    /// The robots' names, in the scenario's order (`["robot"]` for a one-robot scenario
+    /// that names none).
     #[getter]
-    fn sensors<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        PyList::new(py, self.lock().sensors.clone())
+    fn robots(&self) -> Vec<String> {
+        self.lock().names()
+    }
+
+    /// The robots Python drives, by name.
+    #[getter]
+    fn python_robots(&self) -> Vec<String> {
+        let state = self.lock();
+        self.driven_by_python(&state)
+    }
+
+    /// The cameras, in the scenario's order (a team's: a dict of these by robot name).
+    #[getter]
+    fn sensors<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let state = self.lock();
+        per_robot(py, &state, |k| {
+            Ok(PyList::new(py, state.members[k].sensors.clone())?.into_any())
+        })
     }
 
     fn __repr__(&self) -> String {
         let state = self.lock();
+        let robot = |d: &Driver| match d {
+            Driver::Python => "python",
+            Driver::Builtin => "builtin",
+        };
+        let drivers = match state.is_team() {
+            true => format!(
+                "{{{}}}",
+                state
+                    .names()
+                    .iter()
+                    .zip(&self.drivers)
+                    .map(|(n, d)| format!("{n:?}: {:?}", robot(d)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            false => format!("{:?}", robot(&self.drivers[0])),
+        };
         format!(
-            "Simulation({:?}, seed={}, cycle={}, robot={:?})",
+            "Simulation({:?}, seed={}, cycle={}, robot={drivers})",
             self.scenario.scenario.name,
             state.seed(),
             state.session().simulation().cycle(),
-            match self.driver {
-                Driver::Python => "python",
-                Driver::Builtin => "builtin",
-            }
         )
     }
 }

@@ -37,7 +37,7 @@ impl PyVectorSimulation {
             &self.scenario.scenario,
             seed,
             self.renderer,
-            self.driver,
+            &[self.driver],
             self.gpu.clone(),
         )
     }
@@ -60,6 +60,13 @@ impl PyVectorSimulation {
         if !(1..=4096).contains(&num_envs) {
             return Err(PyValueError::new_err(format!(
                 "num_envs={num_envs}: from 1 to 4096 runs"
+            )));
+        }
+        if scenario.scenario.is_team() {
+            return Err(PyValueError::new_err(format!(
+                "scenario {:?} has a team ([[robots]]): VectorSimulation steps one-robot \
+                 scenarios; step a team with Simulation or omniloop.pettingzoo",
+                scenario.scenario.name
             )));
         }
         let choice = renderer_choice(renderer)?;

@@ -176,7 +176,12 @@ mod tests {
         };
         let split = StaticMap::new(&map).split(&seen(), Some(&Isometry2::identity()));
         assert_eq!(split.moving.len(), 3);
-        assert!(split.moving.iter().all(|p| (p - Vector2::new(0.0, 700.0)).norm() < 1e-9));
+        assert!(
+            split
+                .moving
+                .iter()
+                .all(|p| (p - Vector2::new(0.0, 700.0)).norm() < 1e-9)
+        );
         assert_eq!(split.horizon.len(), 6 * 3);
         // Without a pose estimate, the wall may be a robot too.
         let blind = StaticMap::new(&map).split(&seen(), None);

@@ -330,7 +330,10 @@ impl World {
 
     /// What collider `h` belongs to.
     fn owner(&self, h: ColliderHandle) -> Option<Owner> {
-        self.owners.iter().find(|(o, _)| *o == h).map(|(_, owner)| *owner)
+        self.owners
+            .iter()
+            .find(|(o, _)| *o == h)
+            .map(|(_, owner)| *owner)
     }
 
     /// Gap between robot `i`'s disc and the collider `other`.

@@ -150,10 +150,11 @@ impl<'a> Runner<'a> {
             }
         }
         let (mut software, mut named) = (self.software, self.named);
-        let build = move |config: &RobotConfig| match named.iter_mut().find(|(n, _)| *n == config.name) {
-            Some((_, f)) => f(config),
-            None => software(config),
-        };
+        let build =
+            move |config: &RobotConfig| match named.iter_mut().find(|(n, _)| *n == config.name) {
+                Some((_, f)) => f(config),
+                None => software(config),
+            };
         run_scenario_with(
             &self.scenario,
             &self.options,

@@ -210,7 +210,12 @@ fn team_topview_image(
     let paths: Vec<Vec<Point2<f64>>> = out
         .robots
         .iter()
-        .map(|r| r.trajectory.iter().map(|p| Point2::new(p.x_mm, p.y_mm)).collect())
+        .map(|r| {
+            r.trajectory
+                .iter()
+                .map(|p| Point2::new(p.x_mm, p.y_mm))
+                .collect()
+        })
         .collect();
     let mut layers = Vec::new();
     for (k, p) in out.other_paths.iter().enumerate() {

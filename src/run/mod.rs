@@ -14,10 +14,10 @@ pub mod record;
 pub mod score;
 pub mod simulation;
 
-pub use error::RunError;
 pub use agent::{Agent, Truth};
+pub use error::RunError;
 pub use record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};
 pub use simulation::{
-    OutputFile, RobotOutput, RunOptions, RunOutput, Simulation, builtin_software,
-    render_snapshot, straight_line_time_s,
+    OutputFile, RobotOutput, RunOptions, RunOutput, Simulation, builtin_software, render_snapshot,
+    straight_line_time_s,
 };

@@ -139,7 +139,10 @@ impl Simulation {
             frame_folders(dir, scenario.is_team().then_some(names.as_slice()))?;
         }
         let (renderer, gpu) = team_renderer(members.len(), options, &mut say)?;
-        let shared = options.shared_gpu.clone().or(gpu.as_ref().map(BatchServer::handle));
+        let shared = options
+            .shared_gpu
+            .clone()
+            .or(gpu.as_ref().map(BatchServer::handle));
         let mut agents = Vec::with_capacity(members.len());
         for (k, (member, name)) in members.iter().zip(&names).enumerate() {
             let setup = CameraSetup {
@@ -148,8 +151,16 @@ impl Simulation {
                 all: options.save_frames_every.is_some(),
             };
             let build: &mut SoftwareBuilder<'_> = &mut software;
-            let agent = Agent::new(name, k, member, options.takes_frames, setup, build, &mut say)
-                .map_err(|e| in_robot(members.len(), name, e))?;
+            let agent = Agent::new(
+                name,
+                k,
+                member,
+                options.takes_frames,
+                setup,
+                build,
+                &mut say,
+            )
+            .map_err(|e| in_robot(members.len(), name, e))?;
             agents.push(agent);
         }
         let mut others = Vec::new();
@@ -427,8 +438,7 @@ impl Simulation {
         }
         let mut robots = Vec::with_capacity(self.agents.len());
         for a in &self.agents {
-            let (Some(row), Some(estimates)) = (a.trajectory().last(), a.estimates().last())
-            else {
+            let (Some(row), Some(estimates)) = (a.trajectory().last(), a.estimates().last()) else {
                 return;
             };
             robots.push(RobotCycle {
@@ -507,8 +517,16 @@ impl Simulation {
         RunOutput {
             summary: self.summary(wall_time_s),
             map: if team { None } else { first.software().map() },
-            trajectory: if team { Vec::new() } else { first.trajectory().to_vec() },
-            estimates: if team { Vec::new() } else { first.estimates().to_vec() },
+            trajectory: if team {
+                Vec::new()
+            } else {
+                first.trajectory().to_vec()
+            },
+            estimates: if team {
+                Vec::new()
+            } else {
+                first.estimates().to_vec()
+            },
             other_paths,
             files: Vec::new(),
             robots: if team {
@@ -619,7 +637,11 @@ impl Simulation {
 }
 
 /// A team's figures from its robots' rows and the world's record of touches.
-fn team_figures(world: &World, agents: &[Agent], rows: &[super::record::RobotSummary]) -> TeamFigures {
+fn team_figures(
+    world: &World,
+    agents: &[Agent],
+    rows: &[super::record::RobotSummary],
+) -> TeamFigures {
     let with_goal: Vec<(&Agent, &super::record::RobotSummary)> = agents
         .iter()
         .zip(rows)
@@ -628,7 +650,12 @@ fn team_figures(world: &World, agents: &[Agent], rows: &[super::record::RobotSum
     let arrived = with_goal.iter().filter(|(_, r)| r.reached_goal).count();
     let all_arrived = arrived == with_goal.len();
     let last_arrival_s = all_arrived
-        .then(|| with_goal.iter().filter_map(|(_, r)| r.time_to_goal_s).fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t)))))
+        .then(|| {
+            with_goal
+                .iter()
+                .filter_map(|(_, r)| r.time_to_goal_s)
+                .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t))))
+        })
         .flatten();
     let straight_line_time_s = with_goal
         .iter()

@@ -2,8 +2,8 @@
 //! column and field. The experiments' own preparation and checks come in as arguments from
 //! the layer that knows them ([`crate::experiments::parse_scenario`]).
 
-use super::check::{Checker, FieldPath, PathSeg};
 use super::check::Violation;
+use super::check::{Checker, FieldPath, PathSeg};
 use super::rules::validate;
 use super::schema::{RobotSpec, Scenario};
 use super::team;

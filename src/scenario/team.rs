@@ -331,7 +331,11 @@ goal = { x_mm = 1.0, y_mm = 2.0 }
         );
         let problems = resolve(&doc).unwrap_err();
         let paths: Vec<String> = problems.iter().map(|p| p.path.to_string()).collect();
-        assert_eq!(paths, ["robot.radius_mm", "robots[1].height_mm"], "{problems:?}");
+        assert_eq!(
+            paths,
+            ["robot.radius_mm", "robots[1].height_mm"],
+            "{problems:?}"
+        );
         let doc = table("[[robots]]\nname = \"a\"\nspeed = 3\n");
         let problems = resolve(&doc).unwrap_err();
         assert_eq!(problems[0].path.to_string(), "robots[0].speed");

@@ -110,7 +110,12 @@ fn up_to(out: &RunOutput, n: usize) -> RunOutput {
 /// up to four columns, the rows below), the top view on the right, on white.
 fn side_by_side(robots: &[Vec<RgbaImage>], top: &image::RgbImage) -> RgbaImage {
     let columns = robots.len().clamp(1, 4);
-    let cell_w = robots.iter().flatten().map(RgbaImage::width).max().unwrap_or(0);
+    let cell_w = robots
+        .iter()
+        .flatten()
+        .map(RgbaImage::width)
+        .max()
+        .unwrap_or(0);
     let cell_h = robots
         .iter()
         .map(|images| images.iter().map(RgbaImage::height).sum::<u32>())

@@ -77,7 +77,10 @@ fn json(ctx: &Arc<Context>, topic: &str) -> Result<Arc<RawChannel>, foxglove::Fo
 impl RobotChannels {
     /// One robot's channels on `ctx`.
     fn new(ctx: &Arc<Context>, robot: &RobotCameras) -> Result<Self, foxglove::FoxgloveError> {
-        let prefix = robot.robot.as_ref().map_or(String::new(), |r| format!("{r}/"));
+        let prefix = robot
+            .robot
+            .as_ref()
+            .map_or(String::new(), |r| format!("{r}/"));
         let topic = |t: &str| format!("/{prefix}{t}");
         let typed = |t: &str| ChannelBuilder::new(topic(t)).context(ctx);
         Ok(Self {

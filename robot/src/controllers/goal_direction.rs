@@ -57,6 +57,8 @@ pub struct GoalDirectionController(GoalDirection);
 
 impl Controller for GoalDirectionController {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        with_surroundings(s, None, None, |sur, target| self.0.decide(sur, target).v_mm_s)
+        with_surroundings(s, None, None, |sur, target| {
+            self.0.decide(sur, target).v_mm_s
+        })
     }
 }

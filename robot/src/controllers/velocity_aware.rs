@@ -44,10 +44,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         };
         Ok(Box::new(VelocityAwareStack {
             near: (avoid.speed == SpeedChoice::Chosen).then(|| NearField::new(b.radius_mm)),
-            traffic: avoid
-                .traffic
-                .reciprocal()
-                .then(|| StaticMap::new(&c.map)),
+            traffic: avoid.traffic.reciprocal().then(|| StaticMap::new(&c.map)),
             controller: VelocityAware::new(
                 avoid,
                 drive,

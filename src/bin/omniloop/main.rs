@@ -330,6 +330,39 @@ fn parse_pose(text: &str) -> anyhow::Result<Isometry2<f64>> {
     }
 }
 
+/// What a run came to, in a line: the one robot's goal, contacts and clearance, or a team's
+/// arrivals, contacts by kind and the least clearance between two robots.
+fn outcome_line(m: &omniloop::run::Summary) -> String {
+    let head = format!(
+        "{}: {} cycles, {:.2} s simulated in {:.2} s ({:.0} cycles/s)",
+        m.scenario, m.cycles, m.sim_time_s, m.wall_time_s, m.cycles_per_s
+    );
+    let Some(t) = &m.team else {
+        let goal = match m.time_to_goal_s {
+            Some(t) => format!("reached at {t:.2} s"),
+            None => "not reached".into(),
+        };
+        return format!(
+            "{head}; goal {goal}; contacts {}; min clearance {:.1} mm",
+            m.wall_contacts, m.min_clearance_mm
+        );
+    };
+    let last = match (t.last_arrival_s, t.straight_line_time_s) {
+        (Some(a), Some(s)) => format!(", the last at {a:.2} s (straight lines: {s:.2} s)"),
+        _ => String::new(),
+    };
+    format!(
+        "{head}, {} robots; {} of {} arrived{last}; contacts {} (with robots {}); least \
+         clearance between robots {:.1} mm",
+        t.robots,
+        t.arrived,
+        t.with_goal,
+        m.wall_contacts,
+        t.robot_contacts,
+        t.min_robot_clearance_mm
+    )
+}
+
 /// The run's Foxglove log, when it is recorded or served; a live server says where it is and,
 /// when asked, waits for a viewer.
 fn start_log(s: &Scenario, sinks: &Sinks) -> anyhow::Result<Option<FoxgloveLog>> {
@@ -467,22 +500,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 println!("results in {}", dir.display());
                 return Ok(());
             }
-            println!(
-                "{}: {} cycles, {:.2} s simulated in {:.2} s ({:.0} cycles/s); goal {}; \
-                 contacts {}; min clearance {:.1} mm; results in {}",
-                m.scenario,
-                m.cycles,
-                m.sim_time_s,
-                m.wall_time_s,
-                m.cycles_per_s,
-                match m.time_to_goal_s {
-                    Some(t) => format!("reached at {t:.2} s"),
-                    None => "not reached".into(),
-                },
-                m.wall_contacts,
-                m.min_clearance_mm,
-                dir.display()
-            );
+            println!("{}; results in {}", outcome_line(m), dir.display());
             Ok(())
         }
         Command::Render {
