@@ -19,7 +19,8 @@ use std::path::PathBuf;
 struct RunResult {
     /// `summary.json` as a dict.
     summary: Py<PyAny>,
-    /// `trajectory.csv` as a dict of NumPy columns named as its header (NaN where empty).
+    /// `trajectory.csv` as a dict of NumPy columns named as its header (NaN where empty); a
+    /// team's: a dict of these by robot name.
     trajectory: Py<PyAny>,
     /// The folder the run's files were written to, if any.
     out: Option<PathBuf>,
@@ -92,11 +93,19 @@ fn run(
     }
     let summary = serde_json::to_string(&output.summary)
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    let trajectory = if output.robots.is_empty() {
+        trajectory_columns(py, &output.trajectory)?.into_any()
+    } else {
+        // A team's: the columns of each robot, by name.
+        let d = pyo3::types::PyDict::new(py);
+        for r in &output.robots {
+            d.set_item(&r.name, trajectory_columns(py, &r.trajectory)?)?;
+        }
+        d.into_any()
+    };
     Ok(RunResult {
         summary: json_to_py(py, &summary)?.unbind(),
-        trajectory: trajectory_columns(py, &output.trajectory)?
-            .into_any()
-            .unbind(),
+        trajectory: trajectory.unbind(),
         out,
     })
 }

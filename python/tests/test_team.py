@@ -196,3 +196,12 @@ def test_pettingzoo_agents_get_the_gym_observation_and_are_rewarded_for_progress
         env.step({"east": np.zeros(3), "west": np.zeros(3)})
     with pytest.raises(ValueError, match="has no robot 'north'"):
         parallel_env(pair, builtin=["north"])
+
+
+def test_a_whole_team_run_from_python_writes_what_the_command_line_writes(pair, tmp_path):
+    result = omniloop.run(pair, out=tmp_path / "pair")
+    assert set(result.trajectory) == {"east", "west"}
+    assert result.summary["team"]["robots"] == 2
+    assert (tmp_path / "pair" / "robots" / "west" / "estimates.jsonl").is_file()
+    header = (tmp_path / "pair" / "trajectory.csv").read_text().splitlines()[0]
+    assert header.startswith("robot,t_s,")
