@@ -290,10 +290,100 @@ fn bad_team_input_exits_2_with_file_line_column_and_field() {
 
 #[test]
 fn the_shipped_team_scenarios_check() {
-    for file in ["swarm_swap.toml"] {
+    for file in ["swarm_swap.toml", "forward_swarm.toml"] {
         let s = scenario(file);
         assert!(s.is_team(), "{file}");
         let path = scenario_path(file);
         assert!(Path::new(&path).is_file());
     }
+}
+
+#[test]
+fn a_teams_frames_traced_in_one_gpu_batch_match_the_cpus() {
+    let Some(_gpu) = common::gpu_or_skip() else {
+        return;
+    };
+    let s = variant(
+        "swarm_swap.toml",
+        &[("duration_s = 40.0", "duration_s = 1.0")],
+    );
+    let frames = |renderer| {
+        let options = omniloop::run::RunOptions {
+            renderer,
+            ..omniloop::run::RunOptions::default()
+        };
+        let mut sim = omniloop::Simulation::new(&s, &options, |_| {}).unwrap();
+        sim.sense().unwrap();
+        let names: Vec<String> = sim
+            .robots()
+            .iter()
+            .map(|a| a.renderer_name().unwrap_or_default().to_string())
+            .collect();
+        let images: Vec<image::RgbaImage> = sim
+            .robots()
+            .iter()
+            .map(|a| a.frames()[0].image.clone())
+            .collect();
+        (names, images)
+    };
+    let (gpu_names, gpu) = frames(omniloop_sim::RendererChoice::Gpu);
+    let (_, cpu) = frames(omniloop_sim::RendererChoice::Cpu);
+    assert!(
+        gpu_names.iter().all(|n| n.contains("batched")),
+        "{gpu_names:?}"
+    );
+    for (k, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+        common::assert_alike(g, c, 2, &format!("robot r{} GPU against CPU", k + 1));
+    }
+}
+
+#[test]
+fn a_sweep_of_a_team_reports_the_teams_figures_as_columns() {
+    let dir = tmp("team_sweep");
+    let file = dir.join("short.toml");
+    let text = std::fs::read_to_string(scenario_path("swarm_swap.toml")).unwrap();
+    std::fs::write(&file, text.replace("duration_s = 40.0", "duration_s = 1.0")).unwrap();
+    let out = dir.join("sweep");
+    omniloop([
+        "sweep",
+        file.to_str().unwrap(),
+        "--set",
+        "robot.max_speed_mm_s=400,600",
+        "--renderer",
+        "cpu",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    for column in [
+        "team.arrived",
+        "team.robot_contacts",
+        "team.min_robot_clearance_mm",
+    ] {
+        assert!(head.contains(&column), "{column} in {head:?}");
+    }
+    // One second is too short to arrive: no run is a success, each has its six robots.
+    let arrived = head.iter().position(|c| *c == "team.arrived").unwrap();
+    let success = head.iter().position(|c| *c == "success").unwrap();
+    for line in csv.lines().skip(1) {
+        let cells = csv_fields(line);
+        assert_eq!(cells[arrived], "0", "{line}");
+        assert_eq!(cells[success], "false", "{line}");
+    }
+}
+
+/// The fields of a CSV line whose quoted fields may hold commas.
+fn csv_fields(line: &str) -> Vec<String> {
+    let (mut out, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+    for c in line.chars() {
+        match (c, quoted) {
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut cur)),
+            _ => cur.push(c),
+        }
+    }
+    out.push(cur);
+    out
 }

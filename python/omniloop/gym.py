@@ -77,6 +77,14 @@ def _one_robot(scenario: Scenario) -> Scenario:
     return scenario
 
 
+def _episode_seed(seed: Optional[int], previous: Optional[int], first: int) -> int:
+    """The seed of the next episode: the one asked for, else the scenario's the first time and
+    the previous episode's plus one after."""
+    if seed is not None:
+        return int(seed)
+    return first if previous is None else previous + 1
+
+
 class _Task:
     """What the single and the vector environment (and each agent of the PettingZoo
     environment) share: spaces, observation, reward, for one robot (``Scenario.robot``)."""
@@ -176,12 +184,7 @@ class OmniloopEnv(gymnasium.Env):
         self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         super().reset(seed=seed)
-        if seed is not None:
-            episode = int(seed)
-        elif self._episode_seed is None:
-            episode = self.scenario.seed
-        else:
-            episode = self._episode_seed + 1
+        episode = _episode_seed(seed, self._episode_seed, self.scenario.seed)
         self._episode_seed = episode
         obs = self.sim.reset(seed=episode)
         self._truth = self.sim.truth()

@@ -46,7 +46,7 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     ) from e
 
 from . import Scenario, Simulation
-from .gym import ScenarioLike, _scenario, _Task
+from .gym import ScenarioLike, _episode_seed, _scenario, _Task
 
 __all__ = ["OmniloopParallelEnv", "parallel_env"]
 
@@ -115,12 +115,7 @@ class OmniloopParallelEnv(ParallelEnv):
     def reset(
         self, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
     ) -> tuple[dict[str, dict[str, np.ndarray]], dict[str, dict[str, Any]]]:
-        if seed is not None:
-            episode = int(seed)
-        elif self._episode_seed is None:
-            episode = self.scenario.seed
-        else:
-            episode = self._episode_seed + 1
+        episode = _episode_seed(seed, self._episode_seed, self.scenario.seed)
         self._episode_seed = episode
         obs = self.sim.reset(seed=episode)
         self._truth = self.sim.truth()

@@ -3,6 +3,23 @@
 use super::topview::{FigureError, png_bytes, register_font};
 use plotters::prelude::*;
 
+/// The colours of the lines of a figure, in order (Matplotlib's ten, then navy and maroon):
+/// each knob of a robustness panel, each robot of a team.
+pub const PALETTE: [[u8; 3]; 12] = [
+    [31, 119, 180],
+    [255, 127, 14],
+    [44, 160, 44],
+    [214, 39, 40],
+    [148, 103, 189],
+    [140, 86, 75],
+    [227, 119, 194],
+    [127, 127, 127],
+    [188, 189, 34],
+    [23, 190, 207],
+    [0, 0, 128],
+    [128, 0, 0],
+];
+
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Style {

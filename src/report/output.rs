@@ -1,6 +1,7 @@
 //! Writing a run's results: `summary.json`, `trajectory.csv`, `estimates.jsonl` and
 //! `topview.png`.
 
+use super::charts::PALETTE;
 use super::topview::{FigureError, Marker, Panel, PathLayer, render_panels};
 use crate::run::RunOutput;
 use crate::run::record::{write_estimates_jsonl, write_team_trajectory_csv, write_trajectory_csv};
@@ -182,22 +183,6 @@ pub fn run_topview_image(
     render_panels(name, &[panel], width)
 }
 
-/// The colours of a team's robots in figures, in the robots' order (then again).
-pub const ROBOT_COLOURS: [[u8; 3]; 12] = [
-    [31, 119, 180],
-    [255, 127, 14],
-    [44, 160, 44],
-    [214, 39, 40],
-    [148, 103, 189],
-    [140, 86, 75],
-    [227, 119, 194],
-    [127, 127, 127],
-    [188, 189, 34],
-    [23, 190, 207],
-    [0, 0, 128],
-    [128, 0, 0],
-];
-
 /// The top view of a team's run: each robot's true path in its colour, from its start (a
 /// circle of its size, named) to where it is (a filled one), its goal a circle of the goal's
 /// tolerance; the other robots' paths in magenta.
@@ -229,7 +214,7 @@ fn team_topview_image(
     }
     let mut markers = Vec::new();
     for (k, (robot, path)) in out.robots.iter().zip(&paths).enumerate() {
-        let rgb = ROBOT_COLOURS[k % ROBOT_COLOURS.len()];
+        let rgb = PALETTE[k % PALETTE.len()];
         let member = scenario.member(k);
         let radius_mm = member.robot.radius_mm;
         layers.push(PathLayer {

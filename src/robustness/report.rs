@@ -5,7 +5,7 @@
 use super::estimators::Estimator;
 use super::grid::{Cell, Grid, Outcome};
 use super::knobs::Knob;
-use crate::report::charts::{Chart, Series, Style, charts_png};
+use crate::report::charts::{Chart, PALETTE, Series, Style, charts_png};
 use crate::report::topview::FigureError;
 use std::fmt::Write as _;
 
@@ -166,18 +166,6 @@ pub fn csv(grid: &Grid) -> String {
     out
 }
 
-/// The colour of each knob's line.
-const COLOURS: [[u8; 3]; 8] = [
-    [31, 119, 180],
-    [255, 127, 14],
-    [44, 160, 44],
-    [214, 39, 40],
-    [148, 103, 189],
-    [140, 86, 75],
-    [227, 119, 194],
-    [127, 127, 127],
-];
-
 /// `robustness.png`: one panel per estimator, each knob a line of its error against the
 /// knob's level as a share of its largest (so all knobs share the axis), the target's bound
 /// dashed, runs that miss the target crossed. Errors beyond four times the bound are drawn at
@@ -220,7 +208,7 @@ fn panel(grid: &Grid, e: &Estimator, ks: &[&'static Knob], legend: bool) -> Char
         );
         series.push(Series {
             label: if legend { range } else { String::new() },
-            rgb: COLOURS[j % COLOURS.len()],
+            rgb: PALETTE[j % PALETTE.len()],
             points,
             style: Style::Line,
         });

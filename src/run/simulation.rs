@@ -5,7 +5,7 @@
 //! across robots and pixels, on a GPU in one batch a cycle), their software runs in parallel,
 //! and the same scenario and seed give the same run whatever the number of threads.
 
-use super::agent::{Agent, CameraSetup, SoftwareBuilder, Truth, localization_fixes};
+use super::agent::{Agent, CameraSetup, SoftwareBuilder, Truth};
 use super::cameras::sensor_noise_seed;
 use super::error::RunError;
 use super::observer::{CycleView, ObserverHandle, RobotCycle};
@@ -340,8 +340,7 @@ impl Simulation {
                     .collect();
                 handles
                     .into_iter()
-                    .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-                    .collect::<Result<(), RunError>>()
+                    .try_for_each(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             });
         }
         self.agents
@@ -557,36 +556,30 @@ impl Simulation {
     /// (its keys over all robots, its own figures, and a row a robot).
     fn summary(&self, wall_time_s: f64) -> Summary {
         let first = self.first();
-        let stats = self.world.stats(first.body());
-        let score = first.score();
-        let navigation = first
-            .estimates()
-            .iter()
-            .rev()
-            .find_map(|e| e.navigation.as_ref());
+        let r = first.summary(&self.world);
         let summary = Summary {
             scenario: self.scenario.name.clone(),
             seed: self.scenario.seed,
-            controller: first.controller(),
+            controller: r.controller,
             cycles: self.cycle,
             sim_time_s: self.world.time_s(),
             wall_time_s,
             cycles_per_s: 0.0,
-            wall_contacts: stats.contacts,
-            peak_speed_mm_s: stats.peak_speed_mm_s,
-            peak_accel_mm_s2: stats.peak_accel_mm_s2,
-            reached_goal: first.reached_goal(),
-            time_to_goal_s: score.time_to_goal_s(),
-            min_clearance_mm: stats.min_clearance_mm,
-            path_length_mm: stats.path_length_mm,
+            wall_contacts: r.contacts,
+            peak_speed_mm_s: r.peak_speed_mm_s,
+            peak_accel_mm_s2: r.peak_accel_mm_s2,
+            reached_goal: r.reached_goal,
+            time_to_goal_s: r.time_to_goal_s,
+            min_clearance_mm: r.min_clearance_mm,
+            path_length_mm: r.path_length_mm,
             renderer: first.renderer_name().map(str::to_string),
-            freespace_error_mm: score.freespace_error_mm(),
-            pose_error_mm: score.pose_error_mm(),
-            targets_reached: score.targets_reached(),
-            localization_fixes: localization_fixes(first.estimates()),
-            checkpoint_heading_error_deg: score.checkpoint_heading_errors_deg(),
-            unreachable: navigation.map(|n| n.unreachable),
-            watchdog_fired: navigation.map(|n| n.watchdog),
+            freespace_error_mm: r.freespace_error_mm,
+            pose_error_mm: r.pose_error_mm,
+            targets_reached: r.targets_reached,
+            localization_fixes: r.localization_fixes,
+            checkpoint_heading_error_deg: first.score().checkpoint_heading_errors_deg(),
+            unreachable: r.unreachable,
+            watchdog_fired: r.watchdog_fired,
             team: None,
             robots: None,
             experiment: serde_json::Map::new(),
