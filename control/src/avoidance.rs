@@ -161,6 +161,8 @@ pub(crate) fn check_config(c: &AvoidanceConfig) -> Result<(), ControlError> {
     for (name, value) in [
         ("traffic.gap_mm", t.gap_mm),
         ("traffic.keep_right_deg", t.keep_right_deg),
+        ("traffic.moved_s", t.moved_s),
+        ("traffic.yield_mm", t.yield_mm),
     ] {
         if !(value.is_finite() && value >= 0.0) {
             return Err(ControlError::InvalidParameter {

@@ -37,8 +37,18 @@
 //! meeting head-on pass left side to left side; six crossing at the centre turn it into a
 //! roundabout.
 //!
+//! A robot that has arrived holds its target, and buffered cells never make it give way: robots
+//! that arrived first wall in those still on their way (three standing across the Small-Size
+//! field leave gaps narrower than two robots need to pass, and the one that must pass circles
+//! in front of them). With [`TrafficConfig::yield_mm`], a robot within that distance of its
+//! target makes way for moving obstacles that come nearer than that to its edge
+//! ([`TrafficConfig::make_way`]), the share of the room reciprocal avoidance gives every
+//! party (van den Berg, Guy, Lin and Manocha, "Reciprocal n-body collision avoidance", ISRR
+//! 2009, Sect. 5), and comes back once they have passed.
+//!
 //! Which obstacles may move is the robot software's call (its map explains walls, goals and
-//! pillars; everything else may be a robot); the rule itself needs only the points.
+//! pillars; everything else may be a robot; with [`TrafficConfig::moved_s`], only what was
+//! seen to move); the rule itself needs only the points.
 
 use crate::Vec2;
 use crate::angle::angle_diff;
@@ -68,6 +78,19 @@ pub struct TrafficConfig {
     pub keep_right_deg: f64,
     /// A moving obstacle ahead turns the heading from this gap on, mm, fully at `gap_mm`.
     pub look_ahead_mm: f64,
+    /// An obstacle the map does not explain counts as moving only when it stands where the
+    /// robot saw the floor surely free within this time, s; one standing where the floor was
+    /// not seen free lately (a robot that arrived, or waits) is kept at the normal clearance,
+    /// as a wall is. 0: every obstacle the map does not explain may move.
+    pub moved_s: f64,
+    /// A robot within this distance of its target makes way for moving obstacles whose gap
+    /// to its edge is under this, mm, by as much as they come nearer, staying within this of
+    /// its target (see [`TrafficConfig::make_way`]); 0: it holds its target. Without
+    /// `moved_s`, everything the map does not explain counts as moving, robots standing on
+    /// their own targets included: two whose targets leave less than this between their
+    /// edges push each other off them for good, so keep it under the least such gap (or set
+    /// `moved_s`).
+    pub yield_mm: f64,
 }
 
 impl Default for TrafficConfig {
@@ -77,6 +100,8 @@ impl Default for TrafficConfig {
             gap_mm: 150.0,
             keep_right_deg: 50.0,
             look_ahead_mm: 900.0,
+            moved_s: 0.0,
+            yield_mm: 0.0,
         }
     }
 }
@@ -105,6 +130,45 @@ impl TrafficConfig {
     /// Whether the rule is on.
     pub fn reciprocal(&self) -> bool {
         self.rule == TrafficRule::Reciprocal
+    }
+
+    /// Where a robot at its target (`target`, robot frame, within `yield_mm`) heads to make
+    /// way for the moving obstacles `moving` (robot frame) that come nearer than `yield_mm`
+    /// to its edge (`radius_mm` from its centre): away from them (the sum of their
+    /// directions, each weighted by how far it comes inside that reach) by as far as the
+    /// deepest comes inside, but no farther than `yield_mm` from the target; the target
+    /// itself when none comes that near, or farther from it. Buffered Voronoi cells (Zhou et
+    /// al. 2017) and reciprocal avoidance in general (van den Berg et al., "Reciprocal
+    /// n-body collision avoidance", ISRR 2009, Sect. 5: each agent takes half the
+    /// responsibility) let a robot that has arrived stand where it is: it never comes nearer,
+    /// but never makes room either, and robots that arrived first wall in those still on
+    /// their way (three robots standing across a field leave gaps narrower than two robots
+    /// passing need). Making way for what moves, and coming back once it has passed, lends
+    /// the others the room.
+    pub fn make_way(&self, target: Vec2, moving: &[Vec2], radius_mm: f64) -> Vec2 {
+        if !self.reciprocal() || self.yield_mm <= 0.0 || target.norm() > self.yield_mm {
+            return target;
+        }
+        let reach = radius_mm + self.yield_mm;
+        let (mut sum, mut deepest) = (Vec2::zeros(), 0.0_f64);
+        for o in moving {
+            let d = o.norm();
+            if d < 1e-9 || d >= reach {
+                continue;
+            }
+            sum += o / d * (reach - d);
+            deepest = deepest.max(reach - d);
+        }
+        if deepest <= 0.0 || sum.norm() < 1e-9 {
+            return target;
+        }
+        let to = -sum.normalize() * deepest;
+        let off = to - target;
+        if off.norm() <= self.yield_mm {
+            to
+        } else {
+            target + off.normalize() * self.yield_mm
+        }
     }
 
     /// The half-plane of each point (robot frame) that may be another robot or hide one, for
@@ -205,6 +269,74 @@ mod tests {
         assert_eq!(
             off.heading_rad(0.0, 3000.0, &[Vec2::new(200.0, 0.0)], 90.0),
             0.0
+        );
+    }
+
+    #[test]
+    fn moved_s_and_yield_mm_must_be_finite_and_not_negative() {
+        let checked = |t: TrafficConfig| {
+            crate::avoidance::check_config(&crate::AvoidanceConfig {
+                traffic: t,
+                ..crate::AvoidanceConfig::default()
+            })
+        };
+        assert!(checked(on()).is_ok());
+        assert!(
+            checked(TrafficConfig {
+                moved_s: 1.0,
+                ..on()
+            })
+            .is_ok()
+        );
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            assert!(
+                checked(TrafficConfig {
+                    moved_s: bad,
+                    ..on()
+                })
+                .is_err(),
+                "{bad}"
+            );
+            assert!(
+                checked(TrafficConfig {
+                    yield_mm: bad,
+                    ..on()
+                })
+                .is_err(),
+                "{bad}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_robot_at_its_target_makes_way_for_one_coming_near_and_no_farther_than_yield_mm() {
+        let t = TrafficConfig {
+            yield_mm: 250.0,
+            ..on()
+        };
+        // At its target; another robot's edge 200 mm ahead (110 mm from this one's edge, 140
+        // inside the reach of 340 mm): it heads 140 mm back.
+        let to = t.make_way(Vec2::zeros(), &[Vec2::new(200.0, 0.0)], 90.0);
+        assert!((to - Vec2::new(-140.0, 0.0)).norm() < 1e-9, "{to:?}");
+        // Nothing near: the target.
+        let target = Vec2::new(30.0, 40.0);
+        assert_eq!(t.make_way(target, &[Vec2::new(600.0, 0.0)], 90.0), target);
+        // Pressed hard while already off its target: no farther than yield_mm from it.
+        let target = Vec2::new(200.0, 0.0);
+        // Something at its edge on the target's side pushes it 339 mm back, held to 250 mm
+        // from the target.
+        let to = t.make_way(target, &[Vec2::new(1.0, 0.0)], 90.0);
+        assert!((to - Vec2::new(-50.0, 0.0)).norm() < 1e-9, "{to:?}");
+        // Far from its target, or with the rule off: the target.
+        let far = Vec2::new(1000.0, 0.0);
+        assert_eq!(t.make_way(far, &[Vec2::new(200.0, 0.0)], 90.0), far);
+        let off = TrafficConfig {
+            yield_mm: 0.0,
+            ..on()
+        };
+        assert_eq!(
+            off.make_way(Vec2::zeros(), &[Vec2::new(200.0, 0.0)], 90.0),
+            Vec2::zeros()
         );
     }
 }

@@ -154,9 +154,15 @@ impl VelocityAware {
         let path: Vec<Vec2> = (0..=steps)
             .map(|k| at((k as f64 * dt).min(horizon)))
             .collect();
-        // A half-plane is convex: the samples in it, the segments between them are too.
-        if !keep.planes.iter().all(|h| path.iter().all(|p| h.holds(*p))) {
-            return false;
+        // A half-plane is convex: the samples in it, the segments between them are too. One
+        // whose offset is at least the path's reach from the robot holds every sample
+        // (`p . n <= |p|`): only the nearer ones are checked point by point.
+        if !keep.planes.is_empty() {
+            let reach = path.iter().map(|p| p.norm()).fold(0.0, f64::max);
+            let near = keep.planes.iter().filter(|h| h.b < reach);
+            if !near.into_iter().all(|h| path.iter().all(|p| h.holds(*p))) {
+                return false;
+            }
         }
         let obstacles = &keep.obstacles;
         // Only obstacles within reach of the path's bounding box can come too near.

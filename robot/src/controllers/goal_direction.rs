@@ -8,7 +8,7 @@ use crate::controller::{
     with_surroundings,
 };
 use crate::tables::{ConfigProblem, Problems};
-use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, GoalDirection};
+use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, GoalDirection, SpeedChoice};
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -48,6 +48,31 @@ pub fn check_avoidance(spec: &ControlSpec) -> Vec<ConfigProblem> {
                 p.fail("candidates", format!("must be >= 4 (got {})", a.candidates));
             }
             p.non_negative("extra_horizon_s", a.extra_horizon_s);
+            let t = &a.traffic;
+            p.non_negative("traffic.gap_mm", t.gap_mm);
+            p.non_negative("traffic.moved_s", t.moved_s);
+            p.non_negative("traffic.yield_mm", t.yield_mm);
+            if !(t.keep_right_deg.is_finite() && (0.0..=90.0).contains(&t.keep_right_deg)) {
+                p.fail(
+                    "traffic.keep_right_deg",
+                    format!("must lie in [0, 90] (got {})", t.keep_right_deg),
+                );
+            }
+            if !(t.look_ahead_mm.is_finite() && t.look_ahead_mm > t.gap_mm) {
+                p.fail(
+                    "traffic.look_ahead_mm",
+                    format!(
+                        "must be finite and > traffic.gap_mm = {} (got {})",
+                        t.gap_mm, t.look_ahead_mm
+                    ),
+                );
+            }
+            if t.reciprocal() && a.speed != SpeedChoice::Chosen {
+                p.fail(
+                    "traffic.rule",
+                    "\"reciprocal\" bounds the chosen speeds: it needs speed = \"chosen\"",
+                );
+            }
         },
     )
 }

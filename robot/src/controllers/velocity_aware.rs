@@ -12,8 +12,10 @@ use crate::navigation::{
     self, MapSnapshot, NavigationReport, Navigator, PlannerConfig, PlannerKind,
 };
 use crate::near_field::NearField;
-use crate::traffic::StaticMap;
-use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, GoalKind, SpeedChoice, VelocityAware};
+use crate::traffic::TrafficSense;
+use omniloop_control::{
+    AccelLimitedDrive, AvoidanceConfig, GoalKind, SpeedChoice, TrafficConfig, VelocityAware,
+};
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -44,7 +46,12 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         };
         Ok(Box::new(VelocityAwareStack {
             near: (avoid.speed == SpeedChoice::Chosen).then(|| NearField::new(b.radius_mm)),
-            traffic: avoid.traffic.reciprocal().then(|| StaticMap::new(&c.map)),
+            traffic: avoid
+                .traffic
+                .reciprocal()
+                .then(|| TrafficSense::new(&c.map, &avoid.traffic)),
+            rule: avoid.traffic.clone(),
+            radius_mm: b.radius_mm,
             controller: VelocityAware::new(
                 avoid,
                 drive,
@@ -63,14 +70,25 @@ pub struct VelocityAwareStack {
     controller: VelocityAware,
     near: Option<NearField>,
     navigator: Option<Navigator>,
-    /// With the traffic rule: the map that tells walls from what may move.
-    traffic: Option<StaticMap>,
+    /// With the traffic rule: the map and the floor seen free, which tell walls and standing
+    /// obstacles from what may move.
+    traffic: Option<TrafficSense>,
+    /// The traffic rule's settings.
+    rule: TrafficConfig,
+    /// The robot's radius, mm.
+    radius_mm: f64,
 }
 
 impl Controller for VelocityAwareStack {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
         let clear = match (&mut self.near, s.freespace) {
             (Some(near), Some(fs)) => Some(near.update(fs, &s.odometry_pose, s.t_s)),
+            _ => None,
+        };
+        let traffic = match (&mut self.traffic, s.freespace) {
+            (Some(sense), Some(fs)) => {
+                Some(sense.update(fs, s.pose.as_ref(), &s.odometry_pose, s.t_s))
+            }
             _ => None,
         };
         let (target_body_mm, kind) = match (&mut self.navigator, &s.pose, s.target_mm) {
@@ -85,9 +103,17 @@ impl Controller for VelocityAwareStack {
             }
             _ => (s.target_body_mm, GoalKind::Ahead),
         };
-        let traffic = match (&self.traffic, s.freespace) {
-            (Some(map), Some(fs)) => Some(map.split(fs, s.pose.as_ref())),
-            _ => None,
+        // With the traffic rule's yield_mm, a robot at its target makes way for what moves.
+        let rule = &self.rule;
+        let (target_body_mm, kind) = match (&traffic, s.target_body_mm) {
+            (Some(tp), Some(t)) if rule.yield_mm > 0.0 && t.norm() <= rule.yield_mm => {
+                let to = rule.make_way(t, &tp.moving, self.radius_mm);
+                match to == t {
+                    true => (target_body_mm, kind),
+                    false => (Some(to), GoalKind::Ahead),
+                }
+            }
+            _ => (target_body_mm, kind),
         };
         let s = Situation {
             target_body_mm,
