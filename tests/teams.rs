@@ -139,6 +139,36 @@ fn six_robots_swap_through_the_centre_on_their_own_cameras_without_touching() {
     }
 }
 
+/// Runs a shipped team scenario on the CPU with its seed: the summary.
+fn team_run(file: &str) -> omniloop::run::Summary {
+    let out = Runner::new(&scenario(file)).options(cpu()).run().unwrap();
+    eprintln!("{file}: {:?}", out.summary.team);
+    out.summary
+}
+
+#[test]
+fn two_robots_meeting_head_on_in_a_700_mm_corridor_pass_without_touching() {
+    let m = team_run("corridor_passing.toml");
+    let team = m.team.unwrap();
+    assert_eq!((team.arrived, team.with_goal), (2, 2));
+    assert_eq!(m.wall_contacts, 0);
+    assert!(team.min_robot_clearance_mm > 0.0);
+}
+
+#[test]
+fn two_teams_of_six_swap_halves_of_the_field_localizing_on_their_own_cameras() {
+    let m = team_run("ssl_teams.toml");
+    let team = m.team.unwrap();
+    assert_eq!((team.arrived, team.with_goal), (12, 12));
+    assert_eq!(m.wall_contacts, 0);
+    assert!(team.min_robot_clearance_mm > 0.0);
+    // Localization in the loop: every robot used fixes, and its estimate stayed near the truth.
+    for r in m.robots.unwrap() {
+        assert!(r.localization_fixes.unwrap_or(0) > 0, "{}", r.name);
+        assert!(r.pose_error_mm.unwrap() < 30.0, "{}: {:?}", r.name, r.pose_error_mm);
+    }
+}
+
 /// Drives straight ahead at 300 mm/s and reads no camera.
 struct Straight;
 
@@ -290,7 +320,12 @@ fn bad_team_input_exits_2_with_file_line_column_and_field() {
 
 #[test]
 fn the_shipped_team_scenarios_check() {
-    for file in ["swarm_swap.toml", "forward_swarm.toml"] {
+    for file in [
+        "swarm_swap.toml",
+        "corridor_passing.toml",
+        "ssl_teams.toml",
+        "forward_swarm.toml",
+    ] {
         let s = scenario(file);
         assert!(s.is_team(), "{file}");
         let path = scenario_path(file);

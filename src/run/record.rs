@@ -233,7 +233,8 @@ pub struct TeamFigures {
     /// (`null`: never two).
     #[serde(deserialize_with = "null_as_infinity")]
     pub min_robot_clearance_mm: f64,
-    /// Total path of the robots with a goal over the total of their straight lines.
+    /// Total path of the robots with a goal over the total of their straight lines, each less
+    /// its goal's tolerance (as the clutter benchmark's `path_ratio`).
     pub path_ratio: Option<f64>,
 }
 

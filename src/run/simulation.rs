@@ -654,8 +654,15 @@ fn team_figures(
         .iter()
         .filter_map(|(a, _)| straight_line_time_s(a.scenario()))
         .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t))));
+    // As the clutter benchmark's path_ratio: the way to the goal ends at its tolerance.
     let path: f64 = with_goal.iter().map(|(_, r)| r.path_length_mm).sum();
-    let straight: f64 = with_goal.iter().filter_map(|(_, r)| r.straight_mm).sum();
+    let straight: f64 = with_goal
+        .iter()
+        .filter_map(|(a, r)| {
+            let tolerance = a.scenario().goal.as_ref().map_or(0.0, |g| g.tolerance_mm);
+            r.straight_mm.map(|s| (s - tolerance).max(0.0))
+        })
+        .sum();
     let team: Vec<usize> = agents.iter().map(Agent::body).collect();
     TeamFigures {
         robots: agents.len(),
