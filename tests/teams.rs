@@ -165,7 +165,12 @@ fn two_teams_of_six_swap_halves_of_the_field_localizing_on_their_own_cameras() {
     // Localization in the loop: every robot used fixes, and its estimate stayed near the truth.
     for r in m.robots.unwrap() {
         assert!(r.localization_fixes.unwrap_or(0) > 0, "{}", r.name);
-        assert!(r.pose_error_mm.unwrap() < 30.0, "{}: {:?}", r.name, r.pose_error_mm);
+        assert!(
+            r.pose_error_mm.unwrap() < 30.0,
+            "{}: {:?}",
+            r.name,
+            r.pose_error_mm
+        );
     }
 }
 
