@@ -28,6 +28,17 @@ def pinhole() -> omniloop.Scenario:
     return omniloop.Scenario.load(SCENARIOS / "render_pinhole.toml")
 
 
+def goal_in_body(obs, goal):
+    """Where `goal` (world frame, mm) lies in the body frame by the observation's dead
+    reckoning."""
+    import math
+
+    x, y, theta = obs.odometry_pose
+    dx, dy = goal[0] - x, goal[1] - y
+    c, s = math.cos(theta), math.sin(theta)
+    return (c * dx + s * dy, -s * dx + c * dy)
+
+
 def to_goal(goal_body_mm, speed_mm_s: float = 400.0):
     """A proportional step toward a goal given in the body frame: (vx, vy, omega)."""
     gx, gy = float(goal_body_mm[0]), float(goal_body_mm[1])

@@ -6,14 +6,7 @@ import numpy as np
 import pytest
 
 import omniloop
-from conftest import SCENARIOS, to_goal
-
-
-def goal_in_body(obs, goal):
-    x, y, theta = obs.odometry_pose
-    dx, dy = goal[0] - x, goal[1] - y
-    c, s = math.cos(theta), math.sin(theta)
-    return (c * dx + s * dy, -s * dx + c * dy)
+from conftest import SCENARIOS, goal_in_body, to_goal
 
 
 def test_an_observation_holds_what_the_sensors_give(corner):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import omniloop
-from conftest import SCENARIOS, to_goal
+from conftest import SCENARIOS, goal_in_body, to_goal
 
 PAIR = """
 name = "pair"
@@ -57,13 +57,6 @@ def pair() -> omniloop.Scenario:
     return omniloop.Scenario.from_toml(PAIR)
 
 
-def body_goal(obs, goal):
-    x, y, theta = obs.odometry_pose
-    dx, dy = goal[0] - x, goal[1] - y
-    c, s = math.cos(theta), math.sin(theta)
-    return (c * dx + s * dy, -s * dx + c * dy)
-
-
 def test_a_scenario_tells_its_robots(pair):
     assert pair.is_team
     assert list(pair.robots) == ["east", "west"]
@@ -82,7 +75,7 @@ def test_a_team_steps_with_a_command_per_robot_and_sees_per_robot(pair):
     assert obs["east"].frames["omni"].shape == (110, 128, 3)
     goals = {n: (r["goal"]["x_mm"], r["goal"]["y_mm"]) for n, r in pair.robots.items()}
     for _ in range(10):
-        obs = sim.step({n: to_goal(body_goal(obs[n], goals[n])) for n in sim.robots})
+        obs = sim.step({n: to_goal(goal_in_body(obs[n], goals[n])) for n in sim.robots})
     truth = sim.truth()
     assert truth["east"]["x_mm"] > -900.0 and truth["west"]["x_mm"] < 900.0
     # Each robot's odometry is its own: they drive opposite ways.

@@ -460,8 +460,13 @@ impl World {
                 }
             }
         }
-        // rapier keeps speculative contacts and recycles manifolds, so whether two colliders
-        // touch is decided from their exact distance.
+        self.confirm_contacts();
+    }
+
+    /// Decides which pairs rapier reports truly touch (rapier keeps speculative contacts and
+    /// recycles manifolds, so it is decided from their exact distance) and counts each touch
+    /// that begins: for the robot, by what it touched, and once for a pair of robots.
+    fn confirm_contacts(&mut self) {
         for i in 0..self.robots.len() {
             let pairs = std::mem::take(&mut self.robots[i].pairs);
             let mut checked = Vec::with_capacity(pairs.len());
@@ -611,6 +616,32 @@ mod tests {
         let moved = after.pose.translation.vector - before.pose.translation.vector;
         // It stops within v^2 / (2 a) = 11.25 mm, along its heading as it turns.
         assert!(moved.norm() < 12.0, "{moved:?}");
+    }
+
+    #[test]
+    fn a_touch_between_two_robots_is_counted_by_what_was_touched_and_once_for_the_pair() {
+        let (mut a, mut b) = (robot_at(-400.0, 0.0), robot_at(0.0, 0.0));
+        a.accel_limit_mm_s2 = 2000.0;
+        b.accel_limit_mm_s2 = 2000.0;
+        let mut w = World::new(&wall_layout(), &[a, b], 0.002).unwrap();
+        w.set_command(0, VelocityCommand::translate(Vector2::new(300.0, 0.0)));
+        w.set_command(1, VelocityCommand::translate(Vector2::new(-300.0, 0.0)));
+        w.advance(1.0);
+        for i in 0..2 {
+            let st = w.stats(i);
+            assert_eq!(
+                (st.contacts, st.robot_contacts, st.solid_contacts),
+                (1, 1, 0)
+            );
+            assert!(st.min_robot_clearance_mm <= TOUCH_TOLERANCE_MM);
+        }
+        assert_eq!(w.robot_touches(), &[(0, 1)]);
+        // Robot 1 then drives on into the wall's face at x = 450: a solid's touch, not a pair's.
+        w.set_command(0, VelocityCommand::translate(Vector2::new(-300.0, 0.0)));
+        w.set_command(1, VelocityCommand::translate(Vector2::new(300.0, 0.0)));
+        w.advance(2.5);
+        assert_eq!(w.stats(1).solid_contacts, 1);
+        assert_eq!(w.robot_touches().len(), 1);
     }
 
     #[test]
