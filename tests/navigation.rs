@@ -43,7 +43,7 @@ fn an_enclosed_goal_is_reported_unreachable_within_ten_seconds_and_the_robot_sta
     assert!(
         out.estimates[k..]
             .iter()
-            .all(|e| e.navigation.as_ref().is_some_and(|n| n.unreachable))
+            .all(|e| e.navigation.as_ref().is_some_and(|n| n.unreachable.is_some()))
     );
 }
 

@@ -47,7 +47,9 @@ pub use estimates::{
 };
 pub use estimator::PoseEstimator;
 pub use mission::Mission;
-pub use navigation::{CellState, GridGeometry, MapSnapshot, NavigationReport, PlannerConfig};
+pub use navigation::{
+    CellState, GridGeometry, MapSnapshot, NavigationReport, PlannerConfig, Unreachable,
+};
 pub use perception::forward::ForwardVisionConfig;
 pub use perception::{STAGES, StageEntry};
 pub use remote::{Mailbox, Remote, RemoteHandle};

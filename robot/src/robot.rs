@@ -191,14 +191,16 @@ impl RobotSoftware for Robot {
         let navigation = self.controller.navigation().cloned();
         let mut not_found = percepts.not_found;
         if let (Some(n), Some(t)) = (&navigation, target_mm)
-            && n.unreachable
+            && let Some(why) = n.unreachable
         {
             not_found.push(NotFound {
                 source: "planner",
                 reason: format!(
-                    "unreachable: no route through free or unknown cells reaches ({:.0}, {:.0}); \
-                     the robot stopped",
-                    t.x, t.y
+                    "unreachable ({}): {} ({:.0}, {:.0}); the robot stopped",
+                    why.as_str(),
+                    why.explain(),
+                    t.x,
+                    t.y
                 ),
             });
         }

@@ -412,7 +412,7 @@ impl Agent {
             pose_error_mm: self.truth.pose_error_mm(),
             targets_reached: self.truth.targets_reached(),
             localization_fixes: localization_fixes(&self.estimates),
-            unreachable: navigation.map(|n| n.unreachable),
+            unreachable: navigation.map(|n| n.unreachable.is_some()),
             watchdog_fired: navigation.map(|n| n.watchdog),
         }
     }

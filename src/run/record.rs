@@ -387,6 +387,8 @@ struct PlanRecord {
     replans: usize,
     watchdog: usize,
     unreachable: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    unreachable_reason: Option<&'static str>,
     cells_free: usize,
     cells_unknown: usize,
     cells_suspect: usize,
@@ -402,7 +404,8 @@ impl PlanRecord {
             remaining_mm: n.remaining_mm.map(round_mm),
             replans: n.replans,
             watchdog: n.watchdog,
-            unreachable: n.unreachable,
+            unreachable: n.unreachable.is_some(),
+            unreachable_reason: n.unreachable.map(|u| u.as_str()),
             cells_free: n.cells[0],
             cells_unknown: n.cells[1],
             cells_suspect: n.cells[2],

@@ -12,4 +12,4 @@ pub mod planner;
 
 pub use config::{PlannerConfig, PlannerKind, TABLE, check_planner};
 pub use grid::{CellState, GridGeometry, MapSnapshot, OccupancyGrid};
-pub use navigator::{NavigationReport, Navigator};
+pub use navigator::{NavigationReport, Navigator, Unreachable};

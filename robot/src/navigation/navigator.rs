@@ -78,10 +78,43 @@ pub struct NavigationReport {
     pub replans: usize,
     /// Times the watchdog fired so far.
     pub watchdog: usize,
-    /// Whether the goal was found unreachable (the robot stopped).
-    pub unreachable: bool,
+    /// Why the goal was found unreachable (the robot stopped); `None` while it is not.
+    pub unreachable: Option<Unreachable>,
     /// Cells free, unknown, suspect and blocked.
     pub cells: [usize; 4],
+}
+
+/// Why a goal was reported unreachable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Unreachable {
+    /// No route through free, unknown or suspect cells reaches it (or it lies in a pocket
+    /// closed by marks from afar).
+    NoRoute,
+    /// Every route left passes a gap narrower than the robot can drive through.
+    TooNarrow,
+    /// No progress toward it for `stall_s` with every other route tried.
+    NoProgress,
+}
+
+impl Unreachable {
+    /// The reason as written in records and tables.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::NoRoute => "no_route",
+            Self::TooNarrow => "too_narrow",
+            Self::NoProgress => "no_progress",
+        }
+    }
+
+    /// A sentence for the estimates record's `not_found`.
+    pub fn explain(self) -> &'static str {
+        match self {
+            Self::NoRoute => "no route through free or unknown cells reaches it",
+            Self::TooNarrow => "every route to it passes a gap narrower than the robot can drive",
+            Self::NoProgress => "no progress toward it on any route",
+        }
+    }
 }
 
 /// Progress of the robot, for the watchdog.
@@ -231,11 +264,11 @@ impl Navigator {
             self.closed_s = 0.0;
             self.closed_t_s = None;
             self.watchdog = Some(Watchdog::new(here, t_s));
-            self.report.unreachable = false;
+            self.report.unreachable = None;
         }
         self.report.cells = self.grid.counts();
         self.final_leg = true;
-        if self.report.unreachable {
+        if self.report.unreachable.is_some() {
             return self.stop();
         }
         if (target - here).norm() <= self.accept_mm {
@@ -263,7 +296,7 @@ impl Navigator {
             self.plan = None;
         }
         if self.needs_plan(here, t_s) && !self.replan(here, target, t_s) {
-            if self.report.unreachable {
+            if self.report.unreachable.is_some() {
                 return self.stop();
             }
             self.report.lookahead_mm = Some(target);
@@ -305,7 +338,7 @@ impl Navigator {
         let Some((cells, _)) = found else {
             let since = *self.failing_since_s.get_or_insert(t_s);
             if t_s - since >= self.config.unreachable_s - 1e-9 {
-                self.report.unreachable = true;
+                self.report.unreachable = Some(Unreachable::NoRoute);
             }
             self.plan = None;
             self.cost_map = Some(costs);
@@ -313,7 +346,7 @@ impl Navigator {
         };
         self.failing_since_s = None;
         if self.closed_on_far_marks(here, target, t_s) {
-            self.report.unreachable = true;
+            self.report.unreachable = Some(Unreachable::NoRoute);
             self.plan = None;
             self.cost_map = Some(costs);
             return false;
@@ -589,7 +622,7 @@ mod tests {
             .unwrap();
         assert!(v.y.abs() < 1e-6 && v.x > 1900.0 && v.x < 2100.0, "{v:?}");
         assert_eq!(nav.report().replans, 1);
-        assert!(!nav.report().unreachable);
+        assert!(nav.report().unreachable.is_none());
     }
 
     #[test]
@@ -612,14 +645,14 @@ mod tests {
                 v.is_some_and(|v| v.x > 0.0),
                 "heads for the goal while it looks"
             );
-            assert!(!nav.report().unreachable, "not yet at {t} s");
+            assert!(nav.report().unreachable.is_none(), "not yet at {t} s");
             t += 0.04;
         }
         for _ in 0..5 {
             nav.steer(None, &cfg.start, Vector2::zeros(), goal, t);
             t += 0.04;
         }
-        assert!(nav.report().unreachable);
+        assert_eq!(nav.report().unreachable, Some(Unreachable::NoRoute));
         assert!(
             nav.steer(
                 Some(&open_floor()),
