@@ -40,11 +40,11 @@ fn an_enclosed_goal_is_reported_unreachable_within_ten_seconds_and_the_robot_sta
         assert!(v < 1.0, "moving at {v} mm/s at {} s", row.t_s);
     }
     // Every later cycle says so too.
-    assert!(
-        out.estimates[k..]
-            .iter()
-            .all(|e| e.navigation.as_ref().is_some_and(|n| n.unreachable.is_some()))
-    );
+    assert!(out.estimates[k..].iter().all(|e| {
+        e.navigation
+            .as_ref()
+            .is_some_and(|n| n.unreachable.is_some())
+    }));
 }
 
 #[test]

@@ -453,7 +453,7 @@ fn in_free_space(s: &Surroundings<'_>, bearing_rad: f64, d_mm: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::{drive, rush_at_wall, surroundings, wall_ahead};
+    use crate::testing::{Seen, drive, rush_at_wall, surroundings, wall_ahead};
     use std::f64::consts::FRAC_PI_3;
 
     fn controller(speed: SpeedChoice, check_period_brake: bool, v_max: f64) -> VelocityAware {
@@ -522,6 +522,130 @@ mod tests {
             Vec2::zeros(),
         );
         assert!((d.v_mm_s.norm() - 2000.0).abs() < 1e-9);
+    }
+
+    /// Distance along the ray from `p` in direction `u` to the first of `walls` (segments).
+    fn cast(p: Vec2, u: Vec2, walls: &[(Vec2, Vec2)]) -> f64 {
+        walls.iter().fold(f64::INFINITY, |best, &(a, b)| {
+            let (e, w) = (b - a, a - p);
+            let den = u.x * e.y - u.y * e.x;
+            if den.abs() < 1e-12 {
+                return best;
+            }
+            let t = (w.x * e.y - w.y * e.x) / den;
+            let s = (w.x * u.y - w.y * u.x) / den;
+            if t > 0.0 && (0.0..=1.0).contains(&s) {
+                best.min(t)
+            } else {
+                best
+            }
+        })
+    }
+
+    /// Distance from `p` to the segment `a`-`b`.
+    fn to_segment(p: Vec2, (a, b): (Vec2, Vec2)) -> f64 {
+        let ab = b - a;
+        let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+        (p - (a + ab * t)).norm()
+    }
+
+    #[test]
+    fn at_2000_mm_s_no_command_takes_the_body_where_it_cannot_stop_short_of_what_it_saw() {
+        // A 3 m x 2 m room with four square pillars, seen as vision would report it: 32
+        // directions up to 1000 mm, each with three rays (centre and sector edges) whose surely
+        // free distance is the least of the three. The robot (top speed 2000 mm/s, alpha 300
+        // mm/s^2: 6.7 m to stop from the top speed, more than the room) is sent round its
+        // corners; at no cycle may its braking path from the speed it has run past what it
+        // saw, and it must never come nearer a wall than the body's radius plus most of the
+        // margin.
+        let mut walls: Vec<(Vec2, Vec2)> = Vec::new();
+        let square = |c: Vec2, h: f64| {
+            let k = [(-h, -h), (h, -h), (h, h), (-h, h)];
+            (0..4)
+                .map(|i| {
+                    let (a, b) = (k[i], k[(i + 1) % 4]);
+                    (c + Vec2::new(a.0, a.1), c + Vec2::new(b.0, b.1))
+                })
+                .collect::<Vec<_>>()
+        };
+        walls.extend(square(Vec2::zeros(), 1500.0).into_iter().map(|(a, b)| {
+            (
+                Vec2::new(a.x, a.y * 2.0 / 3.0),
+                Vec2::new(b.x, b.y * 2.0 / 3.0),
+            )
+        }));
+        for c in [
+            (-600.0, 400.0),
+            (600.0, -400.0),
+            (0.0, 0.0),
+            (-700.0, -500.0),
+        ] {
+            walls.extend(square(Vec2::new(c.0, c.1), 65.0));
+        }
+        let c = controller(SpeedChoice::Chosen, false, 2000.0);
+        let goals = [
+            (1250.0, 750.0),
+            (-1250.0, -750.0),
+            (1250.0, -750.0),
+            (-1250.0, 750.0),
+        ];
+        let (mut p, mut v) = (Vec2::new(-1250.0, 0.0), Vec2::zeros());
+        let (mut nearest, mut fastest, mut reached) = (f64::INFINITY, 0.0_f64, 0);
+        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
+        let half = 0.5 * TAU / 32.0;
+        for _ in 0..1500 {
+            let goal = goals[reached % goals.len()];
+            let goal = Vec2::new(goal.0, goal.1);
+            if (goal - p).norm() < 100.0 {
+                reached += 1;
+                continue;
+            }
+            let mut seen = Seen {
+                dirs: dirs.clone(),
+                free: Vec::new(),
+                obstacles: Vec::new(),
+                clear: Vec::new(),
+            };
+            for &a in &dirs {
+                let rays = [a - half, a, a + half].map(|r| Vec2::new(r.cos(), r.sin()));
+                let d = rays
+                    .iter()
+                    .map(|u| cast(p, *u, &walls))
+                    .fold(f64::INFINITY, f64::min);
+                seen.free.push(d.min(1000.0));
+                if d < 1000.0 {
+                    seen.obstacles.push(rays[1] * d);
+                }
+                seen.clear.extend(rays.iter().map(|u| u * d.min(1000.0)));
+            }
+            // Braking from here, along the velocity, stays inside what was seen this cycle.
+            let speed = v.norm();
+            if speed > 1.0 {
+                let along = cast(p, v / speed, &walls).min(1000.0);
+                let stop = drive().stopping_distance_mm(speed);
+                assert!(
+                    stop + 90.0 <= along + 1.0,
+                    "{speed} mm/s needs {stop} mm, {along} mm seen"
+                );
+            }
+            let cmd = c.decide(&surroundings(&seen), goal - p, v).v_mm_s;
+            for _ in 0..40 {
+                let v1 = drive().step(v, cmd, 0.001);
+                p += (v + v1) * 0.0005;
+                v = v1;
+                fastest = fastest.max(v.norm());
+                nearest = walls
+                    .iter()
+                    .map(|w| to_segment(p, *w))
+                    .fold(nearest, f64::min);
+            }
+        }
+        assert!(nearest >= 90.0 + 20.0, "came within {nearest} mm of a wall");
+        assert!(
+            fastest > 600.0,
+            "it used the speed it could stop from: {fastest} mm/s"
+        );
+        assert!(reached >= 3, "reached {reached} corners");
     }
 
     #[test]

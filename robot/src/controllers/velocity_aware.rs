@@ -11,8 +11,9 @@ use crate::controller::{
 use crate::navigation::{
     self, MapSnapshot, NavigationReport, Navigator, PlannerConfig, PlannerKind,
 };
-use crate::near_field::NearField;
+use crate::near_field::{NearField, NearSpace};
 use crate::traffic::TrafficSense;
+use nalgebra::Isometry2;
 use omniloop_control::{
     AccelLimitedDrive, AvoidanceConfig, GoalKind, SpeedChoice, TrafficConfig, VelocityAware,
 };
@@ -79,12 +80,37 @@ pub struct VelocityAwareStack {
     radius_mm: f64,
 }
 
+/// Moves each blind point out along its ray to where the map's floor seen free ends
+/// ([`Navigator::free_along`]): the memory by the body forgets in 2 s and 250 mm of travel, the
+/// map keeps what it saw for `forget_s`, in the localized frame. A blind point stays a blind
+/// point (passed at a slant, never headed into), only no nearer than the map allows: a robot
+/// that stood in a 305 mm gap's mouth until its memory of the floor there lapsed no longer
+/// finds phantoms at its body's edge on both sides (the planner's clearance and the
+/// controller's are then the same: see docs/navigation.md).
+fn push_blind_out(space: &mut NearSpace, nav: &Navigator, pose: &Isometry2<f64>, inner_mm: f64) {
+    for b in &mut space.blind {
+        let r = b.norm();
+        if r < 1e-6 || r >= inner_mm {
+            continue;
+        }
+        let d = nav.free_along(pose, *b / r, r, inner_mm);
+        if d > r {
+            *b *= d / r;
+        }
+    }
+}
+
 impl Controller for VelocityAwareStack {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        let clear = match (&mut self.near, s.freespace) {
+        let mut clear = match (&mut self.near, s.freespace) {
             (Some(near), Some(fs)) => Some(near.update(fs, &s.odometry_pose, s.t_s)),
             _ => None,
         };
+        if let (Some(space), Some(nav), Some(pose), Some(fs)) =
+            (&mut clear, &self.navigator, &s.pose, s.freespace)
+        {
+            push_blind_out(space, nav, pose, fs.inner_mm);
+        }
         let traffic = match (&mut self.traffic, s.freespace) {
             (Some(sense), Some(fs)) => {
                 Some(sense.update(fs, s.pose.as_ref(), &s.odometry_pose, s.t_s))
@@ -121,9 +147,14 @@ impl Controller for VelocityAwareStack {
         };
         let v = s.velocity_body_mm_s;
         let c = &self.controller;
-        with_surroundings(&s, clear, traffic.as_ref(), |sur, target| {
+        let command = with_surroundings(&s, clear, traffic.as_ref(), |sur, target| {
             c.decide_toward(sur, target, kind, v).v_mm_s
-        })
+        });
+        // The navigator hears what the controller made of its step.
+        if let (Some(nav), Some(pose)) = (&mut self.navigator, &s.pose) {
+            nav.heard(command.v_mm_s, v, pose, s.t_s);
+        }
+        command
     }
 
     fn navigation(&self) -> Option<&NavigationReport> {

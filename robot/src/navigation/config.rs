@@ -38,6 +38,14 @@ pub struct PlannerConfig {
     pub watchdog_s: f64,
     /// What counts as progress: moving this far, or the remaining path shortening this much, mm.
     pub progress_mm: f64,
+    /// No progress for this long (as the watchdog counts it) closes the place ahead on the
+    /// plan to the planner until the target changes, so that the robot takes another route or,
+    /// with none left, reports the goal unreachable (`no_progress`), s.
+    pub stall_s: f64,
+    /// The controller refusing, for this long, every step toward the point the plan heads for
+    /// (its command makes no headway toward it while the robot stands) closes the gap ahead
+    /// the same way (`too_narrow` when no route is left), s.
+    pub refuse_s: f64,
     /// Time constant with which what was seen fades to unknown, s.
     pub forget_s: f64,
     /// Seed the grid with the walls, goals and pillars of the map the robot is given.
@@ -67,6 +75,8 @@ impl Default for PlannerConfig {
             lookahead_mm: 400.0,
             watchdog_s: 4.0,
             progress_mm: 200.0,
+            stall_s: 10.0,
+            refuse_s: 2.0,
             forget_s: 20.0,
             seed_map: true,
             unreachable_s: 2.0,
@@ -97,6 +107,8 @@ pub fn check_planner(spec: &ControlSpec) -> Vec<ConfigProblem> {
             p.positive("lookahead_mm", c.lookahead_mm);
             p.positive("watchdog_s", c.watchdog_s);
             p.positive("progress_mm", c.progress_mm);
+            p.positive("stall_s", c.stall_s);
+            p.positive("refuse_s", c.refuse_s);
             p.positive("forget_s", c.forget_s);
             p.positive("unreachable_s", c.unreachable_s);
             p.positive("pocket_unreachable_s", c.pocket_unreachable_s);

@@ -39,7 +39,7 @@
 //!   end a run that a look from nearer would have saved).
 
 use super::config::PlannerConfig;
-use super::grid::{GridGeometry, MAX_CELLS, MapSnapshot, OccupancyGrid};
+use super::grid::{CellState, GridGeometry, MAX_CELLS, MapSnapshot, OccupancyGrid};
 use super::planner::{CostMap, CostSettings, Suspects, length};
 use crate::RobotError;
 use crate::config::RobotConfig;
@@ -54,6 +54,13 @@ const REBASE_MM: f64 = 500.0;
 const PENALTY: f32 = 4.0;
 /// The watchdog's penalty: the radius of the region made dearer, mm.
 const PENALTY_RADIUS_MM: f64 = 200.0;
+/// A closed place: the centre of the disc closed lies this far ahead on the plan, mm.
+const CLOSE_AHEAD_MM: f64 = 150.0;
+/// A closed place: the radius of the disc closed, mm.
+const CLOSE_RADIUS_MM: f64 = 100.0;
+/// The controller refuses the plan's step while its command makes less headway than this
+/// toward the lookahead point, the robot standing, mm/s.
+const REFUSE_MM_S: f64 = 30.0;
 /// The least fraction of the top speed a turn is taken at.
 const MIN_TURN_SPEED: f64 = 0.2;
 /// A vertex turning the plan by more than this is a bend to slow for, rad.
@@ -78,6 +85,9 @@ pub struct NavigationReport {
     pub replans: usize,
     /// Times the watchdog fired so far.
     pub watchdog: usize,
+    /// Places closed so far: no progress for `stall_s`, or the controller refusing the plan's
+    /// step for `refuse_s`.
+    pub closed: usize,
     /// Why the goal was found unreachable (the robot stopped); `None` while it is not.
     pub unreachable: Option<Unreachable>,
     /// Cells free, unknown, suspect and blocked.
@@ -186,6 +196,12 @@ pub struct Navigator {
     closed_t_s: Option<f64>,
     /// Whether the point the robot was last sent toward is the target itself.
     final_leg: bool,
+    /// The route's progress for the stall rule: the least remaining way and when it was had.
+    stall: (f64, f64),
+    /// Since when the controller has refused every step toward the lookahead point.
+    refusing_since_s: Option<f64>,
+    /// Why the last place was closed (`stall_s` or `refuse_s`), while one is.
+    closed_by: Option<Unreachable>,
     report: NavigationReport,
 }
 
@@ -219,6 +235,9 @@ impl Navigator {
             closed_s: 0.0,
             closed_t_s: None,
             final_leg: true,
+            stall: (f64::INFINITY, 0.0),
+            refusing_since_s: None,
+            closed_by: None,
             report: NavigationReport::default(),
             config: planner,
         })
@@ -238,6 +257,42 @@ impl Navigator {
     /// The grid's cells now.
     pub fn map(&self) -> MapSnapshot {
         self.grid.snapshot()
+    }
+
+    /// How far along the ray `u` (body frame, a unit vector from the robot's centre at the
+    /// estimated `pose`) the map holds floor seen free without a break, from `from_mm` out to
+    /// `to_mm`; `from_mm` when the cell there is not free. The walk stops in the first cell not
+    /// free, and the answer stops short of it by half a cell's diagonal: a cell is free when its
+    /// centre lay in a sector seen surely free, so its far corner may hold the obstacle.
+    ///
+    /// The controller's near-field memory keeps the same evidence (sectors seen surely free)
+    /// for 2 s and 250 mm of odometry; the map keeps it in the localized frame for `forget_s`.
+    /// Where the memory has forgotten the floor by the body, the map still says how far off
+    /// the obstacle in a blind direction stands, so the controller keeps from it the clearance
+    /// the planner planned with instead of from a blind point at the body's edge.
+    pub fn free_along(
+        &self,
+        pose: &Isometry2<f64>,
+        u: Vector2<f64>,
+        from_mm: f64,
+        to_mm: f64,
+    ) -> f64 {
+        let g = self.grid.geometry();
+        let step = 0.25 * g.cell_mm;
+        let slack = 0.5 * std::f64::consts::SQRT_2 * g.cell_mm;
+        let free = |d: f64| {
+            let p = pose * Point2::from(u * d);
+            g.cell_of(p)
+                .is_some_and(|i| self.grid.state(i) == CellState::Free)
+        };
+        let mut d = from_mm;
+        while d + step <= to_mm && free(d + step) {
+            d += step;
+        }
+        if d >= to_mm - step {
+            return to_mm;
+        }
+        (d - slack).max(from_mm)
     }
 
     /// One cycle: takes the free space seen (if any) from the estimated `pose`, and returns
@@ -265,6 +320,14 @@ impl Navigator {
             self.closed_t_s = None;
             self.watchdog = Some(Watchdog::new(here, t_s));
             self.report.unreachable = None;
+            self.stall = (f64::INFINITY, t_s);
+            self.refusing_since_s = None;
+            self.closed_by = None;
+            for p in &mut self.penalty {
+                if p.is_infinite() {
+                    *p = 0.0;
+                }
+            }
         }
         self.report.cells = self.grid.counts();
         self.final_leg = true;
@@ -295,6 +358,9 @@ impl Navigator {
             self.penalise(ahead, t_s);
             self.plan = None;
         }
+        if self.stalled(remaining, t_s) {
+            self.close_ahead(here, Unreachable::NoProgress);
+        }
         if self.needs_plan(here, t_s) && !self.replan(here, target, t_s) {
             if self.report.unreachable.is_some() {
                 return self.stop();
@@ -305,6 +371,98 @@ impl Navigator {
         }
         let course = pose.rotation * velocity_body_mm_s;
         self.follow(pose, here, course)
+    }
+
+    /// Hears the controller's command this cycle (body frame), the robot moving at
+    /// `velocity_body_mm_s`: a command that makes no headway toward the lookahead point while
+    /// the robot stands, for `refuse_s` in a row, is the controller refusing a step the plan
+    /// allows, and closes the place ahead to the planner (a gap the plan takes and the
+    /// controller will not drive through: the planner hears of it and plans round it).
+    pub fn heard(
+        &mut self,
+        command_body_mm_s: Vector2<f64>,
+        velocity_body_mm_s: Vector2<f64>,
+        pose: &Isometry2<f64>,
+        t_s: f64,
+    ) {
+        let here = Point2::from(pose.translation.vector);
+        let ahead = match (&self.plan, self.report.lookahead_mm) {
+            (Some(_), Some(p)) if (p - here).norm() > self.accept_mm => p,
+            _ => {
+                self.refusing_since_s = None;
+                return;
+            }
+        };
+        let toward = pose.inverse_transform_vector(&(ahead - here)).normalize();
+        let refusing = command_body_mm_s.dot(&toward) < REFUSE_MM_S
+            && velocity_body_mm_s.norm() < COURSE_MIN_SPEED_MM_S;
+        if !refusing {
+            self.refusing_since_s = None;
+            return;
+        }
+        let since = *self.refusing_since_s.get_or_insert(t_s);
+        if t_s - since >= self.config.refuse_s - 1e-9 {
+            self.refusing_since_s = None;
+            self.close_ahead(here, Unreachable::TooNarrow);
+        }
+    }
+
+    /// Whether the remaining way has not shortened by `progress_mm` for `stall_s` (restarting
+    /// the count then).
+    fn stalled(&mut self, remaining_mm: f64, t_s: f64) -> bool {
+        if remaining_mm < self.stall.0 - self.config.progress_mm || !self.stall.0.is_finite() {
+            self.stall = (remaining_mm, t_s);
+            return false;
+        }
+        let stalled = t_s - self.stall.1 >= self.config.stall_s - 1e-9;
+        if stalled {
+            self.stall = (remaining_mm, t_s);
+        }
+        stalled
+    }
+
+    /// Closes to the planner, until the target changes, the disc of `CLOSE_RADIUS_MM` round
+    /// the point `CLOSE_AHEAD_MM` ahead on the plan, and drops the plan.
+    fn close_ahead(&mut self, here: Point2<f64>, why: Unreachable) {
+        let Some(plan) = self.plan.take() else {
+            return;
+        };
+        let (_, s_near) = distance_to_path(&plan.path, here);
+        let at = point_at(
+            &plan.path,
+            (s_near + CLOSE_AHEAD_MM).min(length(&plan.path)),
+        );
+        let g = *self.grid.geometry();
+        let r = (CLOSE_RADIUS_MM / g.cell_mm).ceil() as i64;
+        let Some((cx, cy)) = g.coords_of(at) else {
+            return;
+        };
+        for (x, y) in disc_cells(cx, cy, r, &g) {
+            let i = y * g.width + x;
+            if (g.centre(i) - at).norm() <= CLOSE_RADIUS_MM {
+                self.penalty[i] = f32::INFINITY;
+            }
+        }
+        self.closed_by = Some(why);
+        self.report.closed += 1;
+    }
+
+    /// Why no route reaches `target`: a place the navigator closed, when a route exists
+    /// without the closed places; else no route on the map.
+    fn why_no_route(&self, here: Point2<f64>, target: Point2<f64>) -> Unreachable {
+        let Some(why) = self.closed_by else {
+            return Unreachable::NoRoute;
+        };
+        let open: Vec<f32> = self
+            .penalty
+            .iter()
+            .map(|&p| if p.is_infinite() { 0.0 } else { p })
+            .collect();
+        let costs = CostMap::new(&self.grid, &self.costs, &open, here, Suspects::Costly);
+        match costs.plan(here, target, self.accept_mm) {
+            Some(_) => why,
+            None => Unreachable::NoRoute,
+        }
     }
 
     fn stop(&mut self) -> Option<Vector2<f64>> {
@@ -338,7 +496,7 @@ impl Navigator {
         let Some((cells, _)) = found else {
             let since = *self.failing_since_s.get_or_insert(t_s);
             if t_s - since >= self.config.unreachable_s - 1e-9 {
-                self.report.unreachable = Some(Unreachable::NoRoute);
+                self.report.unreachable = Some(self.why_no_route(here, target));
             }
             self.plan = None;
             self.cost_map = Some(costs);
@@ -358,6 +516,7 @@ impl Navigator {
         {
             w.best_mm = new_len;
             w.best_t_s = t_s;
+            self.stall = (new_len, t_s);
         }
         self.report.path_mm = path.clone();
         self.plan = Some(Plan {
@@ -449,16 +608,10 @@ impl Navigator {
         let Some((cx, cy)) = g.coords_of(at) else {
             return;
         };
-        for dy in -r..=r {
-            for dx in -r..=r {
-                let (x, y) = (cx as i64 + dx, cy as i64 + dy);
-                if x < 0 || y < 0 || x >= g.width as i64 || y >= g.height as i64 {
-                    continue;
-                }
-                let i = y as usize * g.width + x as usize;
-                if (g.centre(i) - at).norm() <= PENALTY_RADIUS_MM {
-                    self.penalty[i] += PENALTY;
-                }
+        for (x, y) in disc_cells(cx, cy, r, &g) {
+            let i = y * g.width + x;
+            if (g.centre(i) - at).norm() <= PENALTY_RADIUS_MM {
+                self.penalty[i] += PENALTY;
             }
         }
     }
@@ -508,6 +661,21 @@ fn grid_geometry(config: &RobotConfig, cell_mm: f64) -> Result<GridGeometry, Rob
         )));
     }
     Ok(g)
+}
+
+/// The cells of the grid within `r` cells of column `cx`, row `cy` along each axis.
+fn disc_cells(
+    cx: usize,
+    cy: usize,
+    r: i64,
+    g: &GridGeometry,
+) -> impl Iterator<Item = (usize, usize)> + use<> {
+    let (w, h) = (g.width as i64, g.height as i64);
+    let (cx, cy) = (cx as i64, cy as i64);
+    (-r..=r)
+        .flat_map(move |dy| (-r..=r).map(move |dx| (cx + dx, cy + dy)))
+        .filter(move |&(x, y)| x >= 0 && y >= 0 && x < w && y < h)
+        .map(|(x, y)| (x as usize, y as usize))
 }
 
 /// Distance from `p` to a polyline, and the arc length of the nearest point on it.

@@ -12,7 +12,8 @@
 //! [`super::grid`]) and `s` its factor `SUSPECT_FACTOR`, `r_i`
 //! the robot's radius plus `inflation_mm` (nearer is impassable), `c` the comfort band
 //! `comfort_mm` in which paths pay `w` to keep off obstacles (the middle of a gap is cheapest),
-//! `u` the `unknown_cost` and `p` the watchdog's penalty on the cell. The heuristic is the
+//! `u` the `unknown_cost` and `p` the watchdog's penalty on the cell (infinite: a place the
+//! navigator closed, impassable). The heuristic is the
 //! octile distance, admissible since every factor is at least 1. A cell within `r_i` of the
 //! robot itself stays passable (at a high factor), so that a robot already too near an obstacle
 //! can leave. The goal is any passable cell whose centre lies within the goal's acceptance
@@ -90,7 +91,11 @@ impl CostMap {
                 if suspects == Suspects::Blocked {
                     d = d.min((at(&suspect, i) - SUSPECT_SPREAD_MM).max(0.0));
                 }
-                let mut f = 1.0 + penalty.get(i).copied().unwrap_or(0.0);
+                let p = penalty.get(i).copied().unwrap_or(0.0);
+                if p.is_infinite() {
+                    return None;
+                }
+                let mut f = 1.0 + p;
                 if grid.state(i) == CellState::Unknown {
                     f += settings.unknown_cost as f32;
                 }
