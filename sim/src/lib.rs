@@ -9,6 +9,7 @@ pub mod floor_marks;
 pub mod floor_rect;
 pub mod layout;
 pub mod optics;
+pub mod reachability;
 pub mod render;
 pub mod sensor;
 pub mod shapes;
@@ -19,6 +20,7 @@ pub use corridor::Corridor;
 pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use floor_rect::FloorRect;
 pub use layout::{Board, Cube, FieldSpec, Layout, Pillar, Wall};
+pub use reachability::{Reachability, Target, reachability};
 pub use render::{
     CameraEffects, FrameNoise, FrameRequest, RenderError, Renderer, RendererChoice, Scene,
     SensorNoise,
