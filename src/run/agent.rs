@@ -7,6 +7,7 @@ use super::cameras::Cameras;
 use super::column_calibration::calibrate_columns;
 use super::error::RunError;
 use super::odometry::WheelOdometry;
+use super::outcome::{GoalFigures, GoalOutcome, ProgressSample, made_progress, route_reachability};
 use super::pilot::Pilot;
 use super::record::{RobotSummary, TrajectoryRow};
 use super::score::TruthScore;
@@ -15,11 +16,11 @@ use crate::scenario::{PilotChoice, Scenario};
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
 use omniloop_robot::{
-    ActuatorState, Estimates, FixOutcome, Frame, Observation, OdometryReading, Outputs,
-    RobotConfig, RobotError, RobotSoftware,
+    ActuatorState, Estimates, FixOutcome, Frame, NavigationReport, Observation, OdometryReading,
+    Outputs, RobotConfig, RobotError, RobotSoftware,
 };
 use omniloop_sim::render::BatchHandle;
-use omniloop_sim::{RendererChoice, RobotState, Scene, SimError, World};
+use omniloop_sim::{Reachability, RendererChoice, RobotState, Scene, SimError, World};
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::resection::ColumnCalibration;
 use std::collections::VecDeque;
@@ -59,6 +60,10 @@ pub struct Agent {
     /// The target it headed for in the cycle being applied (its software's word, or the
     /// pilot's), checked on the truth once the world moved on.
     heading_for: Option<usize>,
+    /// With a goal: whether its route can be driven on the true world (from its start).
+    route: Option<Reachability>,
+    /// With a goal: where it was and on which target, a sample a recorded cycle.
+    progress: Vec<ProgressSample>,
 }
 
 impl Agent {
@@ -88,6 +93,15 @@ impl Agent {
             )?),
             _ => None,
         };
+        let route = match &scenario.goal {
+            Some(g) => Some(route_reachability(
+                &scenario.world,
+                r.radius_mm,
+                scenario.start().point(),
+                g,
+            )?),
+            None => None,
+        };
         let cameras = Cameras::open(
             scenario,
             &software.cameras(),
@@ -111,6 +125,8 @@ impl Agent {
             last_odometry: None,
             commands: VecDeque::new(),
             heading_for: None,
+            route,
+            progress: Vec::new(),
         })
     }
 
@@ -311,8 +327,21 @@ impl Agent {
             self.truth
                 .pose(Point2::new(x, y), Point2::new(row.x_mm, row.y_mm));
         }
+        self.sample_progress(&row);
         self.trajectory.push(row);
         self.estimates.push(estimates);
+    }
+
+    /// With a goal: notes where the robot is in `row` and the target it is on.
+    fn sample_progress(&mut self, row: &TrajectoryRow) {
+        if self.has_goal() {
+            self.progress.push(ProgressSample {
+                t_s: row.t_s,
+                x_mm: row.x_mm,
+                y_mm: row.y_mm,
+                target: self.truth.current_target(),
+            });
+        }
     }
 
     /// Closes its trajectory with the final state (driving runs).
@@ -323,6 +352,7 @@ impl Agent {
             world.command(self.body),
             self.software.estimate(),
         );
+        self.sample_progress(&row);
         self.trajectory.push(row);
     }
 
@@ -391,6 +421,7 @@ impl Agent {
             controller: self.controller(),
             reached_goal: self.reached_goal(),
             time_to_goal_s: self.truth.time_to_goal_s(),
+            goal_figures: self.goal_figures(navigation),
             contacts: stats.contacts,
             solid_contacts: stats.solid_contacts,
             robot_contacts: stats.robot_contacts,
@@ -415,6 +446,24 @@ impl Agent {
             unreachable: navigation.map(|n| n.unreachable.is_some()),
             watchdog_fired: navigation.map(|n| n.watchdog),
         }
+    }
+
+    /// With a goal: how its run ended so far (reached; else unreachable when its planner last
+    /// said so; else time up or stuck by its progress on the truth), and its route's
+    /// reachability.
+    fn goal_figures(&self, navigation: Option<&NavigationReport>) -> Option<GoalFigures> {
+        let (goal, route) = (self.scenario.goal.as_ref()?, self.route?);
+        let reason = navigation
+            .and_then(|n| n.unreachable)
+            .map(|u| u.as_str().to_string());
+        let progressing = made_progress(&self.progress, &goal.targets());
+        let outcome = GoalOutcome::of(self.reached_goal(), reason.is_some(), progressing);
+        Some(GoalFigures {
+            outcome,
+            unreachable_reason: reason.filter(|_| outcome == GoalOutcome::Unreachable),
+            goal_reachable: route.reachable,
+            reachable_margin_mm: route.margin_mm,
+        })
     }
 
     /// Ends its run: its trajectory and estimates.

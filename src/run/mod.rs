@@ -1,7 +1,8 @@
 //! The run layer: the closed loop on the simulator's side ([`simulation`]), the sensors and
 //! actuators it simulates ([`cameras`], [`odometry`], [`column_calibration`]), its pilot for
-//! the other robots ([`pilot`]), the truth-side scores ([`score`]) and the records of a run
-//! ([`record`]). It never calls up into an experiment: an experiment drives it.
+//! the other robots ([`pilot`]), the truth-side scores ([`score`]), how a run with a goal
+//! ended ([`outcome`]) and the records of a run ([`record`]). It never calls up into an
+//! experiment: an experiment drives it.
 
 pub mod agent;
 pub mod cameras;
@@ -9,6 +10,7 @@ pub mod column_calibration;
 pub mod error;
 pub mod observer;
 pub mod odometry;
+pub mod outcome;
 pub mod pilot;
 pub mod record;
 pub mod score;
@@ -16,6 +18,7 @@ pub mod simulation;
 
 pub use agent::{Agent, Truth};
 pub use error::RunError;
+pub use outcome::{GoalFigures, GoalOutcome};
 pub use record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};
 pub use simulation::{
     OutputFile, RobotOutput, RunOptions, RunOutput, Simulation, builtin_software, render_snapshot,

@@ -1,5 +1,6 @@
 //! What a run leaves behind: the trajectory (one row a control cycle) and the summary.
 
+use super::outcome::GoalFigures;
 use nalgebra::{Isometry2, Point2};
 use omniloop_robot::{Estimates, Fix, FixOutcome, Measurement, NavigationReport};
 use omniloop_vision::{LocalizationMode, LocalizationQuality};
@@ -111,6 +112,11 @@ pub struct Summary {
     pub reached_goal: bool,
     /// When it did.
     pub time_to_goal_s: Option<f64>,
+    /// With a goal: how the run ended (`outcome`, `unreachable_reason`) and whether the goal
+    /// could be reached on the true world (`goal_reachable`, `reachable_margin_mm`); for a
+    /// team, its worst robot's outcome and its narrowest route.
+    #[serde(flatten)]
+    pub goal_figures: Option<GoalFigures>,
     /// Smallest distance from the robot's edge to a wall, cube, pillar or robot (infinite,
     /// written as `null`, when no cycle ran).
     #[serde(deserialize_with = "null_as_infinity")]
@@ -167,6 +173,10 @@ pub struct RobotSummary {
     pub reached_goal: bool,
     /// When it did.
     pub time_to_goal_s: Option<f64>,
+    /// With a goal: how its run ended and whether its goal could be reached (as the
+    /// summary's).
+    #[serde(flatten)]
+    pub goal_figures: Option<GoalFigures>,
     /// How many times it started touching anything.
     pub contacts: u32,
     /// Of those, walls, cubes, pillars and boards.
@@ -512,5 +522,48 @@ mod tests {
         assert!(m.experiment.contains_key("places"));
         let again: Summary = serde_json::from_str(&serde_json::to_string(&m).unwrap()).unwrap();
         assert_eq!(again, m);
+    }
+
+    /// A goal's figures sit among the summary's own keys, a margin of no route as `null`, and
+    /// read back apart from the experiment's keys; without a goal there are none.
+    #[test]
+    fn goal_figures_are_keys_of_the_summary_and_read_back() {
+        use super::super::outcome::GoalOutcome;
+        let text = r#"{"scenario":"s","seed":1,"controller":"c","cycles":3,"sim_time_s":0.1,
+            "wall_time_s":0.1,"cycles_per_s":30.0,"wall_contacts":0,"peak_speed_mm_s":0.0,
+            "peak_accel_mm_s2":0.0,"reached_goal":false,"time_to_goal_s":null,
+            "outcome":"unreachable","unreachable_reason":"too_narrow","goal_reachable":false,
+            "reachable_margin_mm":null,"min_clearance_mm":5.0,"path_length_mm":0.0,
+            "straight_mm":1500.0}"#;
+        let m: Summary = serde_json::from_str(text).unwrap();
+        let g = m.goal_figures.clone().unwrap();
+        assert_eq!(g.outcome, GoalOutcome::Unreachable);
+        assert_eq!(g.unreachable_reason.as_deref(), Some("too_narrow"));
+        assert_eq!((g.goal_reachable, g.reachable_margin_mm), (false, None));
+        let keys: Vec<&String> = m.experiment.keys().collect();
+        assert_eq!(
+            keys,
+            ["straight_mm"],
+            "the goal's keys are not the experiment's"
+        );
+        let json = serde_json::to_value(&m).unwrap();
+        assert_eq!(json["reachable_margin_mm"], serde_json::Value::Null);
+        assert_eq!(json["outcome"], "unreachable");
+        let again: Summary = serde_json::from_value(json).unwrap();
+        assert_eq!(again, m);
+        let none = Summary {
+            goal_figures: None,
+            ..m
+        };
+        let json = serde_json::to_value(&none).unwrap();
+        for key in [
+            "outcome",
+            "unreachable_reason",
+            "goal_reachable",
+            "reachable_margin_mm",
+        ] {
+            assert!(json.get(key).is_none(), "{key}");
+        }
+        assert_eq!(serde_json::from_value::<Summary>(json).unwrap(), none);
     }
 }

@@ -92,6 +92,15 @@ impl TruthScore {
         }
     }
 
+    /// The target the robot is on: the first not reached yet (the number of targets once all
+    /// are).
+    pub fn current_target(&self) -> usize {
+        self.reached
+            .iter()
+            .position(|r| !r)
+            .unwrap_or(self.reached.len())
+    }
+
     /// When the goal was reached.
     pub fn time_to_goal_s(&self) -> Option<f64> {
         self.time_to_goal_s
@@ -179,6 +188,7 @@ mod tests {
         // Passing the goal while heading for the waypoint does not reach the goal.
         s.targets(Point2::new(0.0, 450.0), Some(0), 1.0);
         assert_eq!((s.targets_reached(), s.time_to_goal_s()), (Some(0), None));
+        assert_eq!(s.current_target(), 0);
         // The robot believed it reached the waypoint 150 mm short of it: not reached.
         s.targets(Point2::new(850.0, 0.0), Some(0), 2.0);
         s.targets(Point2::new(0.0, 480.0), Some(1), 3.0);
@@ -187,6 +197,7 @@ mod tests {
             (s.targets_reached(), s.time_to_goal_s()),
             (Some(1), Some(3.0))
         );
+        assert_eq!(s.current_target(), 0, "the waypoint is still to be reached");
         assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
         assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
         assert_eq!(median(&[]), None);

@@ -9,8 +9,9 @@ use super::agent::{Agent, CameraSetup, SoftwareBuilder, Truth};
 use super::cameras::sensor_noise_seed;
 use super::error::RunError;
 use super::observer::{CycleView, ObserverHandle, RobotCycle};
+use super::outcome::{GoalFigures, GoalOutcome};
 use super::pilot::Pilot;
-use super::record::{Summary, TeamFigures, TrajectoryRow};
+use super::record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::AccelLimitedDrive;
@@ -570,6 +571,7 @@ impl Simulation {
             peak_accel_mm_s2: r.peak_accel_mm_s2,
             reached_goal: r.reached_goal,
             time_to_goal_s: r.time_to_goal_s,
+            goal_figures: r.goal_figures,
             min_clearance_mm: r.min_clearance_mm,
             path_length_mm: r.path_length_mm,
             renderer: first.renderer_name().map(str::to_string),
@@ -607,6 +609,7 @@ impl Simulation {
             peak_accel_mm_s2: rows.iter().map(|r| r.peak_accel_mm_s2).fold(0.0, f64::max),
             reached_goal: figures.with_goal > 0 && figures.all_arrived,
             time_to_goal_s: figures.last_arrival_s,
+            goal_figures: team_goal_figures(&rows),
             min_clearance_mm: rows
                 .iter()
                 .map(|r| r.min_clearance_mm)
@@ -629,13 +632,39 @@ impl Simulation {
     }
 }
 
+/// A team's goal figures over its robots with a goal: the worst outcome
+/// ([`GoalOutcome::worst`]), with the reasons of the robots that reported unreachable when
+/// that is the team's; every route reachable, and the narrowest margin. `None` when no robot
+/// has a goal.
+fn team_goal_figures(rows: &[RobotSummary]) -> Option<GoalFigures> {
+    let figures: Vec<&GoalFigures> = rows
+        .iter()
+        .filter_map(|r| r.goal_figures.as_ref())
+        .collect();
+    let outcome = GoalOutcome::worst(figures.iter().map(|f| f.outcome))?;
+    let mut reasons: Vec<&str> = figures
+        .iter()
+        .filter_map(|f| f.unreachable_reason.as_deref())
+        .collect();
+    reasons.sort_unstable();
+    reasons.dedup();
+    let reachable = figures.iter().all(|f| f.goal_reachable);
+    Some(GoalFigures {
+        outcome,
+        unreachable_reason: (outcome == GoalOutcome::Unreachable && !reasons.is_empty())
+            .then(|| reasons.join("+")),
+        goal_reachable: reachable,
+        reachable_margin_mm: figures
+            .iter()
+            .map(|f| f.reachable_margin_mm)
+            .collect::<Option<Vec<f64>>>()
+            .and_then(|m| m.into_iter().reduce(f64::min)),
+    })
+}
+
 /// A team's figures from its robots' rows and the world's record of touches.
-fn team_figures(
-    world: &World,
-    agents: &[Agent],
-    rows: &[super::record::RobotSummary],
-) -> TeamFigures {
-    let with_goal: Vec<(&Agent, &super::record::RobotSummary)> = agents
+fn team_figures(world: &World, agents: &[Agent], rows: &[RobotSummary]) -> TeamFigures {
+    let with_goal: Vec<(&Agent, &RobotSummary)> = agents
         .iter()
         .zip(rows)
         .filter(|(a, _)| a.has_goal())
