@@ -1,7 +1,10 @@
 //! Navigation among clutter: a seed gives the Small-Size field with `cubes` cubes at random, and
 //! a start and a goal at random free places at least `min_distance_mm` apart, the goal
 //! reachable through gaps at least `passage_mm` wide (a layout whose goal is not is drawn again:
-//! the benchmark measures navigation, not luck). The sweep keys `experiment.clutter.seed` and
+//! the benchmark measures navigation, not luck). With `require_passage = false` the first
+//! layout with a start and a goal is kept, passable or not: the benchmark then measures whether
+//! the robot ends honestly (it reaches the goal, or reports it unreachable), and the summary's
+//! `goal_reachable` and `reachable_margin_mm` say which goals could be reached. The sweep keys `experiment.clutter.seed` and
 //! `experiment.clutter.cubes` make a benchmark of it; the metrics add the straight-line
 //! distance from start to goal (`straight_mm`) and, when the goal was reached, the path ratio
 //! (`path_ratio`: the path's length over the shortest way into the goal's tolerance circle,
@@ -34,6 +37,11 @@ pub struct ClutterSpec {
     pub clearance_mm: f64,
     /// The goal must be reachable through gaps at least this wide, mm.
     pub passage_mm: f64,
+    /// Whether the goal must be reachable through gaps of `passage_mm` (a layout whose goal is
+    /// not is drawn again); false keeps the first layout with a start and a goal, so that some
+    /// goals are behind narrow gaps or closed off. The same seed draws the same cubes, start
+    /// and goal either way until a layout is refused.
+    pub require_passage: bool,
     /// The goal's tolerance, mm.
     pub goal_tolerance_mm: f64,
 }
@@ -47,6 +55,7 @@ impl Default for ClutterSpec {
             min_distance_mm: 1500.0,
             clearance_mm: 60.0,
             passage_mm: 260.0,
+            require_passage: true,
             goal_tolerance_mm: 100.0,
         }
     }
@@ -86,7 +95,7 @@ impl ClutterSpec {
             let Some(goal) = random_place(&mut rng, field, radius_mm, &far) else {
                 continue;
             };
-            if !self.reachable(field, &cubes, start, goal) {
+            if self.require_passage && !self.reachable(field, &cubes, start, goal) {
                 continue;
             }
             return Ok(ClutterLayout {
@@ -99,10 +108,15 @@ impl ClutterSpec {
                 goal: [goal.x, goal.y],
             });
         }
+        let joined = if self.require_passage {
+            format!(" joined by gaps of {} mm", self.passage_mm)
+        } else {
+            String::new()
+        };
         Err(format!(
-            "no layout of {} cubes in {TRIES} draws leaves a start and a goal {} mm apart joined \
-             by gaps of {} mm: fewer cubes or a shorter min_distance_mm",
-            self.cubes, self.min_distance_mm, self.passage_mm
+            "no layout of {} cubes in {TRIES} draws leaves a start and a goal {} mm apart{joined}: \
+             fewer cubes or a shorter min_distance_mm",
+            self.cubes, self.min_distance_mm
         ))
     }
 
@@ -354,5 +368,107 @@ mod tests {
         let (s, g) = (Point2::new(-800.0, 0.0), Point2::new(800.0, 0.0));
         assert!(!spec.reachable(&field, &wall, s, g));
         assert!(spec.reachable(&field, &wall[..5], s, g));
+    }
+
+    /// Layouts of today's seeds, pinned: the default settings draw exactly these, whatever is
+    /// added to the generator.
+    #[test]
+    fn default_layouts_are_pinned() {
+        let field = FieldSpec::default();
+        let pins = [
+            (
+                1,
+                10,
+                [587.5552226225473, 500.25830885274195],
+                [-711.8168074733347, -443.7389213802162],
+                [-784.1736717187998, 499.2398714611402],
+            ),
+            (
+                7,
+                16,
+                [179.04807479846068, 334.2820179796132],
+                [-1097.8981357998778, -588.38678706204],
+                [554.7968321129235, 207.635128371301],
+            ),
+            (
+                3,
+                20,
+                [-1177.011711482038, 347.2146040507532],
+                [379.05954474361465, 546.6483620970059],
+                [1189.5772708534678, 571.112270605433],
+            ),
+        ];
+        for (seed, cubes, start, goal, first) in pins {
+            let spec = ClutterSpec {
+                seed,
+                cubes,
+                ..ClutterSpec::default()
+            };
+            let l = spec.layout(&field, 90.0).unwrap();
+            assert_eq!([l.start.x_mm, l.start.y_mm], start, "seed {seed}");
+            assert_eq!(l.goal, goal, "seed {seed}");
+            assert_eq!(l.cubes[0].center_mm, first, "seed {seed}");
+        }
+    }
+
+    /// Twenty cubes draw for every seed tried. With the passage required, every goal is
+    /// reachable on the true world with about the passage's margin (`passage_mm / 2` less the
+    /// radius, 40 mm, less half a cell of the generator's grid); without it the first draw is kept: the same scene
+    /// wherever the default kept its first draw, and some goals closed off or narrow.
+    #[test]
+    fn twenty_cubes_draw_with_or_without_a_passage() {
+        let field = FieldSpec::default();
+        let (mut kept_first, mut hard) = (0, 0);
+        for seed in 1..=20 {
+            let spec = ClutterSpec {
+                seed,
+                cubes: 20,
+                ..ClutterSpec::default()
+            };
+            let strict = spec.layout(&field, 90.0).unwrap();
+            let route = truth(&field, &strict);
+            assert!(
+                route.margin_mm.is_some_and(|m| m >= 40.0 - CELL_MM / 2.0),
+                "seed {seed}: {route:?}"
+            );
+            let loose = ClutterSpec {
+                require_passage: false,
+                ..spec
+            }
+            .layout(&field, 90.0)
+            .unwrap();
+            assert_eq!(loose.cubes.len(), 20);
+            if loose == strict {
+                kept_first += 1;
+            } else if truth(&field, &loose).margin_mm.is_none_or(|m| m < 40.0) {
+                hard += 1;
+            }
+        }
+        assert!(kept_first > 0 && hard > 0, "{kept_first} kept, {hard} hard");
+    }
+
+    /// The layout's route on the true world for a robot of 90 mm.
+    fn truth(field: &FieldSpec, l: &ClutterLayout) -> omniloop_sim::Reachability {
+        let world = omniloop_sim::Layout {
+            field: Some(field.clone()),
+            cubes: l.cubes.clone(),
+            ..omniloop_sim::Layout::default()
+        };
+        let goal = omniloop_sim::Target {
+            point_mm: Point2::from(l.goal),
+            tolerance_mm: 100.0,
+        };
+        let start = Point2::new(l.start.x_mm, l.start.y_mm);
+        omniloop_sim::reachability(&world, 90.0, start, &[goal]).unwrap()
+    }
+
+    #[test]
+    fn require_passage_is_checked_as_a_boolean() {
+        let text = "[experiment.clutter]\nrequire_passage = \"no\"\n";
+        let err = crate::experiments::parse_scenario(text, "c.toml".as_ref(), "c").unwrap_err();
+        assert!(err.to_string().contains("require_passage"), "{err}");
+        let text = "[experiment.clutter]\ncubes = 20\nrequire_passage = false\n";
+        let s = crate::experiments::parse_scenario(text, "c.toml".as_ref(), "c").unwrap();
+        assert_eq!(s.world.cubes.len(), 20);
     }
 }
