@@ -38,13 +38,14 @@ pub struct PlannerConfig {
     pub watchdog_s: f64,
     /// What counts as progress: moving this far, or the remaining path shortening this much, mm.
     pub progress_mm: f64,
-    /// No progress for this long (as the watchdog counts it) closes the place ahead on the
-    /// plan to the planner until the target changes, so that the robot takes another route or,
-    /// with none left, reports the goal unreachable (`no_progress`), s.
+    /// No progress for this long (the remaining way not shortened by `progress_mm`) closes the
+    /// narrowest place ahead on the plan until the target changes: dearer after one failure
+    /// there, impassable after two, so that the robot takes another route or, with none left,
+    /// reports the goal unreachable (`no_progress`), s.
     pub stall_s: f64,
     /// The controller refusing, for this long, every step toward the point the plan heads for
-    /// (its command makes no headway toward it while the robot stands) closes the gap ahead
-    /// the same way (`too_narrow` when no route is left), s.
+    /// (its command makes no headway toward it while the robot stands) closes the narrowest
+    /// place ahead the same way (`too_narrow` when no route is left), s.
     pub refuse_s: f64,
     /// Time constant with which what was seen fades to unknown, s.
     pub forget_s: f64,
@@ -76,7 +77,7 @@ impl Default for PlannerConfig {
             watchdog_s: 4.0,
             progress_mm: 200.0,
             stall_s: 10.0,
-            refuse_s: 2.0,
+            refuse_s: 4.0,
             forget_s: 20.0,
             seed_map: true,
             unreachable_s: 2.0,

@@ -58,6 +58,9 @@ const PENALTY_RADIUS_MM: f64 = 200.0;
 const CLOSE_AHEAD_MM: f64 = 150.0;
 /// A closed place: the radius of the disc closed, mm.
 const CLOSE_RADIUS_MM: f64 = 100.0;
+/// A place closed once: the added cost factor (crossing it costs as much as 2 m of floor
+/// round it, so the robot tries every other way first).
+const CLOSED_FACTOR: f32 = 20.0;
 /// The controller refuses the plan's step while its command makes less headway than this
 /// toward the lookahead point, the robot standing, mm/s.
 const REFUSE_MM_S: f64 = 30.0;
@@ -185,6 +188,9 @@ pub struct Navigator {
     grid: OccupancyGrid,
     penalty: Vec<f32>,
     penalty_t_s: f64,
+    /// Places closed to the planner until the target changes, a level a cell: 1 after one
+    /// failure there (dearer by `CLOSED_FACTOR`), 2 after a second (impassable).
+    closed: Vec<u8>,
     cost_map: Option<CostMap>,
     plan: Option<Plan>,
     target: Option<Point2<f64>>,
@@ -198,6 +204,8 @@ pub struct Navigator {
     final_leg: bool,
     /// The route's progress for the stall rule: the least remaining way and when it was had.
     stall: (f64, f64),
+    /// When the stall rule last started again from a longer plan.
+    stall_rebased_s: f64,
     /// Since when the controller has refused every step toward the lookahead point.
     refusing_since_s: Option<f64>,
     /// Why the last place was closed (`stall_s` or `refuse_s`), while one is.
@@ -227,6 +235,7 @@ impl Navigator {
             grid: OccupancyGrid::new(geometry, &config.map, &planner),
             penalty: vec![0.0; geometry.len()],
             penalty_t_s: 0.0,
+            closed: vec![0; geometry.len()],
             cost_map: None,
             plan: None,
             target: None,
@@ -236,6 +245,7 @@ impl Navigator {
             closed_t_s: None,
             final_leg: true,
             stall: (f64::INFINITY, 0.0),
+            stall_rebased_s: f64::NEG_INFINITY,
             refusing_since_s: None,
             closed_by: None,
             report: NavigationReport::default(),
@@ -321,13 +331,10 @@ impl Navigator {
             self.watchdog = Some(Watchdog::new(here, t_s));
             self.report.unreachable = None;
             self.stall = (f64::INFINITY, t_s);
+            self.stall_rebased_s = f64::NEG_INFINITY;
             self.refusing_since_s = None;
             self.closed_by = None;
-            for p in &mut self.penalty {
-                if p.is_infinite() {
-                    *p = 0.0;
-                }
-            }
+            self.closed.fill(0);
         }
         self.report.cells = self.grid.counts();
         self.final_leg = true;
@@ -359,7 +366,11 @@ impl Navigator {
             self.plan = None;
         }
         if self.stalled(remaining, t_s) {
-            self.close_ahead(here, Unreachable::NoProgress);
+            self.close_ahead(
+                here,
+                2.0 * self.config.lookahead_mm,
+                Unreachable::NoProgress,
+            );
         }
         if self.needs_plan(here, t_s) && !self.replan(here, target, t_s) {
             if self.report.unreachable.is_some() {
@@ -403,7 +414,7 @@ impl Navigator {
         let since = *self.refusing_since_s.get_or_insert(t_s);
         if t_s - since >= self.config.refuse_s - 1e-9 {
             self.refusing_since_s = None;
-            self.close_ahead(here, Unreachable::TooNarrow);
+            self.close_ahead(here, self.config.lookahead_mm, Unreachable::TooNarrow);
         }
     }
 
@@ -422,28 +433,46 @@ impl Navigator {
     }
 
     /// Closes to the planner, until the target changes, the disc of `CLOSE_RADIUS_MM` round
-    /// the point `CLOSE_AHEAD_MM` ahead on the plan, and drops the plan.
-    fn close_ahead(&mut self, here: Point2<f64>, why: Unreachable) {
-        let Some(plan) = self.plan.take() else {
+    /// the narrowest place of the plan within `window_mm` ahead of the robot (at least
+    /// `CLOSE_AHEAD_MM` ahead): the gap the robot fails to pass, not the floor where it stands
+    /// (which may be where two routes part). Closed once, the place is dearer by
+    /// `CLOSED_FACTOR` (every other way is tried first); failed there again, it is impassable,
+    /// and with no route left the goal is reported unreachable for `why`. Drops the plan.
+    fn close_ahead(&mut self, here: Point2<f64>, window_mm: f64, why: Unreachable) {
+        let (Some(plan), Some(costs)) = (self.plan.take(), &self.cost_map) else {
             return;
         };
         let (_, s_near) = distance_to_path(&plan.path, here);
-        let at = point_at(
-            &plan.path,
-            (s_near + CLOSE_AHEAD_MM).min(length(&plan.path)),
-        );
+        let total = length(&plan.path);
+        let step = 0.5 * costs.geometry().cell_mm;
+        let mut best = (f64::INFINITY, None);
+        let mut s = (s_near + CLOSE_AHEAD_MM).min(total);
+        while s <= (s_near + window_mm).min(total) {
+            let p = point_at(&plan.path, s);
+            let room = costs.room_at(p);
+            if room < best.0 {
+                best = (room, Some(p));
+            }
+            s += step;
+        }
+        let at = best.1.unwrap_or_else(|| point_at(&plan.path, s.min(total)));
         let g = *self.grid.geometry();
         let r = (CLOSE_RADIUS_MM / g.cell_mm).ceil() as i64;
         let Some((cx, cy)) = g.coords_of(at) else {
             return;
         };
-        for (x, y) in disc_cells(cx, cy, r, &g) {
-            let i = y * g.width + x;
-            if (g.centre(i) - at).norm() <= CLOSE_RADIUS_MM {
-                self.penalty[i] = f32::INFINITY;
-            }
+        let cells: Vec<usize> = disc_cells(cx, cy, r, &g)
+            .map(|(x, y)| y * g.width + x)
+            .filter(|&i| (g.centre(i) - at).norm() <= CLOSE_RADIUS_MM)
+            .collect();
+        // Failing a second time where it failed before, the robot gives the place up.
+        let again = g.cell_of(at).is_some_and(|i| self.closed[i] > 0);
+        for i in cells {
+            self.closed[i] = self.closed[i].max(if again { 2 } else { 1 });
         }
-        self.closed_by = Some(why);
+        if again {
+            self.closed_by = Some(why);
+        }
         self.report.closed += 1;
     }
 
@@ -453,16 +482,24 @@ impl Navigator {
         let Some(why) = self.closed_by else {
             return Unreachable::NoRoute;
         };
-        let open: Vec<f32> = self
-            .penalty
-            .iter()
-            .map(|&p| if p.is_infinite() { 0.0 } else { p })
-            .collect();
-        let costs = CostMap::new(&self.grid, &self.costs, &open, here, Suspects::Costly);
+        let costs = CostMap::new(&self.grid, &self.costs, &self.penalty, here, Suspects::Costly);
         match costs.plan(here, target, self.accept_mm) {
             Some(_) => why,
             None => Unreachable::NoRoute,
         }
+    }
+
+    /// The watchdog's penalties with the closed places: dearer once, impassable twice.
+    fn penalties(&self) -> Vec<f32> {
+        self.penalty
+            .iter()
+            .zip(&self.closed)
+            .map(|(&p, &c)| match c {
+                0 => p,
+                1 => p + CLOSED_FACTOR,
+                _ => f32::INFINITY,
+            })
+            .collect()
     }
 
     fn stop(&mut self) -> Option<Vector2<f64>> {
@@ -484,13 +521,8 @@ impl Navigator {
     /// `unreachable_s` of that, marks the goal unreachable).
     fn replan(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
         self.fade_penalty(t_s);
-        let costs = CostMap::new(
-            &self.grid,
-            &self.costs,
-            &self.penalty,
-            here,
-            Suspects::Costly,
-        );
+        let penalties = self.penalties();
+        let costs = CostMap::new(&self.grid, &self.costs, &penalties, here, Suspects::Costly);
         let found = costs.plan(here, target, self.accept_mm);
         self.report.replans += 1;
         let Some((cells, _)) = found else {
@@ -516,7 +548,12 @@ impl Navigator {
         {
             w.best_mm = new_len;
             w.best_t_s = t_s;
-            self.stall = (new_len, t_s);
+            // The stall rule starts again from a longer plan at most once a `stall_s`: a robot
+            // sent back and forth between two routes makes a longer plan every few seconds.
+            if t_s - self.stall_rebased_s >= self.config.stall_s {
+                self.stall = (new_len, t_s);
+                self.stall_rebased_s = t_s;
+            }
         }
         self.report.path_mm = path.clone();
         self.plan = Some(Plan {
