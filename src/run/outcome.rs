@@ -68,8 +68,9 @@ pub struct GoalFigures {
     /// How the run ended.
     pub outcome: GoalOutcome,
     /// With `outcome` unreachable: the planner's reason (`no_route`, `too_narrow`,
-    /// `no_progress`).
-    #[serde(skip_serializing_if = "Option::is_none", default)]
+    /// `no_progress`); `null` otherwise (written, so that it stands beside `outcome` in a
+    /// sweep's table).
+    #[serde(default)]
     pub unreachable_reason: Option<String>,
     /// Whether the robot's disc can roll from its start through its targets on the true world
     /// (computed when the run starts; see [`omniloop_sim::reachability`]).
