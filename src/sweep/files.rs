@@ -2,19 +2,39 @@
 
 use super::plan::Plan;
 use super::plot;
-use super::report::{self, Row};
+use super::report::{self, ReportSettings, Row};
 use super::workers::Outcome;
 use std::path::Path;
 
 /// The report of `outcomes` into `dir`: `sweep.csv`, `sweep.md` (after `header` and the
 /// figure's name) and `sweep.png` of `plot` (success_rate when no run has that number, with a
-/// warning on standard error); the markdown and the rows.
+/// warning on standard error); the markdown and the rows. The report's settings are the
+/// defaults ([`report_with`] takes them).
 pub fn report(
     dir: &Path,
     plan: &Plan,
     outcomes: &[Option<Outcome>],
     plot: &str,
     header: &str,
+) -> anyhow::Result<(String, Vec<Row>)> {
+    report_with(
+        dir,
+        plan,
+        outcomes,
+        plot,
+        header,
+        &ReportSettings::default(),
+    )
+}
+
+/// [`report`] with the report's `settings`.
+pub fn report_with(
+    dir: &Path,
+    plan: &Plan,
+    outcomes: &[Option<Outcome>],
+    plot: &str,
+    header: &str,
+    settings: &ReportSettings,
 ) -> anyhow::Result<(String, Vec<Row>)> {
     let rows = report::rows(plan, outcomes);
     let mut metric = plot.to_string();
@@ -23,18 +43,19 @@ pub fn report(
         metric = "success_rate".into();
     }
     let header = format!("{header} Figure: sweep.png ({metric}).");
-    let md = write_outputs(dir, plan, &rows, &metric, &header)?;
+    let md = write_outputs(dir, plan, &rows, &metric, &header, settings)?;
     Ok((md, rows))
 }
 
-/// Writes `sweep.csv`, `sweep.md` (after `header`) and `sweep.png` of `metric` into `dir`;
-/// returns the markdown.
+/// Writes `sweep.csv`, `sweep.md` (after `header`, as `settings` ask) and `sweep.png` of
+/// `metric` into `dir`; returns the markdown.
 pub fn write_outputs(
     dir: &Path,
     plan: &Plan,
     rows: &[Row],
     metric: &str,
     header: &str,
+    settings: &ReportSettings,
 ) -> anyhow::Result<String> {
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -43,7 +64,7 @@ pub fn write_outputs(
         std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))
     };
     write("sweep.csv", report::csv(plan, rows).as_bytes())?;
-    let md = report::markdown(plan, rows, header);
+    let md = report::markdown(plan, rows, header, settings);
     write("sweep.md", md.as_bytes())?;
     write("sweep.png", &plot::sweep_png(plan, rows, metric)?)?;
     Ok(md)

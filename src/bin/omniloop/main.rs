@@ -186,6 +186,10 @@ enum Command {
         /// Go on with the sweep in OUT: the jobs OUT/rows.jsonl has are not run again.
         #[arg(long)]
         resume: bool,
+        /// sweep.md's outcomes: goals reachable on the true world with at least this margin
+        /// (mm) count for success, the others for honesty (reached or reported unreachable).
+        #[arg(long, value_name = "MM", default_value_t = omniloop::sweep::DEFAULT_REACHABLE_MARGIN_MM, value_parser = margin_mm)]
+        reachable_margin_mm: f64,
     },
     /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate;
     /// with --format, fit a standard camera model to its rays and write that tool's file.
@@ -218,6 +222,14 @@ fn live_addr(addr: &str) -> Result<String, String> {
         ..LiveOptions::default()
     };
     options.host_port().map(|_| options.addr)
+}
+
+/// A margin in mm: a finite number >= 0.
+fn margin_mm(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("`{text}` is not a margin (a number of mm >= 0)")),
+    }
 }
 
 fn camera_format(name: &str) -> Result<CameraFormat, String> {
@@ -595,6 +607,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plan,
             collect,
             resume,
+            reachable_margin_mm,
         } => sweep::command(sweep::Args {
             scenario,
             sets: set,
@@ -608,6 +621,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             plan,
             collect,
             resume,
+            report: omniloop::sweep::ReportSettings {
+                reachable_margin_mm,
+            },
         }),
         Command::Calibrate {
             scenario,

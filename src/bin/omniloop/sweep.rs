@@ -8,8 +8,9 @@ use anyhow::Context;
 use omniloop::RunOptions;
 use omniloop::sweep::journal::ERROR_FILE;
 use omniloop::sweep::{
-    Journal, Outcome, Plan, PlanError, PlanFileError, Record, Seeds, Set, SweepOptions,
-    collect_runs, plan, planned_job, read_plan, run_job, run_remaining, shared_gpu, write_plan,
+    Journal, Outcome, Plan, PlanError, PlanFileError, Record, ReportSettings, Seeds, Set,
+    SweepOptions, collect_runs, plan, planned_job, read_plan, run_job, run_remaining, shared_gpu,
+    write_plan,
 };
 use omniloop::{LoadError, report::default_out_dir};
 use omniloop_sim::RendererChoice;
@@ -34,6 +35,8 @@ pub struct Args {
     pub collect: Option<PathBuf>,
     /// Go on from the sweep folder's rows.jsonl.
     pub resume: bool,
+    /// What sweep.md is asked for (the margin of goals counted for success).
+    pub report: ReportSettings,
 }
 
 /// Set by Ctrl-C: no new runs start.
@@ -76,7 +79,7 @@ fn checked_plan(scenario: &std::path::Path, sets: &[Set], seeds: &Seeds) -> anyh
 /// Runs the sweep, writes its plan, or collects its runs.
 pub fn command(a: Args) -> anyhow::Result<()> {
     if let Some(dir) = &a.collect {
-        return collect(dir, &a.plot);
+        return collect(dir, &a.plot, &a.report);
     }
     let Some(scenario) = &a.scenario else {
         anyhow::bail!("omniloop sweep needs a scenario file (or --collect DIR)");
@@ -172,30 +175,32 @@ fn run_sweep(a: &Args, plan: &Plan, dir: &std::path::Path) -> anyhow::Result<()>
         options.threads,
         ran as f64 / wall_s.max(1e-9),
     );
-    report(dir, plan, &outcomes, &a.plot, &header)?;
+    report(dir, plan, &outcomes, &a.plot, &header, &a.report)?;
     if stopped {
         return Err(Exit(130).into());
     }
     Ok(())
 }
 
-/// `sweep.csv`, `sweep.md` and `sweep.png` of `outcomes` into `dir`; the table printed.
+/// `sweep.csv`, `sweep.md` (as `settings` ask) and `sweep.png` of `outcomes` into `dir`; the
+/// table printed.
 fn report(
     dir: &std::path::Path,
     plan: &Plan,
     outcomes: &[Option<Outcome>],
     plot: &str,
     header: &str,
+    settings: &ReportSettings,
 ) -> anyhow::Result<()> {
-    let (md, _) = omniloop::sweep::write_report(dir, plan, outcomes, plot, header)?;
+    let (md, _) = omniloop::sweep::write_report_with(dir, plan, outcomes, plot, header, settings)?;
     print!("{md}");
     println!("\nwritten to {}", dir.display());
     Ok(())
 }
 
 /// `--collect DIR`: the report of `DIR/plan.jsonl`'s jobs from their folders in `DIR/runs/`,
-/// into DIR (DIR may be the plan file itself, its folder then).
-fn collect(path: &std::path::Path, plot: &str) -> anyhow::Result<()> {
+/// into DIR (DIR may be the plan file itself, its folder then), as `settings` ask.
+fn collect(path: &std::path::Path, plot: &str, settings: &ReportSettings) -> anyhow::Result<()> {
     let (file, dir) = if path.is_file() {
         let dir = path.parent().unwrap_or(std::path::Path::new("."));
         (path.to_path_buf(), dir.to_path_buf())
@@ -216,7 +221,7 @@ fn collect(path: &std::path::Path, plot: &str) -> anyhow::Result<()> {
         plan.jobs.len(),
         dir.join("runs").display()
     );
-    report(dir, &plan, &outcomes, plot, &header)
+    report(dir, &plan, &outcomes, plot, &header, settings)
 }
 
 /// `omniloop run --plan FILE --job N`: the job's run, its outputs into `out` (default
