@@ -80,6 +80,10 @@ const COURSE_MIN_SPEED_MM_S: f64 = 50.0;
 /// nearer the wall, the wider the blocked arc).
 const BLIND_SLANT_RAD: f64 = std::f64::consts::FRAC_PI_6;
 
+/// A blind point nearer than the body's edge by more than this is held at its distance (no
+/// slant), mm: the points placed at the edge this cycle lie at the edge to rounding.
+const BLIND_EDGE_TOLERANCE_MM: f64 = 0.5;
+
 /// An obstacle point and the squared distance every predicted path must keep from it.
 #[derive(Debug, Clone, Copy)]
 struct Obstacle {
@@ -316,12 +320,22 @@ impl VelocityAware {
         let clearance = self.radius_mm + self.config.margin_mm;
         let points = [s.clear_points];
         let mut obstacles = self.reachable(&points, v_now, speed, clearance, true);
-        // A blind point at the body's edge may be passed at a slant; one already nearer than
-        // that allows (a remembered one the robot came nearer to) need only get no nearer.
+        // A blind point at the body's edge (or beyond it) may be passed at a slant; one nearer
+        // than the body's edge (a remembered one the robot came nearer to) need only get no
+        // nearer: the robot has come up to whatever stands there, a cube's face perhaps, and
+        // sliding past it at a slant would close on the face.
         let slant = self.radius_mm * BLIND_SLANT_RAD.cos();
-        obstacles.extend(s.blind_points.iter().map(|&p| Obstacle {
-            p,
-            c2: (clearance * clearance).min(p.norm_squared().min(slant * slant)),
+        obstacles.extend(s.blind_points.iter().map(|&p| {
+            let d2 = p.norm_squared();
+            let hold = if d2 < (self.radius_mm - BLIND_EDGE_TOLERANCE_MM).powi(2) {
+                d2
+            } else {
+                slant * slant
+            };
+            Obstacle {
+                p,
+                c2: (clearance * clearance).min(hold),
+            }
         }));
         let traffic = &self.config.traffic;
         let planes = if traffic.reciprocal() {

@@ -396,6 +396,7 @@ struct PlanRecord {
     remaining_mm: Option<f64>,
     replans: usize,
     watchdog: usize,
+    closed: usize,
     unreachable: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     unreachable_reason: Option<&'static str>,
@@ -414,6 +415,7 @@ impl PlanRecord {
             remaining_mm: n.remaining_mm.map(round_mm),
             replans: n.replans,
             watchdog: n.watchdog,
+            closed: n.closed,
             unreachable: n.unreachable.is_some(),
             unreachable_reason: n.unreachable.map(|u| u.as_str()),
             cells_free: n.cells[0],
