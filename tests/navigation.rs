@@ -141,3 +141,32 @@ fn the_clutter_layout_follows_its_seed_and_the_run_writes_the_plan_and_the_map()
     assert_ne!(a.goal, b.goal);
     assert_eq!(a.world.cubes.len(), 10);
 }
+
+#[test]
+fn the_corner_route_passes_every_corner_and_leaves_the_pocket_by_the_gap_it_came_in_by() {
+    // The waypoint at (1200, 600) lies in the pocket between E2's cube at (1000, 450) and the
+    // field's corner; the way on to (1200, -600) is back down the 305 mm gap beside the cube.
+    // Standing in the gap's mouth with the floor by its body out of the near-field memory, the
+    // robot once stood there for the rest of the run; the map's floor now says how far off the
+    // cube and the wall in its blind zone stand.
+    let out = run_scenario(
+        &scenario("field_corner_route.toml"),
+        &cpu(),
+        |_| {},
+        |_, _| {},
+    )
+    .unwrap();
+    let s = &out.summary;
+    assert!(s.reached_goal, "{s:?}");
+    assert_eq!(s.targets_reached, Some(4), "{s:?}");
+    assert_eq!(s.wall_contacts, 0, "{s:?}");
+    assert!(s.time_to_goal_s.is_some_and(|t| t < 60.0), "{s:?}");
+    // It went through the pocket: within 100 mm of (1200, 600), then below the cube.
+    let near = |x: f64, y: f64| {
+        out.trajectory
+            .iter()
+            .position(|r| (r.x_mm - x).hypot(r.y_mm - y) <= 100.0)
+    };
+    let (pocket, below) = (near(1200.0, 600.0), near(1200.0, -600.0));
+    assert!(pocket.is_some() && below > pocket, "{pocket:?} {below:?}");
+}

@@ -196,11 +196,11 @@ impl RobotSoftware for Robot {
             not_found.push(NotFound {
                 source: "planner",
                 reason: format!(
-                    "unreachable ({}): {} ({:.0}, {:.0}); the robot stopped",
-                    why.as_str(),
+                    "unreachable: {} ({:.0}, {:.0}); the robot stopped ({})",
                     why.explain(),
                     t.x,
-                    t.y
+                    t.y,
+                    why.as_str()
                 ),
             });
         }

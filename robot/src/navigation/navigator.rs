@@ -482,7 +482,13 @@ impl Navigator {
         let Some(why) = self.closed_by else {
             return Unreachable::NoRoute;
         };
-        let costs = CostMap::new(&self.grid, &self.costs, &self.penalty, here, Suspects::Costly);
+        let costs = CostMap::new(
+            &self.grid,
+            &self.costs,
+            &self.penalty,
+            here,
+            Suspects::Costly,
+        );
         match costs.plan(here, target, self.accept_mm) {
             Some(_) => why,
             None => Unreachable::NoRoute,
@@ -883,6 +889,111 @@ mod tests {
         }
         assert_eq!(nav.report().watchdog, 1);
         assert!(nav.penalty.iter().any(|&p| p > 3.0));
+    }
+
+    /// A box with a corridor 400 mm wide from the robot to the goal: the only route.
+    fn corridor_map() -> WorldMap {
+        let mut map = box_map(1500.0);
+        for y in [-200.0, 200.0] {
+            map.bounds.push(MapSegment {
+                from_mm: Point2::new(-1300.0, y),
+                to_mm: Point2::new(1300.0, y),
+                half_thickness_mm: 25.0,
+            });
+        }
+        map
+    }
+
+    #[test]
+    fn a_robot_that_makes_no_progress_closes_the_place_ahead_and_twice_there_gives_the_goal_up() {
+        let cfg = robot(corridor_map(), [1000.0, 0.0]);
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let goal = Point2::new(1000.0, 0.0);
+        let mut t = 0.0;
+        // The robot stands where it is, whatever it is told (held up by what it cannot pass).
+        while t < 10.5 {
+            nav.steer(Some(&open_floor()), &cfg.start, Vector2::zeros(), goal, t);
+            t += 0.04;
+        }
+        assert_eq!(nav.report().closed, 1, "closed once after stall_s (10 s)");
+        assert!(nav.closed.contains(&1) && !nav.closed.contains(&2));
+        assert!(
+            nav.report().unreachable.is_none(),
+            "the only route is dearer, not shut"
+        );
+        while t < 25.0 {
+            nav.steer(Some(&open_floor()), &cfg.start, Vector2::zeros(), goal, t);
+            t += 0.04;
+        }
+        assert_eq!(nav.report().closed, 2);
+        assert!(nav.closed.contains(&2), "failed there again: impassable");
+        assert_eq!(nav.report().unreachable, Some(Unreachable::NoProgress));
+        // A new target opens every place again.
+        let other = Point2::new(-1300.0, 0.0);
+        nav.steer(Some(&open_floor()), &cfg.start, Vector2::zeros(), other, t);
+        assert!(nav.closed.iter().all(|&c| c == 0));
+        assert!(nav.report().unreachable.is_none());
+    }
+
+    #[test]
+    fn a_step_the_controller_refuses_for_refuse_s_closes_the_gap_ahead_to_the_planner() {
+        let cfg = robot(corridor_map(), [1000.0, 0.0]);
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let goal = Point2::new(1000.0, 0.0);
+        let mut t = 0.0;
+        let mut step = |nav: &mut Navigator, t: f64, command: Vector2<f64>| {
+            nav.steer(Some(&open_floor()), &cfg.start, Vector2::zeros(), goal, t);
+            nav.heard(command, Vector2::zeros(), &cfg.start, t);
+        };
+        // Heading on toward the plan's point: no refusal, however long.
+        while t < 3.9 {
+            step(&mut nav, t, Vector2::new(200.0, 0.0));
+            t += 0.04;
+        }
+        assert_eq!(nav.report().closed, 0);
+        // Sideways only, standing: the controller refuses the plan's step.
+        let from = t;
+        while t < from + 3.9 {
+            step(&mut nav, t, Vector2::new(0.0, 100.0));
+            t += 0.04;
+        }
+        assert_eq!(nav.report().closed, 0, "not before refuse_s (4 s)");
+        step(&mut nav, t + 0.2, Vector2::new(0.0, 100.0));
+        assert_eq!(nav.report().closed, 1);
+        assert!(nav.closed.contains(&1));
+    }
+
+    #[test]
+    fn the_map_says_how_far_the_floor_is_free_along_a_ray() {
+        let cfg = robot(box_map(1500.0), [1000.0, 0.0]);
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let u = Vector2::new(1.0, 0.0);
+        // Nothing seen yet: no floor known beyond the body's edge.
+        assert_eq!(nav.free_along(&cfg.start, u, 90.0, 200.0), 90.0);
+        for k in 0..10 {
+            nav.steer(
+                Some(&open_floor()),
+                &cfg.start,
+                Vector2::zeros(),
+                Point2::new(1000.0, 0.0),
+                k as f64 * 0.04,
+            );
+        }
+        // Open floor seen from here and there: free out to the template's inner edge. (The
+        // floor under the body is never seen: seen from where the robot stands, the map holds
+        // only what lies beyond the inner edge.)
+        let d = nav.free_along(
+            &(cfg.start * Isometry2::translation(-300.0, 0.0)),
+            u,
+            90.0,
+            200.0,
+        );
+        assert!((d - 200.0).abs() < 1e-9, "{d}");
+        // Toward the box's wall (its face at x = -1475), from 175 mm off it: the walk ends in
+        // the last free cell, half a cell's diagonal short of the first not free.
+        let by_wall = Isometry2::new(Vector2::new(-1300.0, 0.0), 0.0);
+        let d = nav.free_along(&by_wall, -u, 90.0, 400.0);
+        assert!(d > 120.0 && d < 175.0, "{d}");
     }
 
     #[test]
