@@ -435,7 +435,8 @@ impl Navigator {
     /// Closes to the planner, until the target changes, the disc of `CLOSE_RADIUS_MM` round
     /// the narrowest place of the plan within `window_mm` ahead of the robot (at least
     /// `CLOSE_AHEAD_MM` ahead): the gap the robot fails to pass, not the floor where it stands
-    /// (which may be where two routes part). Closed once, the place is dearer by
+    /// (which may be where two routes part); or, when the plan passes a place closed once
+    /// within that reach, that place (the robot failed again on the way through it). Closed once, the place is dearer by
     /// `CLOSED_FACTOR` (every other way is tried first); failed there again, it is impassable,
     /// and with no route left the goal is reported unreachable for `why`. Drops the plan.
     fn close_ahead(&mut self, here: Point2<f64>, window_mm: f64, why: Unreachable) {
@@ -445,10 +446,18 @@ impl Navigator {
         let (_, s_near) = distance_to_path(&plan.path, here);
         let total = length(&plan.path);
         let step = 0.5 * costs.geometry().cell_mm;
+        let g = *self.grid.geometry();
+        let closed_once = |p: Point2<f64>| g.cell_of(p).is_some_and(|i| self.closed[i] > 0);
+        // The narrowest place ahead; but a place on the way closed once already is where the
+        // robot failed again.
         let mut best = (f64::INFINITY, None);
         let mut s = (s_near + CLOSE_AHEAD_MM).min(total);
         while s <= (s_near + window_mm).min(total) {
             let p = point_at(&plan.path, s);
+            if closed_once(p) {
+                best = (f64::NEG_INFINITY, Some(p));
+                break;
+            }
             let room = costs.room_at(p);
             if room < best.0 {
                 best = (room, Some(p));
@@ -456,7 +465,6 @@ impl Navigator {
             s += step;
         }
         let at = best.1.unwrap_or_else(|| point_at(&plan.path, s.min(total)));
-        let g = *self.grid.geometry();
         let r = (CLOSE_RADIUS_MM / g.cell_mm).ceil() as i64;
         let Some((cx, cy)) = g.coords_of(at) else {
             return;
@@ -527,7 +535,11 @@ impl Navigator {
     /// `unreachable_s` of that, marks the goal unreachable).
     fn replan(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
         self.fade_penalty(t_s);
-        let penalties = self.penalties();
+        let penalties = if self.closed_by.is_some() || self.report.closed > 0 {
+            std::borrow::Cow::Owned(self.penalties())
+        } else {
+            std::borrow::Cow::Borrowed(&self.penalty[..])
+        };
         let costs = CostMap::new(&self.grid, &self.costs, &penalties, here, Suspects::Costly);
         let found = costs.plan(here, target, self.accept_mm);
         self.report.replans += 1;

@@ -65,8 +65,10 @@ pub struct CostSettings {
 pub struct CostMap {
     geometry: GridGeometry,
     factor: Vec<Option<f32>>,
-    /// Each cell's distance to the nearest blocked or suspect cell, mm.
-    room_mm: Vec<f32>,
+    /// Each cell's distance to the nearest blocked cell and to the nearest suspect cell, mm
+    /// (`None`: there is none).
+    blocked_mm: Option<Vec<f32>>,
+    suspect_mm: Option<Vec<f32>>,
 }
 
 impl CostMap {
@@ -87,9 +89,6 @@ impl CostMap {
         let comfort = settings.comfort_mm.max(1e-6) as f32;
         let escape2 =
             ((settings.inflated_mm + g.cell_mm) * (settings.inflated_mm + g.cell_mm)) as f32;
-        let room_mm = (0..g.len())
-            .map(|i| at(&blocked, i).min(at(&suspect, i)))
-            .collect();
         let factor = (0..g.len())
             .map(|i| {
                 let mut d = at(&blocked, i);
@@ -121,16 +120,18 @@ impl CostMap {
         Self {
             geometry: g,
             factor,
-            room_mm,
+            blocked_mm: blocked,
+            suspect_mm: suspect,
         }
     }
 
     /// The distance from the cell holding `p` to the nearest blocked or suspect cell, mm
     /// (infinite outside the grid or where none is).
     pub fn room_at(&self, p: Point2<f64>) -> f64 {
-        self.geometry
-            .cell_of(p)
-            .map_or(f64::INFINITY, |i| f64::from(self.room_mm[i]))
+        let at = |v: &Option<Vec<f32>>, i: usize| v.as_ref().map_or(f32::INFINITY, |v| v[i]);
+        self.geometry.cell_of(p).map_or(f64::INFINITY, |i| {
+            f64::from(at(&self.blocked_mm, i).min(at(&self.suspect_mm, i)))
+        })
     }
 
     /// Where the grid lies.
