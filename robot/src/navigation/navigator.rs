@@ -54,16 +54,26 @@ const REBASE_MM: f64 = 500.0;
 const PENALTY: f32 = 4.0;
 /// The watchdog's penalty: the radius of the region made dearer, mm.
 const PENALTY_RADIUS_MM: f64 = 200.0;
+/// A replan keeps the plan being followed while it costs no more than this many times the
+/// new one.
+const KEEP_PLAN: f64 = 1.15;
 /// A closed place: the centre of the disc closed lies this far ahead on the plan, mm.
 const CLOSE_AHEAD_MM: f64 = 150.0;
 /// A closed place: the radius of the disc closed, mm.
 const CLOSE_RADIUS_MM: f64 = 100.0;
+/// A place this far or farther from the nearest blocked or suspect cell is open floor: closed
+/// once at most, never given up (a gap of about twice this, 320 mm, which the controller
+/// drives through at any speed), mm.
+const OPEN_ROOM_MM: f64 = 160.0;
 /// A place closed once: the added cost factor (crossing it costs as much as 2 m of floor
 /// round it, so the robot tries every other way first).
 const CLOSED_FACTOR: f32 = 20.0;
 /// The controller refuses the plan's step while its command makes less headway than this
 /// toward the lookahead point, the robot standing, mm/s.
 const REFUSE_MM_S: f64 = 30.0;
+/// Turns are taken at no more than the speed whose turning circle is this wide, mm (400 mm/s
+/// at 300 mm/s^2, with room to spare: a 400 mm/s robot turns as before).
+const TURN_RADIUS_MM: f64 = 540.0;
 /// The least fraction of the top speed a turn is taken at.
 const MIN_TURN_SPEED: f64 = 0.2;
 /// A vertex turning the plan by more than this is a bend to slow for, rad.
@@ -455,7 +465,7 @@ impl Navigator {
         while s <= (s_near + window_mm).min(total) {
             let p = point_at(&plan.path, s);
             if closed_once(p) {
-                best = (f64::NEG_INFINITY, Some(p));
+                best = (costs.room_at(p), Some(p));
                 break;
             }
             let room = costs.room_at(p);
@@ -473,8 +483,10 @@ impl Navigator {
             .map(|(x, y)| y * g.width + x)
             .filter(|&i| (g.centre(i) - at).norm() <= CLOSE_RADIUS_MM)
             .collect();
-        // Failing a second time where it failed before, the robot gives the place up.
-        let again = g.cell_of(at).is_some_and(|i| self.closed[i] > 0);
+        // Failing a second time where it failed before, the robot gives the place up; but not
+        // open floor, where what held it up was not the room to pass.
+        let narrow = best.0 < OPEN_ROOM_MM;
+        let again = narrow && g.cell_of(at).is_some_and(|i| self.closed[i] > 0);
         for i in cells {
             self.closed[i] = self.closed[i].max(if again { 2 } else { 1 });
         }
@@ -559,7 +571,10 @@ impl Navigator {
             self.cost_map = Some(costs);
             return false;
         }
-        let path = costs.taut(here, &cells, target);
+        let mut path = costs.taut(here, &cells, target);
+        if let Some(kept) = self.kept_plan(&costs, &path, here) {
+            path = kept;
+        }
         let new_len = length(&path);
         if let (Some(w), Some(old)) = (&mut self.watchdog, self.report.remaining_mm)
             && new_len > old + REBASE_MM
@@ -580,6 +595,32 @@ impl Navigator {
         });
         self.cost_map = Some(costs);
         true
+    }
+
+    /// The rest of the plan being followed, from `here`, when it is still passable on `costs`
+    /// and costs no more than `KEEP_PLAN` times the new plan `fresh`: a new plan that is only a
+    /// little cheaper does not turn the robot round (at 600 mm/s and 300 mm/s^2 a robot turns
+    /// on a circle of 1.2 m; flipping between two routes of about the same cost every few
+    /// replans sent fast robots round in loops).
+    fn kept_plan(
+        &self,
+        costs: &CostMap,
+        fresh: &[Point2<f64>],
+        here: Point2<f64>,
+    ) -> Option<Vec<Point2<f64>>> {
+        let old = &self.plan.as_ref()?.path;
+        let (_, s_near) = distance_to_path(old, here);
+        let mut rest = vec![here, point_at(old, s_near)];
+        let mut at = 0.0;
+        for w in old.windows(2) {
+            at += (w[1] - w[0]).norm();
+            if at > s_near {
+                rest.push(w[1]);
+            }
+        }
+        let kept = costs.path_cost(&rest)?;
+        let new = costs.path_cost(fresh)?;
+        (kept <= KEEP_PLAN * new).then_some(rest)
     }
 
     /// Counts the time the map with every far mark taken as right has no route from `here` to
@@ -645,13 +686,18 @@ impl Navigator {
         Some(pose.inverse_transform_vector(&(v.normalize() * reach)))
     }
 
-    /// The distance in which the robot brakes from the top speed to the speed it takes a turn
-    /// by `theta` at (infinite for a gentle turn).
+    /// The distance in which the robot brakes to the speed it takes a turn by `theta` at
+    /// (infinite for a gentle turn): `v_c = v_t max(cos theta, MIN_TURN_SPEED)`, with `v_t`
+    /// the top speed, or, for a faster robot, the speed whose turning circle `v^2 / alpha` is
+    /// `TURN_RADIUS_MM` (400 mm/s at 300 mm/s^2): the turn speed scaled by a top speed of
+    /// 2000 mm/s (400 mm/s for a right angle, a 533 mm circle) swung robots round every bend
+    /// of their plan in loops a metre across.
     fn braking_mm(&self, theta: f64) -> f64 {
         if theta <= BEND_RAD {
             return f64::INFINITY;
         }
-        let v = self.max_speed_mm_s * theta.cos().max(MIN_TURN_SPEED);
+        let turning = (self.accel_mm_s2 * TURN_RADIUS_MM).sqrt();
+        let v = self.max_speed_mm_s.min(turning) * theta.cos().max(MIN_TURN_SPEED);
         v * v / (2.0 * self.accel_mm_s2)
     }
 
@@ -953,7 +999,7 @@ mod tests {
         let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
         let goal = Point2::new(1000.0, 0.0);
         let mut t = 0.0;
-        let mut step = |nav: &mut Navigator, t: f64, command: Vector2<f64>| {
+        let step = |nav: &mut Navigator, t: f64, command: Vector2<f64>| {
             nav.steer(Some(&open_floor()), &cfg.start, Vector2::zeros(), goal, t);
             nav.heard(command, Vector2::zeros(), &cfg.start, t);
         };
