@@ -23,6 +23,11 @@
 //!   `PENALTY`, which fades like the grid's
 //!   evidence, and replans: a place where the robot keeps failing becomes dearer than
 //!   another way round.
+//! - Places closed (ours): the controller refusing the plan's step for `refuse_s`, or no
+//!   progress for `stall_s`, closes the plan's narrowest place ahead (or a place on the way
+//!   closed once before): dearer the first time, impassable the second (unless 160 mm of room
+//!   or more), until the target changes; with no route left the goal is reported unreachable
+//!   (`too_narrow`, `no_progress`).
 //! - Unreachable: while no route through free, unknown or suspect cells reaches the goal, the
 //!   controller heads straight for it (it still keeps every command inside the surely free
 //!   space), so that the robot looks nearer, where the map is finer; when no route has been
@@ -54,9 +59,6 @@ const REBASE_MM: f64 = 500.0;
 const PENALTY: f32 = 4.0;
 /// The watchdog's penalty: the radius of the region made dearer, mm.
 const PENALTY_RADIUS_MM: f64 = 200.0;
-/// A replan keeps the plan being followed while it costs no more than this many times the
-/// new one.
-const KEEP_PLAN: f64 = 1.15;
 /// A closed place: the centre of the disc closed lies this far ahead on the plan, mm.
 const CLOSE_AHEAD_MM: f64 = 150.0;
 /// A closed place: the radius of the disc closed, mm.
@@ -571,10 +573,7 @@ impl Navigator {
             self.cost_map = Some(costs);
             return false;
         }
-        let mut path = costs.taut(here, &cells, target);
-        if let Some(kept) = self.kept_plan(&costs, &path, here) {
-            path = kept;
-        }
+        let path = costs.taut(here, &cells, target);
         let new_len = length(&path);
         if let (Some(w), Some(old)) = (&mut self.watchdog, self.report.remaining_mm)
             && new_len > old + REBASE_MM
@@ -595,32 +594,6 @@ impl Navigator {
         });
         self.cost_map = Some(costs);
         true
-    }
-
-    /// The rest of the plan being followed, from `here`, when it is still passable on `costs`
-    /// and costs no more than `KEEP_PLAN` times the new plan `fresh`: a new plan that is only a
-    /// little cheaper does not turn the robot round (at 600 mm/s and 300 mm/s^2 a robot turns
-    /// on a circle of 1.2 m; flipping between two routes of about the same cost every few
-    /// replans sent fast robots round in loops).
-    fn kept_plan(
-        &self,
-        costs: &CostMap,
-        fresh: &[Point2<f64>],
-        here: Point2<f64>,
-    ) -> Option<Vec<Point2<f64>>> {
-        let old = &self.plan.as_ref()?.path;
-        let (_, s_near) = distance_to_path(old, here);
-        let mut rest = vec![here, point_at(old, s_near)];
-        let mut at = 0.0;
-        for w in old.windows(2) {
-            at += (w[1] - w[0]).norm();
-            if at > s_near {
-                rest.push(w[1]);
-            }
-        }
-        let kept = costs.path_cost(&rest)?;
-        let new = costs.path_cost(fresh)?;
-        (kept <= KEEP_PLAN * new).then_some(rest)
     }
 
     /// Counts the time the map with every far mark taken as right has no route from `here` to

@@ -254,23 +254,6 @@ impl CostMap {
         Some((cells, cost as f64 / UNITS_PER_MM))
     }
 
-    /// The cost of following the polyline `path` on this map, mm-equivalents: its length
-    /// weighed by the factors of the cells it crosses (sampled every half cell); `None` where
-    /// it crosses an impassable cell.
-    pub fn path_cost(&self, path: &[Point2<f64>]) -> Option<f64> {
-        let step = 0.5 * self.geometry.cell_mm;
-        let mut total = 0.0;
-        for w in path.windows(2) {
-            let len = (w[1] - w[0]).norm();
-            let n = (len / step).ceil().max(1.0) as usize;
-            for k in 0..n {
-                let p = w[0] + (w[1] - w[0]) * ((k as f64 + 0.5) / n as f64);
-                total += f64::from(self.factor_at(p)?) * len / n as f64;
-            }
-        }
-        Some(total)
-    }
-
     /// The path through `cells` pulled taut: from `from`, each vertex the farthest later cell
     /// centre the straight line reaches over passable cells, ending at `to` when the last cell
     /// sees it.
