@@ -563,31 +563,28 @@ mod tests {
         (p - (a + ab * t)).norm()
     }
 
-    #[test]
-    fn at_2000_mm_s_no_command_takes_the_body_where_it_cannot_stop_short_of_what_it_saw() {
-        // A 3 m x 2 m room with four square pillars, seen as vision would report it: 32
-        // directions up to 1000 mm, each with three rays (centre and sector edges) whose surely
-        // free distance is the least of the three. The robot (top speed 2000 mm/s, alpha 300
-        // mm/s^2: 6.7 m to stop from the top speed, more than the room) is sent round its
-        // corners; at no cycle may its braking path from the speed it has run past what it
-        // saw, and it must never come nearer a wall than the body's radius plus most of the
-        // margin.
-        let mut walls: Vec<(Vec2, Vec2)> = Vec::new();
-        let square = |c: Vec2, h: f64| {
-            let k = [(-h, -h), (h, -h), (h, h), (-h, h)];
-            (0..4)
-                .map(|i| {
-                    let (a, b) = (k[i], k[(i + 1) % 4]);
-                    (c + Vec2::new(a.0, a.1), c + Vec2::new(b.0, b.1))
-                })
-                .collect::<Vec<_>>()
-        };
-        walls.extend(square(Vec2::zeros(), 1500.0).into_iter().map(|(a, b)| {
-            (
-                Vec2::new(a.x, a.y * 2.0 / 3.0),
-                Vec2::new(b.x, b.y * 2.0 / 3.0),
-            )
-        }));
+    /// The four sides of a square of half-side `h` round `c`.
+    fn square(c: Vec2, h: f64) -> Vec<(Vec2, Vec2)> {
+        let k = [(-h, -h), (h, -h), (h, h), (-h, h)];
+        (0..4)
+            .map(|i| {
+                let (a, b) = (k[i], k[(i + 1) % 4]);
+                (c + Vec2::new(a.0, a.1), c + Vec2::new(b.0, b.1))
+            })
+            .collect()
+    }
+
+    /// A 3 m x 2 m room with four square pillars 130 mm across.
+    fn room_with_pillars() -> Vec<(Vec2, Vec2)> {
+        let mut walls: Vec<(Vec2, Vec2)> = square(Vec2::zeros(), 1500.0)
+            .into_iter()
+            .map(|(a, b)| {
+                (
+                    Vec2::new(a.x, a.y * 2.0 / 3.0),
+                    Vec2::new(b.x, b.y * 2.0 / 3.0),
+                )
+            })
+            .collect();
         for c in [
             (-600.0, 400.0),
             (600.0, -400.0),
@@ -596,6 +593,43 @@ mod tests {
         ] {
             walls.extend(square(Vec2::new(c.0, c.1), 65.0));
         }
+        walls
+    }
+
+    /// `walls` seen from `p` as vision would report them: 32 directions up to 1000 mm, each
+    /// with three rays (centre and sector edges) whose surely free distance is the least of
+    /// the three.
+    fn seen_from(p: Vec2, walls: &[(Vec2, Vec2)]) -> Seen {
+        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
+        let half = 0.5 * TAU / 32.0;
+        let mut seen = Seen {
+            dirs: dirs.clone(),
+            free: Vec::new(),
+            obstacles: Vec::new(),
+            clear: Vec::new(),
+        };
+        for &a in &dirs {
+            let rays = [a - half, a, a + half].map(|r| Vec2::new(r.cos(), r.sin()));
+            let d = rays
+                .iter()
+                .map(|u| cast(p, *u, walls))
+                .fold(f64::INFINITY, f64::min);
+            seen.free.push(d.min(1000.0));
+            if d < 1000.0 {
+                seen.obstacles.push(rays[1] * d);
+            }
+            seen.clear.extend(rays.iter().map(|u| u * d.min(1000.0)));
+        }
+        seen
+    }
+
+    #[test]
+    fn at_2000_mm_s_no_command_takes_the_body_where_it_cannot_stop_short_of_what_it_saw() {
+        // The robot (top speed 2000 mm/s, alpha 300 mm/s^2: 6.7 m to stop from the top speed,
+        // more than the room) is sent round the room's corners; at no cycle may its braking
+        // path from the speed it has run past what it saw, and it must never come nearer a
+        // wall than the body's radius plus most of the margin.
+        let walls = room_with_pillars();
         let c = controller(SpeedChoice::Chosen, false, 2000.0);
         let goals = [
             (1250.0, 750.0),
@@ -605,8 +639,6 @@ mod tests {
         ];
         let (mut p, mut v) = (Vec2::new(-1250.0, 0.0), Vec2::zeros());
         let (mut nearest, mut fastest, mut reached) = (f64::INFINITY, 0.0_f64, 0);
-        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
-        let half = 0.5 * TAU / 32.0;
         for _ in 0..1500 {
             let goal = goals[reached % goals.len()];
             let goal = Vec2::new(goal.0, goal.1);
@@ -614,25 +646,7 @@ mod tests {
                 reached += 1;
                 continue;
             }
-            let mut seen = Seen {
-                dirs: dirs.clone(),
-                free: Vec::new(),
-                obstacles: Vec::new(),
-                clear: Vec::new(),
-            };
-            for &a in &dirs {
-                let rays = [a - half, a, a + half].map(|r| Vec2::new(r.cos(), r.sin()));
-                let d = rays
-                    .iter()
-                    .map(|u| cast(p, *u, &walls))
-                    .fold(f64::INFINITY, f64::min);
-                seen.free.push(d.min(1000.0));
-                if d < 1000.0 {
-                    seen.obstacles.push(rays[1] * d);
-                }
-                seen.clear.extend(rays.iter().map(|u| u * d.min(1000.0)));
-            }
-            // Braking from here, along the velocity, stays inside what was seen this cycle.
+            // Braking from here, along the velocity, stays inside what is seen this cycle.
             let speed = v.norm();
             if speed > 1.0 {
                 let along = cast(p, v / speed, &walls).min(1000.0);
@@ -642,16 +656,15 @@ mod tests {
                     "{speed} mm/s needs {stop} mm, {along} mm seen"
                 );
             }
+            let seen = seen_from(p, &walls);
             let cmd = c.decide(&surroundings(&seen), goal - p, v).v_mm_s;
             for _ in 0..40 {
                 let v1 = drive().step(v, cmd, 0.001);
                 p += (v + v1) * 0.0005;
                 v = v1;
                 fastest = fastest.max(v.norm());
-                nearest = walls
-                    .iter()
-                    .map(|w| to_segment(p, *w))
-                    .fold(nearest, f64::min);
+                let d = walls.iter().map(|w| to_segment(p, *w));
+                nearest = d.fold(nearest, f64::min);
             }
         }
         assert!(nearest >= 90.0 + 20.0, "came within {nearest} mm of a wall");
