@@ -922,10 +922,11 @@ mod tests {
         assert!(nav.penalty.iter().any(|&p| p > 3.0));
     }
 
-    /// A box with a corridor 400 mm wide from the robot to the goal: the only route.
+    /// A box with a corridor 300 mm wide between the walls' faces from the robot to the goal:
+    /// the only route, and a narrow one (under `OPEN_ROOM_MM` from the walls).
     fn corridor_map() -> WorldMap {
         let mut map = box_map(1500.0);
-        for y in [-200.0, 200.0] {
+        for y in [-175.0, 175.0] {
             map.bounds.push(MapSegment {
                 from_mm: Point2::new(-1300.0, y),
                 to_mm: Point2::new(1300.0, y),
