@@ -5,7 +5,7 @@ use crate::boundary::{Observation, OdometryReading, Outputs, RobotSoftware};
 use crate::config::{ODOMETRY, RobotConfig};
 use crate::controller::{Controller, Situation};
 use crate::controllers;
-use crate::estimates::{Estimates, Fix};
+use crate::estimates::{Estimates, Fix, NotFound};
 use crate::estimator::PoseEstimator;
 use crate::mission::Mission;
 use crate::perception::{self, Belief, Percepts, Stage, StageEntry};
@@ -193,7 +193,16 @@ impl RobotSoftware for Robot {
         if let (Some(n), Some(t)) = (&navigation, target_mm)
             && let Some(why) = n.unreachable
         {
-            not_found.push(why.not_found(t));
+            not_found.push(NotFound {
+                source: "planner",
+                reason: format!(
+                    "unreachable: {} ({:.0}, {:.0}); the robot stopped ({})",
+                    why.explain(),
+                    t.x,
+                    t.y,
+                    why.as_str()
+                ),
+            });
         }
         Ok(Outputs {
             command,

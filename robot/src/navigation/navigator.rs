@@ -48,7 +48,6 @@ use super::grid::{CellState, GridGeometry, MAX_CELLS, MapSnapshot, OccupancyGrid
 use super::planner::{CostMap, CostSettings, Suspects, length};
 use crate::RobotError;
 use crate::config::RobotConfig;
-use crate::estimates::NotFound;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_vision::FreeSpace;
 
@@ -139,20 +138,6 @@ impl Unreachable {
             Self::NoRoute => "no route through free or unknown cells reaches it",
             Self::TooNarrow => "every route to it passes a gap narrower than the robot can drive",
             Self::NoProgress => "no progress toward it on any route",
-        }
-    }
-
-    /// The planner's entry in the estimates record's `not_found` for the target `t` (world mm).
-    pub fn not_found(self, t: Point2<f64>) -> NotFound {
-        NotFound {
-            source: "planner",
-            reason: format!(
-                "unreachable: {} ({:.0}, {:.0}); the robot stopped ({})",
-                self.explain(),
-                t.x,
-                t.y,
-                self.as_str()
-            ),
         }
     }
 }
