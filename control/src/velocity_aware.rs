@@ -14,7 +14,9 @@
 //!   it has seen to be free; an obstacle already within the clearance need only get no nearer,
 //!   and a blind point (something at an unknown distance inside the body's blind zone, placed
 //!   at the body's edge) may be passed at a slant of up to 30 degrees, never headed into: the
-//!   path keeps `r cos 30°` from it, or, nearer than that already, gets no nearer.
+//!   path keeps `r cos 30°` from it, or, nearer than that already, gets no nearer; one moved
+//!   out beyond the edge (where the robot's map says the obstacle begins) is kept `d cos 30°`
+//!   from, never less than the body's radius.
 //!   And the next decision comes one control period later, so the path that holds `v_b`
 //!   for that period and then brakes must be clear too: whatever the next cycle sees, braking
 //!   stays safe. In each direction the fastest admissible of `speeds` speeds is found (by
@@ -139,8 +141,9 @@ impl VelocityAware {
             && (!period_brake || self.phases_clear(v_now, v_b, self.period_s, keep))
     }
 
-    /// Toward `v_b` for `t1`, then toward rest until stopped (plus `extra_horizon_s`).
-    fn phases_clear(&self, v_now: Vec2, v_b: Vec2, t1: f64, keep: &Keep) -> bool {
+    /// The path toward `v_b` for `t1`, then toward rest until stopped (plus
+    /// `extra_horizon_s`), sampled every `prediction_step_s` (robot frame, from the origin).
+    fn phases(&self, v_now: Vec2, v_b: Vec2, t1: f64) -> Vec<Vec2> {
         let alpha = self.drive.accel_limit_mm_s2();
         let p1 = self.drive.displacement(v_now, v_b, t1);
         let v1 = self.drive.velocity_at(v_now, v_b, t1);
@@ -155,9 +158,14 @@ impl VelocityAware {
                 p1 + self.drive.displacement(v1, Vec2::zeros(), t - t1)
             }
         };
-        let path: Vec<Vec2> = (0..=steps)
+        (0..=steps)
             .map(|k| at((k as f64 * dt).min(horizon)))
-            .collect();
+            .collect()
+    }
+
+    /// Whether the path toward `v_b` for `t1`, then to rest, keeps clear of `keep`.
+    fn phases_clear(&self, v_now: Vec2, v_b: Vec2, t1: f64, keep: &Keep) -> bool {
+        let path = self.phases(v_now, v_b, t1);
         // A half-plane is convex: the samples in it, the segments between them are too. One
         // whose offset is at least the path's reach from the robot holds every sample
         // (`p . n <= |p|`): only the nearer ones are checked point by point.
@@ -320,22 +328,14 @@ impl VelocityAware {
         let clearance = self.radius_mm + self.config.margin_mm;
         let points = [s.clear_points];
         let mut obstacles = self.reachable(&points, v_now, speed, clearance, true);
-        // A blind point at the body's edge (or beyond it) may be passed at a slant; one nearer
-        // than the body's edge (a remembered one the robot came nearer to) need only get no
-        // nearer: the robot has come up to whatever stands there, a cube's face perhaps, and
-        // sliding past it at a slant would close on the face.
-        let slant = self.radius_mm * BLIND_SLANT_RAD.cos();
-        obstacles.extend(s.blind_points.iter().map(|&p| {
-            let d2 = p.norm_squared();
-            let hold = if d2 < (self.radius_mm - BLIND_EDGE_TOLERANCE_MM).powi(2) {
-                d2
-            } else {
-                slant * slant
-            };
-            Obstacle {
-                p,
-                c2: (clearance * clearance).min(hold),
-            }
+        // A blind point at the body's edge may be passed at a slant; one nearer than the edge
+        // (a remembered one the robot came nearer to) need only get no nearer: the robot has
+        // come up to whatever stands there, a cube's face perhaps, and sliding past it at a
+        // slant would close on the face; one beyond the edge is never passed nearer than the
+        // edge (see `blind_keep_mm`).
+        obstacles.extend(s.blind_points.iter().map(|&p| Obstacle {
+            p,
+            c2: self.blind_keep_mm(p.norm(), clearance).powi(2),
         }));
         let traffic = &self.config.traffic;
         let planes = if traffic.reciprocal() {
@@ -379,6 +379,26 @@ impl VelocityAware {
         };
         self.best_heading(&near, scored_rad, speed, v_now, score)
             .unwrap_or(STOP)
+    }
+
+    /// How far every path keeps from a blind point `d_mm` from the robot's centre, mm. At the
+    /// body's edge (placed there for want of knowing better: whatever stands there may be
+    /// anywhere out to the blind zone's edge), `r cos 30°`: it may be passed at a slant. Nearer
+    /// than the edge (a remembered point the robot came nearer to), `d_mm`: no nearer. Beyond
+    /// the edge (moved out to where the robot's map says the floor seen free ends, or
+    /// remembered where the robot's edge once was: the obstacle begins right behind it), the
+    /// slant's `d_mm cos 30°`, but never less than the body's edge: passed at `r cos 30°`,
+    /// such a point let the body graze a cube's corner. Never more than `clearance`.
+    fn blind_keep_mm(&self, d_mm: f64, clearance: f64) -> f64 {
+        let r = self.radius_mm;
+        let keep = if d_mm < r - BLIND_EDGE_TOLERANCE_MM {
+            d_mm
+        } else if d_mm <= r + BLIND_EDGE_TOLERANCE_MM {
+            r * BLIND_SLANT_RAD.cos()
+        } else {
+            (d_mm * BLIND_SLANT_RAD.cos()).max(r + BLIND_EDGE_TOLERANCE_MM)
+        };
+        keep.min(clearance)
     }
 
     /// The admissible heading and speed with the best score, headings nearest the goal first.
@@ -793,6 +813,46 @@ mod tests {
         let v = c.decide(&s, goal, Vec2::zeros()).v_mm_s;
         assert!(v.norm() > 1.0, "stood still");
         assert!(v.dot(&p) <= 1e-9, "{v:?} approaches the blind point");
+    }
+
+    #[test]
+    fn a_blind_point_beyond_the_body_edge_is_never_passed_nearer_than_the_edge() {
+        let c = controller(SpeedChoice::Chosen, false, 400.0);
+        let slant = 30f64.to_radians().cos();
+        // At the edge: the slant; nearer: no nearer; beyond: the slant, but not inside the edge.
+        assert!((c.blind_keep_mm(90.0, 120.0) - 90.0 * slant).abs() < 1e-9);
+        assert!((c.blind_keep_mm(80.0, 120.0) - 80.0).abs() < 1e-9);
+        assert!((c.blind_keep_mm(95.0, 120.0) - 90.5).abs() < 1e-9);
+        assert!((c.blind_keep_mm(130.0, 120.0) - 130.0 * slant).abs() < 1e-9);
+        assert!((c.blind_keep_mm(200.0, 120.0) - 120.0).abs() < 1e-9);
+        // A point the map moved out to 100 mm, the goal beyond it at a slant of 20 degrees:
+        // the command's path (toward it, then braking to rest) keeps the body off the point.
+        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
+        let free = vec![1000.0; 32];
+        let clear: Vec<Vec2> = dirs
+            .iter()
+            .map(|a| Vec2::new(a.cos(), a.sin()) * 1000.0)
+            .collect();
+        let p = Vec2::new(100.0, 0.0);
+        let blind = [p];
+        let s = unobstructed(&dirs, &free, &clear, &blind);
+        let goal = Vec2::new(20f64.to_radians().cos(), 20f64.to_radians().sin()) * 1000.0;
+        let v = c.decide(&s, goal, Vec2::zeros()).v_mm_s;
+        assert!(v.norm() > 1.0, "stood still");
+        let t_a = c.drive.settle_time_s(Vec2::zeros(), v);
+        let nearest = c
+            .phases(Vec2::zeros(), v, t_a)
+            .windows(2)
+            .map(|w| {
+                let ab = w[1] - w[0];
+                let u = ((p - w[0]).dot(&ab) / ab.norm_squared().max(1e-12)).clamp(0.0, 1.0);
+                (p - (w[0] + ab * u)).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            nearest >= 90.0,
+            "the body came within {nearest:.1} mm of the point"
+        );
     }
 
     #[test]
