@@ -47,6 +47,10 @@ pub struct PlannerConfig {
     /// (its command makes no headway toward it while the robot stands) closes the narrowest
     /// place ahead the same way (`too_narrow` when no route is left), s.
     pub refuse_s: f64,
+    /// The way still to go not once shorter, by `progress_mm`, than the least it has been
+    /// for this long, whatever routes were tried: the goal is reported unreachable
+    /// (`no_progress`), s. The bound on a run that wanders between routes it cannot drive.
+    pub give_up_s: f64,
     /// Time constant with which what was seen fades to unknown, s.
     pub forget_s: f64,
     /// Seed the grid with the walls, goals and pillars of the map the robot is given.
@@ -78,6 +82,7 @@ impl Default for PlannerConfig {
             progress_mm: 200.0,
             stall_s: 10.0,
             refuse_s: 4.0,
+            give_up_s: 30.0,
             forget_s: 20.0,
             seed_map: true,
             unreachable_s: 2.0,
@@ -110,6 +115,7 @@ pub fn check_planner(spec: &ControlSpec) -> Vec<ConfigProblem> {
             p.positive("progress_mm", c.progress_mm);
             p.positive("stall_s", c.stall_s);
             p.positive("refuse_s", c.refuse_s);
+            p.positive("give_up_s", c.give_up_s);
             p.positive("forget_s", c.forget_s);
             p.positive("unreachable_s", c.unreachable_s);
             p.positive("pocket_unreachable_s", c.pocket_unreachable_s);

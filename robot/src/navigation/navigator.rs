@@ -67,6 +67,9 @@ const CLOSE_RADIUS_MM: f64 = 100.0;
 /// once at most, never given up (a gap of about twice this, 320 mm, which the controller
 /// drives through at any speed), mm.
 const OPEN_ROOM_MM: f64 = 160.0;
+/// With no route at the planner's inflation, a route is sought at the body's radius plus this,
+/// mm, before the goal is given up.
+const TIGHT_MM: f64 = 10.0;
 /// A place closed once: the added cost factor (crossing it costs as much as 2 m of floor
 /// round it, so the robot tries every other way first).
 const CLOSED_FACTOR: f32 = 20.0;
@@ -118,7 +121,8 @@ pub enum Unreachable {
     NoRoute,
     /// Every route left passes a gap narrower than the robot can drive through.
     TooNarrow,
-    /// No progress toward it for `stall_s` with every other route tried.
+    /// No progress toward it for `stall_s` with every other route tried, or none on any route
+    /// for `give_up_s`.
     NoProgress,
 }
 
@@ -218,6 +222,9 @@ pub struct Navigator {
     stall: (f64, f64),
     /// When the stall rule last started again from a longer plan.
     stall_rebased_s: f64,
+    /// The least way still to go since the target was set, and when it was had (for
+    /// `give_up_s`; never started again from a longer plan).
+    closest: (f64, f64),
     /// Since when the controller has refused every step toward the lookahead point.
     refusing_since_s: Option<f64>,
     /// Why the last place was closed (`stall_s` or `refuse_s`), while one is.
@@ -258,6 +265,7 @@ impl Navigator {
             final_leg: true,
             stall: (f64::INFINITY, 0.0),
             stall_rebased_s: f64::NEG_INFINITY,
+            closest: (f64::INFINITY, 0.0),
             refusing_since_s: None,
             closed_by: None,
             report: NavigationReport::default(),
@@ -344,6 +352,7 @@ impl Navigator {
             self.report.unreachable = None;
             self.stall = (f64::INFINITY, t_s);
             self.stall_rebased_s = f64::NEG_INFINITY;
+            self.closest = (f64::INFINITY, t_s);
             self.refusing_since_s = None;
             self.closed_by = None;
             self.closed.fill(0);
@@ -359,6 +368,10 @@ impl Navigator {
             return Some(pose.inverse_transform_vector(&(target - here)));
         }
         let remaining = self.report.remaining_mm.unwrap_or(f64::INFINITY);
+        if self.gave_up(remaining, t_s) {
+            self.report.unreachable = Some(Unreachable::NoProgress);
+            return self.stop();
+        }
         let fired = self
             .watchdog
             .as_mut()
@@ -428,6 +441,18 @@ impl Navigator {
             self.refusing_since_s = None;
             self.close_ahead(here, self.config.lookahead_mm, Unreachable::TooNarrow);
         }
+    }
+
+    /// Whether the remaining way has not been shorter, by `progress_mm`, than its least so far
+    /// for `give_up_s`.
+    fn gave_up(&mut self, remaining_mm: f64, t_s: f64) -> bool {
+        if remaining_mm < self.closest.0 - self.config.progress_mm || !self.closest.0.is_finite() {
+            if remaining_mm.is_finite() {
+                self.closest = (remaining_mm, t_s);
+            }
+            return false;
+        }
+        t_s - self.closest.1 >= self.config.give_up_s - 1e-9
     }
 
     /// Whether the remaining way has not shortened by `progress_mm` for `stall_s` (restarting
@@ -504,22 +529,23 @@ impl Navigator {
         let Some(why) = self.closed_by else {
             return Unreachable::NoRoute;
         };
-        let costs = CostMap::new(
-            &self.grid,
-            &self.costs,
-            &self.penalty,
-            here,
-            Suspects::Costly,
-        );
+        let tight = CostSettings {
+            inflated_mm: self.radius_mm + TIGHT_MM,
+            ..self.costs
+        };
+        let costs = CostMap::new(&self.grid, &tight, &self.penalty, here, Suspects::Costly);
         match costs.plan(here, target, self.accept_mm) {
             Some(_) => why,
             None => Unreachable::NoRoute,
         }
     }
 
-    /// The watchdog's penalties with the closed places: dearer once, impassable twice.
-    fn penalties(&self) -> Vec<f32> {
-        self.penalty
+    /// The watchdog's penalties with the closed places: dearer once, impassable twice; but
+    /// never impassable under the robot's body at `here` (a robot that drifted into a place
+    /// it gave up must be able to back out of it: shut, it had no route at all).
+    fn penalties(&self, here: Point2<f64>) -> Vec<f32> {
+        let mut penalties: Vec<f32> = self
+            .penalty
             .iter()
             .zip(&self.closed)
             .map(|(&p, &c)| match c {
@@ -527,7 +553,18 @@ impl Navigator {
                 1 => p + CLOSED_FACTOR,
                 _ => f32::INFINITY,
             })
-            .collect()
+            .collect();
+        let g = self.grid.geometry();
+        if let Some((cx, cy)) = g.coords_of(here) {
+            let r = (self.radius_mm / g.cell_mm).ceil() as i64;
+            for (x, y) in disc_cells(cx, cy, r, g) {
+                let i = y * g.width + x;
+                if penalties[i].is_infinite() {
+                    penalties[i] = self.penalty[i] + CLOSED_FACTOR;
+                }
+            }
+        }
+        penalties
     }
 
     fn stop(&mut self) -> Option<Vector2<f64>> {
@@ -550,12 +587,23 @@ impl Navigator {
     fn replan(&mut self, here: Point2<f64>, target: Point2<f64>, t_s: f64) -> bool {
         self.fade_penalty(t_s);
         let penalties = if self.closed_by.is_some() || self.report.closed > 0 {
-            std::borrow::Cow::Owned(self.penalties())
+            std::borrow::Cow::Owned(self.penalties(here))
         } else {
             std::borrow::Cow::Borrowed(&self.penalty[..])
         };
-        let costs = CostMap::new(&self.grid, &self.costs, &penalties, here, Suspects::Costly);
-        let found = costs.plan(here, target, self.accept_mm);
+        let mut costs = CostMap::new(&self.grid, &self.costs, &penalties, here, Suspects::Costly);
+        let mut found = costs.plan(here, target, self.accept_mm);
+        if found.is_none() {
+            // No route with the comfort of the inflation: one the body fits, with
+            // `TIGHT_MM` to spare, before giving up (the map's edges are a cell and a ring
+            // out, and the controller drives where its body fits).
+            let tight = CostSettings {
+                inflated_mm: self.radius_mm + TIGHT_MM,
+                ..self.costs
+            };
+            costs = CostMap::new(&self.grid, &tight, &penalties, here, Suspects::Costly);
+            found = costs.plan(here, target, self.accept_mm);
+        }
         self.report.replans += 1;
         let Some((cells, _)) = found else {
             let since = *self.failing_since_s.get_or_insert(t_s);
@@ -920,6 +968,39 @@ mod tests {
         }
         assert_eq!(nav.report().watchdog, 1);
         assert!(nav.penalty.iter().any(|&p| p > 3.0));
+    }
+
+    #[test]
+    fn a_robot_that_circles_the_goal_without_nearing_it_gives_it_up_after_give_up_s() {
+        let cfg = robot(box_map(1500.0), [0.0, 0.0]);
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let goal = Point2::origin();
+        // Round the goal at 800 mm, once every 8 s: moving, on open floor, never nearer.
+        let at = |t: f64| {
+            let a = TAU * t / 8.0;
+            Isometry2::new(Vector2::new(-800.0 * a.cos(), 800.0 * a.sin()), 0.0)
+        };
+        let mut t = 0.0;
+        while t < 29.5 {
+            nav.steer(Some(&open_floor()), &at(t), Vector2::zeros(), goal, t);
+            assert!(nav.report().unreachable.is_none(), "not yet at {t} s");
+            t += 0.04;
+        }
+        while t < 30.5 {
+            nav.steer(Some(&open_floor()), &at(t), Vector2::zeros(), goal, t);
+            t += 0.04;
+        }
+        assert_eq!(nav.report().unreachable, Some(Unreachable::NoProgress));
+        // A robot that nears the goal steadily is never given up.
+        let mut nav = Navigator::new(&cfg, PlannerConfig::default()).unwrap();
+        let mut t = 0.0;
+        while t < 40.0 {
+            let x = -1400.0 + 30.0 * t;
+            let pose = Isometry2::new(Vector2::new(x, 0.0), 0.0);
+            nav.steer(Some(&open_floor()), &pose, Vector2::zeros(), goal, t);
+            assert!(nav.report().unreachable.is_none(), "given up at {t} s");
+            t += 0.04;
+        }
     }
 
     /// A box with a corridor 300 mm wide between the walls' faces from the robot to the goal:
