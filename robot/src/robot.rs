@@ -8,6 +8,7 @@ use crate::controllers;
 use crate::estimates::{Estimates, Fix, NotFound};
 use crate::estimator::PoseEstimator;
 use crate::mission::Mission;
+use crate::navigation::Unreachable;
 use crate::perception::{self, Belief, Percepts, Stage, StageEntry};
 use nalgebra::Isometry2;
 
@@ -67,6 +68,34 @@ impl Robot {
     /// Fixes used and rejected so far.
     pub fn fixes(&self) -> (usize, usize) {
         self.estimator.fixes()
+    }
+
+    /// Runs every perception stage on this cycle's observation; a stage whose camera's frame
+    /// was lost finds nothing (a `not_found` entry), unless it carries on without frames.
+    fn perceive(&mut self, obs: &Observation<'_>, belief: &Belief) -> Result<Percepts, RobotError> {
+        let mut percepts = Percepts::default();
+        for stage in &mut self.stages {
+            // A frame lost on its way: the stage finds nothing this cycle, unless it carries
+            // on without one.
+            let lost = (stage.wants_frames() && !stage.runs_without_frames())
+                .then(|| {
+                    stage
+                        .cameras()
+                        .iter()
+                        .find(|c| !obs.frames.iter().any(|f| f.sensor == **c))
+                        .map(|c| c.to_string())
+                })
+                .flatten();
+            if let Some(camera) = lost {
+                percepts.not_found.push(NotFound {
+                    source: stage.name(),
+                    reason: format!("no frame of camera {camera:?} this cycle"),
+                });
+                continue;
+            }
+            stage.run(obs, belief, &mut percepts)?;
+        }
+        Ok(percepts)
     }
 }
 
@@ -128,28 +157,7 @@ impl RobotSoftware for Robot {
             fixed: self.estimator.has_fix(),
             odometry_pose: self.estimator.odometry_pose(),
         };
-        let mut percepts = Percepts::default();
-        for stage in &mut self.stages {
-            // A frame lost on its way: the stage finds nothing this cycle, unless it carries
-            // on without one.
-            let lost = (stage.wants_frames() && !stage.runs_without_frames())
-                .then(|| {
-                    stage
-                        .cameras()
-                        .iter()
-                        .find(|c| !obs.frames.iter().any(|f| f.sensor == **c))
-                        .map(|c| c.to_string())
-                })
-                .flatten();
-            if let Some(camera) = lost {
-                percepts.not_found.push(crate::estimates::NotFound {
-                    source: stage.name(),
-                    reason: format!("no frame of camera {camera:?} this cycle"),
-                });
-                continue;
-            }
-            stage.run(obs, &belief, &mut percepts)?;
-        }
+        let percepts = self.perceive(obs, &belief)?;
         let fixes: Vec<Fix> = percepts
             .fixes
             .into_iter()
@@ -193,16 +201,7 @@ impl RobotSoftware for Robot {
         if let (Some(n), Some(t)) = (&navigation, target_mm)
             && let Some(why) = n.unreachable
         {
-            not_found.push(NotFound {
-                source: "planner",
-                reason: format!(
-                    "unreachable: {} ({:.0}, {:.0}); the robot stopped ({})",
-                    why.explain(),
-                    t.x,
-                    t.y,
-                    why.as_str()
-                ),
-            });
+            not_found.push(unreachable_entry(why, t));
         }
         Ok(Outputs {
             command,
@@ -224,5 +223,19 @@ impl RobotSoftware for Robot {
                 navigation,
             },
         })
+    }
+}
+
+/// The estimates record's entry for a goal the planner found unreachable at `target` (world mm).
+fn unreachable_entry(why: Unreachable, target: nalgebra::Point2<f64>) -> NotFound {
+    NotFound {
+        source: "planner",
+        reason: format!(
+            "unreachable: {} ({:.0}, {:.0}); the robot stopped ({})",
+            why.explain(),
+            target.x,
+            target.y,
+            why.as_str()
+        ),
     }
 }
