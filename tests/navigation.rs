@@ -7,9 +7,14 @@ mod common;
 use common::{cpu, omniloop, scenario, tmp};
 use omniloop::run_scenario;
 
+/// Runs the shipped scenario `file` on the CPU renderer, without progress or frames.
+fn run_shipped(file: &str) -> omniloop::RunOutput {
+    run_scenario(&scenario(file), &cpu(), |_| {}, |_, _| {}).unwrap()
+}
+
 #[test]
 fn an_enclosed_goal_is_reported_unreachable_within_ten_seconds_and_the_robot_stands_still() {
-    let out = run_scenario(&scenario("trap_enclosed.toml"), &cpu(), |_| {}, |_, _| {}).unwrap();
+    let out = run_shipped("trap_enclosed.toml");
     let s = &out.summary;
     assert_eq!(s.unreachable, Some(true), "{s:?}");
     assert!(!s.reached_goal);
@@ -49,7 +54,7 @@ fn an_enclosed_goal_is_reported_unreachable_within_ten_seconds_and_the_robot_sta
 
 #[test]
 fn the_goal_behind_a_cul_de_sac_facing_the_start_is_reached_without_contact() {
-    let out = run_scenario(&scenario("trap_cul_de_sac.toml"), &cpu(), |_| {}, |_, _| {}).unwrap();
+    let out = run_shipped("trap_cul_de_sac.toml");
     let s = &out.summary;
     assert!(s.reached_goal, "{s:?}");
     assert_eq!(s.wall_contacts, 0, "{s:?}");
@@ -64,13 +69,7 @@ fn the_goal_behind_a_cul_de_sac_facing_the_start_is_reached_without_contact() {
 
 #[test]
 fn a_goal_in_a_field_corner_behind_a_cube_is_reached_without_contact() {
-    let out = run_scenario(
-        &scenario("trap_corner_goal.toml"),
-        &cpu(),
-        |_| {},
-        |_, _| {},
-    )
-    .unwrap();
+    let out = run_shipped("trap_corner_goal.toml");
     let s = &out.summary;
     assert!(s.reached_goal, "{s:?}");
     assert_eq!(s.wall_contacts, 0, "{s:?}");
@@ -149,13 +148,7 @@ fn the_corner_route_passes_every_corner_and_leaves_the_pocket_by_the_gap_it_came
     // Standing in the gap's mouth with the floor by its body out of the near-field memory, the
     // robot once stood there for the rest of the run; the map's floor now says how far off the
     // cube and the wall in its blind zone stand.
-    let out = run_scenario(
-        &scenario("field_corner_route.toml"),
-        &cpu(),
-        |_| {},
-        |_, _| {},
-    )
-    .unwrap();
+    let out = run_shipped("field_corner_route.toml");
     let s = &out.summary;
     assert!(s.reached_goal, "{s:?}");
     assert_eq!(s.targets_reached, Some(4), "{s:?}");

@@ -17,6 +17,18 @@ pub struct Seen {
     pub clear: Vec<Vec2>,
 }
 
+impl Seen {
+    /// Nothing seen yet in `n` directions evenly spaced from 0.
+    pub fn in_directions(n: usize) -> Self {
+        Self {
+            dirs: (0..n).map(|j| j as f64 * TAU / n as f64).collect(),
+            free: Vec::new(),
+            obstacles: Vec::new(),
+            clear: Vec::new(),
+        }
+    }
+}
+
 /// The surroundings of `seen` with a 1000 mm template.
 pub fn surroundings(seen: &Seen) -> Surroundings<'_> {
     Surroundings {
@@ -33,14 +45,8 @@ pub fn surroundings(seen: &Seen) -> Surroundings<'_> {
 
 /// A wall across the robot's path at x = `x_mm`, seen in 32 directions up to 1000 mm.
 pub fn wall_ahead(x_mm: f64) -> Seen {
-    let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
-    let mut seen = Seen {
-        dirs: dirs.clone(),
-        free: Vec::new(),
-        obstacles: Vec::new(),
-        clear: Vec::new(),
-    };
-    for &a in &dirs {
+    let mut seen = Seen::in_directions(32);
+    for a in seen.dirs.clone() {
         let c = a.cos();
         let d = if c > 1e-9 { x_mm / c } else { f64::INFINITY };
         let u = Vec2::new(c, a.sin());

@@ -620,15 +620,9 @@ mod tests {
     /// with three rays (centre and sector edges) whose surely free distance is the least of
     /// the three.
     fn seen_from(p: Vec2, walls: &[(Vec2, Vec2)]) -> Seen {
-        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
         let half = 0.5 * TAU / 32.0;
-        let mut seen = Seen {
-            dirs: dirs.clone(),
-            free: Vec::new(),
-            obstacles: Vec::new(),
-            clear: Vec::new(),
-        };
-        for &a in &dirs {
+        let mut seen = Seen::in_directions(32);
+        for a in seen.dirs.clone() {
             let rays = [a - half, a, a + half].map(|r| Vec2::new(r.cos(), r.sin()));
             let d = rays
                 .iter()
@@ -743,6 +737,16 @@ mod tests {
         }
     }
 
+    /// 32 directions seen free to 1000 mm: the directions, free distances and clear points.
+    fn open_floor() -> (Vec<f64>, Vec<f64>, Vec<Vec2>) {
+        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
+        let clear = dirs
+            .iter()
+            .map(|a| Vec2::new(a.cos(), a.sin()) * 1000.0)
+            .collect();
+        (dirs, vec![1000.0; 32], clear)
+    }
+
     /// Blind points at the body's edge (90 mm) in the directions `from_deg..=to_deg`, three a
     /// sector of 32 as the near-field memory gives them, and clear space (1000 mm) elsewhere.
     fn blind_arc(from_deg: i32, to_deg: i32) -> (Vec<f64>, Vec<f64>, Vec<Vec2>, Vec<Vec2>) {
@@ -799,12 +803,7 @@ mod tests {
         // it at a slant of 40 degrees: placed afresh at the body's edge it would be passed at
         // that slant, coming nearer every cycle; remembered, it gets no nearer.
         let c = controller(SpeedChoice::Chosen, false, 400.0);
-        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
-        let free = vec![1000.0; 32];
-        let clear: Vec<Vec2> = dirs
-            .iter()
-            .map(|a| Vec2::new(a.cos(), a.sin()) * 1000.0)
-            .collect();
+        let (dirs, free, clear) = open_floor();
         let p = Vec2::new(75.0, 0.0);
         let blind = [p];
         let s = unobstructed(&dirs, &free, &clear, &blind);
@@ -827,12 +826,7 @@ mod tests {
         assert!((c.blind_keep_mm(200.0, 120.0) - 120.0).abs() < 1e-9);
         // A point the map moved out to 100 mm, the goal beyond it at a slant of 20 degrees:
         // the command's path (toward it, then braking to rest) keeps the body off the point.
-        let dirs: Vec<f64> = (0..32).map(|j| j as f64 * TAU / 32.0).collect();
-        let free = vec![1000.0; 32];
-        let clear: Vec<Vec2> = dirs
-            .iter()
-            .map(|a| Vec2::new(a.cos(), a.sin()) * 1000.0)
-            .collect();
+        let (dirs, free, clear) = open_floor();
         let p = Vec2::new(100.0, 0.0);
         let blind = [p];
         let s = unobstructed(&dirs, &free, &clear, &blind);
