@@ -529,14 +529,24 @@ impl Navigator {
         let Some(why) = self.closed_by else {
             return Unreachable::NoRoute;
         };
-        let tight = CostSettings {
-            inflated_mm: self.radius_mm + TIGHT_MM,
-            ..self.costs
-        };
-        let costs = CostMap::new(&self.grid, &tight, &self.penalty, here, Suspects::Costly);
+        let costs = CostMap::new(
+            &self.grid,
+            &self.tight_costs(),
+            &self.penalty,
+            here,
+            Suspects::Costly,
+        );
         match costs.plan(here, target, self.accept_mm) {
             Some(_) => why,
             None => Unreachable::NoRoute,
+        }
+    }
+
+    /// The costs of a tight route: the body's radius plus `TIGHT_MM` inflated.
+    fn tight_costs(&self) -> CostSettings {
+        CostSettings {
+            inflated_mm: self.radius_mm + TIGHT_MM,
+            ..self.costs
         }
     }
 
@@ -597,10 +607,7 @@ impl Navigator {
             // No route with the comfort of the inflation: one the body fits, with
             // `TIGHT_MM` to spare, before giving up (the map's edges are a cell and a ring
             // out, and the controller drives where its body fits).
-            let tight = CostSettings {
-                inflated_mm: self.radius_mm + TIGHT_MM,
-                ..self.costs
-            };
+            let tight = self.tight_costs();
             costs = CostMap::new(&self.grid, &tight, &penalties, here, Suspects::Costly);
             found = costs.plan(here, target, self.accept_mm);
         }
