@@ -837,11 +837,7 @@ mod tests {
         let nearest = c
             .phases(Vec2::zeros(), v, t_a)
             .windows(2)
-            .map(|w| {
-                let ab = w[1] - w[0];
-                let u = ((p - w[0]).dot(&ab) / ab.norm_squared().max(1e-12)).clamp(0.0, 1.0);
-                (p - (w[0] + ab * u)).norm()
-            })
+            .map(|w| to_segment(p, (w[0], w[1])))
             .fold(f64::INFINITY, f64::min);
         assert!(
             nearest >= 90.0,
