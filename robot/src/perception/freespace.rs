@@ -189,6 +189,23 @@ impl FreeSpaceStage {
     }
 }
 
+impl FreeSpaceStage {
+    /// The free space of `img`, a frame of this stage's camera taken now, as the stage gives it
+    /// within a cycle (on the first frame, the template is laid about the robot's own image
+    /// first): what a robot's software outside omniloop's loop (a ROS 2 node) gets from a frame.
+    pub fn detect_frame(&mut self, img: &RgbaImage) -> Result<FreeSpace, RobotError> {
+        if !self.centred {
+            self.recentre(img)?;
+        }
+        Ok(self.detector.detect(img)?)
+    }
+
+    /// The camera whose frames it reads.
+    pub fn camera(&self) -> &str {
+        &self.camera
+    }
+}
+
 /// The brightest channel of the robot's own dark image (its top and the camera seen in the
 /// mirror).
 const DARK_LEVEL: u8 = 64;
@@ -232,7 +249,7 @@ impl Stage for FreeSpaceStage {
         match obs.frames.iter().find(|f| f.sensor == self.camera) {
             Some(frame) if (obs.t_s - frame.t_s).abs() < 1e-9 => {
                 // Taken now: as it is.
-                let fs = self.detector.detect(frame.image)?;
+                let fs = self.detect_frame(frame.image)?;
                 self.last = Some((fs.clone(), now, frame.t_s));
                 out.freespace = Some(fs);
                 return Ok(());
