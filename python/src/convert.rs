@@ -2,7 +2,7 @@
 //! values as TOML values, and the checks on what Python hands in.
 
 use numpy::ndarray::Array3;
-use numpy::{PyArray1, PyArray3};
+use numpy::{PyArray1, PyArray3, PyReadonlyArray3, PyUntypedArrayMethods};
 use omniloop::TrajectoryRow;
 use omniloop::run::RunError;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -34,6 +34,26 @@ pub fn rgb_array<'py>(py: Python<'py>, img: &image::RgbaImage) -> Bound<'py, PyA
         out.copy_from_slice(&px[..3]);
     }
     rgb_from_vec(py, h, w, rgb)
+}
+
+/// An `H x W x 3` `uint8` array (an observation's frame) as an opaque RGBA image.
+pub fn rgba_from_array(frame: &PyReadonlyArray3<'_, u8>) -> PyResult<image::RgbaImage> {
+    let shape = frame.shape();
+    if shape[2] != 3 || shape[0] == 0 || shape[1] == 0 {
+        return Err(PyValueError::new_err(format!(
+            "a frame is an H x W x 3 uint8 array (RGB), got shape {shape:?}"
+        )));
+    }
+    let (h, w) = (shape[0], shape[1]);
+    let view = frame.as_array();
+    let pixels = view.as_standard_layout();
+    let mut rgba = vec![255u8; h * w * 4];
+    let rgb = pixels.as_slice().unwrap_or(&[]);
+    for (out, px) in rgba.chunks_exact_mut(4).zip(rgb.chunks_exact(3)) {
+        out[..3].copy_from_slice(px);
+    }
+    image::RgbaImage::from_raw(w as u32, h as u32, rgba)
+        .ok_or_else(|| PyValueError::new_err("the frame's pixels do not fill its shape"))
 }
 
 /// An RGB image as an `H x W x 3` `uint8` array.

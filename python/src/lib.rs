@@ -2,7 +2,9 @@
 //! a simulation stepped from Python with Python as the robot's software, and N of them stepped
 //! together. The pure-Python part (`omniloop/`) adds the Gymnasium environments.
 
+mod camera;
 mod convert;
+mod freespace;
 mod scenario;
 mod simulation;
 mod sweep;
@@ -125,6 +127,7 @@ fn _omniloop(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulation::Observation>()?;
     m.add_class::<simulation::Odometry>()?;
     m.add_class::<vector::PyVectorSimulation>()?;
+    m.add_class::<freespace::PyFreeSpaceDetector>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(default_scenario, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep_plan, m)?)?;

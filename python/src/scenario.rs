@@ -4,7 +4,7 @@
 use crate::convert::{ScenarioError, toml_value};
 use omniloop::scenario::LoadError;
 use omniloop::{Scenario, load_scenario, parse_scenario};
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::path::{Path, PathBuf};
@@ -158,6 +158,32 @@ impl PyScenario {
         Ok(d)
     }
 
+    /// Camera `sensor` of `robot` (defaults: the first of each) as a standard camera model,
+    /// a dict: `image_size_px`, `intrinsics` (a pinhole camera's; for a mirror, Mei's unified
+    /// model fitted to its traced rays, as `omniloop calibrate --format opencv-omnidir`
+    /// writes it), `model_frame_in_body` (`rotation` whose columns are the model frame's axes
+    /// in the body frame, `translation_mm`), `pan_unit`.
+    #[pyo3(signature = (sensor = None, robot = None))]
+    fn camera_model<'py>(
+        &self,
+        py: Python<'py>,
+        sensor: Option<&str>,
+        robot: Option<&str>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let names = self.scenario.robot_names();
+        let k = match robot {
+            None => 0,
+            Some(r) => names.iter().position(|n| n == r).ok_or_else(|| {
+                PyValueError::new_err(format!("no robot {r:?} (robots: {})", names.join(", ")))
+            })?,
+        };
+        let member = self.scenario.member(k);
+        let spec = member
+            .sensor(sensor)
+            .map_err(|e| PyValueError::new_err(format!("robot {:?}: {e}", names[k])))?;
+        crate::camera::camera_model(py, spec)
+    }
+
     /// Whether the scenario has a team (`[[robots]]`).
     #[getter]
     fn is_team(&self) -> bool {
@@ -206,6 +232,14 @@ fn robot_dict<'py>(py: Python<'py>, s: &Scenario, name: &str) -> PyResult<Bound<
         sensors.append(sd)?;
     }
     d.set_item("sensors", sensors)?;
+    let o = &s.odometry;
+    let od = PyDict::new(py);
+    od.set_item("speed_noise_frac", o.speed_noise_frac)?;
+    od.set_item("omega_noise_rad_s", o.omega_noise_rad_s)?;
+    od.set_item("scale_bias_frac", o.scale_bias_frac)?;
+    od.set_item("omega_bias_rad_s", o.omega_bias_rad_s)?;
+    od.set_item("slip_s", o.slip_s)?;
+    d.set_item("odometry", od)?;
     match &s.goal {
         Some(g) => {
             let gd = PyDict::new(py);

@@ -7,13 +7,16 @@
 //! `Simulation.truth()`, for scoring and recording.
 
 use crate::convert::{finite_numbers, json_to_py, rgb_array, rgb_image_array, run_error};
+use crate::freespace::PyFreeSpaceDetector;
 use crate::scenario::PyScenario;
 use nalgebra::{Isometry2, Vector2};
 use omniloop::control::DeadReckoning;
+use omniloop::robot::perception::FreeSpaceStage;
 use omniloop::robot::{ActuatorCommand, ActuatorState, BodyCommand, Remote, RemoteHandle};
 use omniloop::run::record::estimates_line;
 use omniloop::run::{RunError, RunOptions};
 use omniloop::scenario::PilotChoice;
+use omniloop::vision::FreeSpaceConfig;
 use omniloop::{Scenario, Session, Truth};
 use omniloop_sim::RendererChoice;
 use omniloop_sim::render::BatchHandle;
@@ -150,13 +153,15 @@ pub struct State {
 
 impl State {
     /// Builds the run of `scenario` with `seed`, each robot driven by its entry of `drivers`
-    /// (in the scenario's order of robots), and senses its first frames.
+    /// (in the scenario's order of robots), and senses its first frames; with `takes_frames`,
+    /// vision's camera is rendered and calibrated whatever the software reads.
     pub fn new(
         scenario: &Scenario,
         seed: u64,
         renderer: RendererChoice,
         drivers: &[Driver],
         shared_gpu: Option<BatchHandle>,
+        takes_frames: bool,
     ) -> Result<Self, RunError> {
         let mut scenario = scenario.clone();
         scenario.seed = seed;
@@ -167,6 +172,7 @@ impl State {
         let options = RunOptions {
             renderer,
             shared_gpu,
+            takes_frames,
             ..RunOptions::default()
         };
         let names = scenario.robot_names();
@@ -276,6 +282,20 @@ impl State {
     /// The robots' names, in order.
     pub fn names(&self) -> Vec<String> {
         self.members.iter().map(|m| m.name.clone()).collect()
+    }
+
+    /// The index of the robot called `name` (the first when `None`).
+    fn robot_index(&self, name: Option<&str>) -> PyResult<usize> {
+        let Some(name) = name else { return Ok(0) };
+        self.members
+            .iter()
+            .position(|m| m.name == name)
+            .ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "no robot {name:?} (robots: {})",
+                    self.names().join(", ")
+                ))
+            })
     }
 
     /// Where dead reckoning puts robot `k` (world frame, from the start it is told).
@@ -623,6 +643,8 @@ pub struct PySimulation {
     renderer: RendererChoice,
     /// Who drives each robot, in the robots' order.
     drivers: Vec<Driver>,
+    /// Vision's camera is rendered and calibrated whatever the software reads.
+    frames: bool,
     state: Mutex<State>,
 }
 
@@ -742,15 +764,18 @@ impl PySimulation {
     /// A run of `scenario` with `seed` (default: the scenario's), the `renderer` (`"cpu"`,
     /// `"gpu"` or `"auto"`) and `robot`: `"python"` (you step it with commands) or
     /// `"builtin"` (the scenario's own robot software decides); for a team, one of these for
-    /// every robot or a dict naming each robot's (`{"blue1": "python", "blue2": "builtin"}`).
+    /// every robot or a dict naming each robot's (`{"blue1": "python", "blue2": "builtin"}`);
+    /// `frames=True` renders (and calibrates) vision's camera even where the built-in software
+    /// reads no frame, to watch it or run a detector on it.
     #[new]
-    #[pyo3(signature = (scenario, seed = None, renderer = "cpu", robot = None))]
+    #[pyo3(signature = (scenario, seed = None, renderer = "cpu", robot = None, frames = false))]
     fn new(
         py: Python<'_>,
         scenario: PyRef<'_, PyScenario>,
         seed: Option<u64>,
         renderer: &str,
         robot: Option<&Bound<'_, PyAny>>,
+        frames: bool,
     ) -> PyResult<Self> {
         let renderer = renderer_choice(renderer)?;
         let drivers = match robot {
@@ -762,12 +787,13 @@ impl PySimulation {
         let drivers = drivers.resolve(&s.name, &s.robot_names())?;
         let seed = seed.unwrap_or(s.seed);
         let state = py
-            .detach(|| State::new(s, seed, renderer, &drivers, None))
+            .detach(|| State::new(s, seed, renderer, &drivers, None, frames))
             .map_err(run_error)?;
         Ok(Self {
             scenario,
             renderer,
             drivers,
+            frames,
             state: Mutex::new(state),
         })
     }
@@ -785,6 +811,7 @@ impl PySimulation {
                     self.renderer,
                     &self.drivers,
                     None,
+                    self.frames,
                 )
             })
             .map_err(run_error)?;
@@ -922,6 +949,32 @@ impl PySimulation {
     #[getter]
     fn done(&self) -> bool {
         self.lock().done()
+    }
+
+    /// The free-space stage of `robot`'s vision camera (default: the first robot), built as
+    /// the built-in robot builds it (its calibration, its `[vision.freespace]` settings), to
+    /// run on frames from `observe()` or `step()`; raises `ValueError` when its vision camera
+    /// is not a mirror that sees the floor.
+    #[pyo3(signature = (robot = None))]
+    fn free_space_detector(&self, robot: Option<&str>) -> PyResult<PyFreeSpaceDetector> {
+        let state = self.lock();
+        let k = state.robot_index(robot)?;
+        let agent = &state.session().simulation().robots()[k];
+        let name = agent.name().to_string();
+        let Some(cal) = agent.vision_calibration() else {
+            return Err(PyValueError::new_err(format!(
+                "robot {name:?}: its vision camera is not a mirror camera with an image-to-floor \
+                 calibration, so it has no free space"
+            )));
+        };
+        let config: FreeSpaceConfig = agent
+            .scenario()
+            .vision
+            .table("freespace")
+            .map_err(|e| PyValueError::new_err(format!("robot {name:?}: {e}")))?;
+        let stage = FreeSpaceStage::new(&cal.sensor, config, cal)
+            .map_err(|e| PyValueError::new_err(format!("robot {name:?}: {e}")))?;
+        Ok(PyFreeSpaceDetector::new(stage))
     }
 
     /// The robots' names, in the scenario's order (`["robot"]` for a one-robot scenario

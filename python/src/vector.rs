@@ -39,6 +39,7 @@ impl PyVectorSimulation {
             self.renderer,
             &[self.driver],
             self.gpu.clone(),
+            false,
         )
     }
 }
