@@ -14,6 +14,7 @@ if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
   "$venv/bin/python" -m pip install -q --upgrade pip
 fi
-# The dev profile is the one `cargo test` just built: the extension reuses its artifacts.
-MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test]"
+# The dev profile is the one `cargo test` just built: the extension reuses its artifacts. The
+# `ros` extra brings ROS 2 (rclpy, Fast DDS, the messages) for the ROS 2 bridge's tests.
+MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test,ros]"
 "$venv/bin/python" -m pytest -q python/tests
