@@ -26,7 +26,7 @@ if sys.version_info < (3, 10):
 os.environ["ROS_DOMAIN_ID"] = str(random.Random(os.getpid()).randint(1, 100))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 import rclpy  # noqa: E402
-from geometry_msgs.msg import PoseStamped, Twist  # noqa: E402
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped  # noqa: E402
 from nav_msgs.msg import Odometry  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from rclpy.qos import DurabilityPolicy, QoSProfile  # noqa: E402
@@ -65,13 +65,23 @@ class Client(Node):
         self.cmd = self.create_publisher(Twist, f"{NS}/cmd_vel", 10)
         self.reset = self.create_client(Trigger, "/omniloop/reset")
         self.last = time.monotonic()
+        self.pending = None
 
     def on_goal(self, msg: PoseStamped) -> None:
         self.goal = (msg.pose.position.x, msg.pose.position.y)
+        if self.pending is not None:  # a frame came before the goal: answered now
+            self.answer(self.pending)
+            self.pending = None
 
     def on_odom(self, msg: Odometry) -> None:
         self.last = time.monotonic()
         self.msgs["odom"].append(msg)
+        if self.goal is None:
+            self.pending = msg
+            return
+        self.answer(msg)
+
+    def answer(self, msg: Odometry) -> None:
         cycle = len(self.msgs["odom"]) - 1
         if cycle == RESET_AT:
             self.reset.call_async(Trigger.Request())
@@ -382,3 +392,41 @@ def test_pause_step_and_reset_by_hand():
         log = node.communicate(timeout=20)[0]
         rclpy.shutdown()
     assert node.returncode == 0, log
+
+
+def test_twist_stamped_commands_drive_in_lockstep():
+    """With `--twist-stamped`, a command answers the frame its stamp is at or after; the
+    robot reaches its goal on such commands alone."""
+    script = Path(sys.executable).parent / "omniloop-ros"
+    cmd = [str(script), str(SCENARIO), "--lockstep", "--twist-stamped", "--exit-at-end"]
+    goal = []
+    rclpy.init()
+    node = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        client = rclpy.create_node("omniloop_stamped_client")
+        pub = client.create_publisher(TwistStamped, f"{NS}/cmd_vel", 10)
+        latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        client.create_subscription(
+            PoseStamped, f"{NS}/goal_pose", lambda m: goal.append(m.pose.position), latched
+        )
+
+        def answer(msg: Odometry) -> None:
+            p, g = msg.pose.pose.position, goal[0] if goal else msg.pose.pose.position
+            dx, dy = g.x - p.x, g.y - p.y  # heading stays 0: body = map axes
+            k = min(0.8, 2.0 * math.hypot(dx, dy)) / max(math.hypot(dx, dy), 1e-9)
+            out = TwistStamped()
+            out.header.stamp = msg.header.stamp
+            out.twist.linear.x, out.twist.linear.y = k * dx, k * dy
+            pub.publish(out)
+
+        client.create_subscription(Odometry, f"{NS}/odom", answer, 10)
+        while node.poll() is None:
+            rclpy.spin_once(client, timeout_sec=0.05)
+        client.destroy_node()
+    finally:
+        if node.poll() is None:
+            node.kill()
+        rclpy.shutdown()
+    log = node.stdout.read()
+    assert node.returncode == 0 and "reached goal True" in log, log
+    assert "no command" not in log  # every cycle was answered in time
