@@ -17,6 +17,7 @@ Services ``~/reset`` (``std_srvs/Trigger``, seed from the ``seed`` parameter), `
 from __future__ import annotations
 
 import array
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -94,7 +95,6 @@ class RobotPort:
         self.spec = scenario.robots[name]
         self.sensors = [s["name"] for s in self.spec["sensors"]]
         self.models = {s: scenario.camera_model(s, robot=name) for s in self.sensors}
-        self.infos = {s: mapping.camera_info(m) for s, m in self.models.items()}
         topic = lambda t: f"/{ns}/{t}"  # noqa: E731
         self.images = {
             s: node.create_publisher(Image, topic(f"{s}/image_raw"), RELIABLE) for s in self.sensors
@@ -108,7 +108,7 @@ class RobotPort:
         self.goal = node.create_publisher(PoseStamped, topic("goal_pose"), LATCHED)
         # Each topic's message, built once: a cycle sets what changes.
         self.image_msgs = {s: Image(encoding="rgb8", is_bigendian=0) for s in self.sensors}
-        self.info_msgs = {s: camera_info_msg(self.infos[s]) for s in self.sensors}
+        self.info_msgs = {s: camera_info_msg(self.models[s]) for s in self.sensors}
         for s in self.sensors:
             self.image_msgs[s].header.frame_id = self.info_msgs[s].header.frame_id = self.frame(
                 f"{s}_optical"
@@ -268,16 +268,9 @@ def fill_odometry(msg: Odometry, stamp: Time, pose: tuple, body_velocity: tuple)
     return msg
 
 
-def camera_info_msg(i: mapping.CameraInfo) -> CameraInfo:
-    return CameraInfo(
-        height=i.height,
-        width=i.width,
-        distortion_model=i.distortion_model,
-        d=i.d,
-        k=i.k,
-        r=i.r,
-        p=i.p,
-    )
+def camera_info_msg(model: dict) -> CameraInfo:
+    """A camera model (``Scenario.camera_model``) as a ``CameraInfo``."""
+    return CameraInfo(**dataclasses.asdict(mapping.camera_info(model)))
 
 
 class Bridge:
@@ -302,10 +295,9 @@ class Bridge:
         self.t_s = 0.0
         self.clock = self.node.create_publisher(Clock, "/clock", RELIABLE)
         self.clock_msg = Clock()
-        self.tf = self.tf_static = None
+        self.tf = None
         if TFMessage is not None:
             self.tf = self.node.create_publisher(TFMessage, "/tf", RELIABLE)
-            self.tf_static = self.node.create_publisher(TFMessage, "/tf_static", LATCHED)
         else:
             log.info(
                 "tf2_msgs cannot be imported (it has no wheel on the package index): /tf is not "
@@ -330,7 +322,7 @@ class Bridge:
         self.commands = CommandWait.of(self.node, subs) if options.lockstep and subs else None
         mode = "lockstep" if options.lockstep else f"realtime x{options.realtime_factor:g}"
         log.info(
-            f"scenario {scenario.name!r}, seed {seed}, {mode}, robots driven by {options.robot}: "
+            f"scenario {scenario.name!r}, seed {self.seed()}, {mode}, robots driven by {options.robot}: "
             + ", ".join(f"/{p.ns}" for p in self.ports)
         )
 
@@ -338,6 +330,8 @@ class Bridge:
         """``cmd_vel_timeout`` takes effect at once, ``seed`` at the next reset;
         ``twist_stamped`` is fixed once the subscription is made."""
         for p in params:
+            if p.name == "seed" and not int(p.value) >= 0:
+                return SetParametersResult(successful=False, reason="a seed is >= 0")
             if p.name == "cmd_vel_timeout":
                 value = float(p.value)
                 if not value >= 0:

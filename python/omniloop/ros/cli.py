@@ -97,6 +97,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         ("--cmd-vel-timeout", args.cmd_vel_timeout),
         ("--lockstep-timeout", args.lockstep_timeout),
         ("--realtime", args.realtime),
+        ("--seed", 0 if args.seed is None else args.seed),
     ]:
         if not value >= 0:
             print(f"error: {name} must be a number >= 0 (got {value})", file=sys.stderr)
