@@ -119,6 +119,7 @@ class RobotPort:
         self.scan = None
         self.detector = None
         self.scan_sensor: Optional[str] = None
+        self.scan_axis_mm = (0.0, 0.0)
         self.covariance = OdometryCovariance.from_spec(self.spec["odometry"])
         self.command: tuple = self.stop()
         self.command_t_s = -math.inf
@@ -138,7 +139,10 @@ class RobotPort:
         return (0.0, 0.0) if self.spec["differential"] else (0.0, 0.0, 0.0)
 
     def attach(self, sim: "omniloop.Simulation") -> None:
-        """Takes the detector of a new episode's simulation (its free space starts afresh)."""
+        """Starts a new episode of ``sim``: the covariance and the command afresh, and the
+        detector of its free space."""
+        self.covariance.reset()
+        self.command, self.command_t_s, self.command_stamp = self.stop(), -math.inf, -math.inf
         try:
             self.detector = sim.free_space_detector(robot=self.name)
         except ValueError as e:
@@ -150,8 +154,6 @@ class RobotPort:
         self.scan_msg.header.frame_id = self.frame(f"{self.scan_sensor}_scan")
         if self.scan is None:
             self.scan = self.bridge.node.create_publisher(LaserScan, f"/{self.ns}/scan", RELIABLE)
-        self.covariance.reset()
-        self.command, self.command_t_s, self.command_stamp = self.stop(), -math.inf, -math.inf
 
     def on_cmd_vel(self, msg) -> None:
         twist = msg.twist if self.bridge.options.twist_stamped else msg
@@ -221,6 +223,7 @@ class RobotPort:
 
     def publish_scan(self, free: dict, stamp: Time) -> None:
         scan = mapping.free_space_scan(free)
+        self.scan_axis_mm = free["axis_mm"]
         msg = self.scan_msg
         msg.angle_min, msg.angle_max, msg.angle_increment = (
             scan.angle_min,
@@ -391,13 +394,13 @@ class Bridge:
                 )
             )
         if port.detector is not None:
-            free_axis = port.models[port.scan_sensor]["model_frame_in_body"]["translation_mm"]
+            ax, ay = port.scan_axis_mm
             tfs.append(
                 transform(
                     stamp,
                     port.frame("base_link"),
                     port.frame(f"{port.scan_sensor}_scan"),
-                    (free_axis[0] * MM, free_axis[1] * MM, 0.0),
+                    (ax * MM, ay * MM, 0.0),
                     (0.0, 0.0, 0.0, 1.0),
                 )
             )
@@ -426,8 +429,10 @@ class Bridge:
         """A new episode with ``seed``, its first observation published."""
         if self.sim is None:
             o = self.options
+            # Every camera is rendered to be published, whatever the software reads.
+            frames = all(p.sensors for p in self.ports)
             self.sim = omniloop.Simulation(
-                self.scenario, seed=seed, renderer=o.renderer, robot=o.robot, frames=True
+                self.scenario, seed=seed, renderer=o.renderer, robot=o.robot, frames=frames
             )
         else:
             self.sim.reset(seed=seed)
