@@ -18,6 +18,7 @@ use crate::sensor::Sensor;
 use bytemuck::{Pod, Zeroable};
 use nalgebra::Isometry2;
 use omniloop_vision::camera_model::CameraFile;
+use rayon::prelude::*;
 
 /// The sensor and pose of one frame, as the shader reads them.
 #[repr(C)]
@@ -488,14 +489,22 @@ impl GpuRenderer {
         if requests.is_empty() {
             return Ok(Vec::new());
         }
-        let mut out = Vec::with_capacity(requests.len());
-        self.trace(requests, |all| {
-            let mut at = 0;
-            for r in requests {
+        // Each frame's place in the readback; the frames are copied out on every core (a
+        // large batch's copies, into fresh memory, cost ten times its tracing on one).
+        let spans: Vec<(usize, usize)> = requests
+            .iter()
+            .scan(0, |at, r| {
                 let n = (r.sensor.width_px * r.sensor.height_px) as usize;
-                out.push(all[at..at + n].to_vec());
-                at += n;
-            }
+                *at += n;
+                Some((*at - n, n))
+            })
+            .collect();
+        let mut out = Vec::new();
+        self.trace(requests, |all| {
+            out = spans
+                .par_iter()
+                .map(|&(at, n)| all[at..at + n].to_vec())
+                .collect();
         })?;
         Ok(out)
     }
