@@ -18,7 +18,31 @@ use crate::sensor::Sensor;
 use bytemuck::{Pod, Zeroable};
 use nalgebra::Isometry2;
 use omniloop_vision::camera_model::CameraFile;
-use rayon::prelude::*;
+
+/// The frames at `spans` (start, length) of `all`, each its own vector. A large batch's copies,
+/// into fresh memory, cost ten times its tracing on one core, so they are shared among threads
+/// of their own: not rayon's, whose workers may all be waiting on this very batch (runs stepped
+/// in parallel that share the GPU).
+fn copy_frames(all: &[u32], spans: &[(usize, usize)]) -> Vec<Vec<u32>> {
+    let copy = |s: &[(usize, usize)]| -> Vec<Vec<u32>> {
+        s.iter().map(|&(at, n)| all[at..at + n].to_vec()).collect()
+    };
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if spans.len() < 2 * threads {
+        return copy(spans);
+    }
+    let per = spans.len().div_ceil(threads);
+    std::thread::scope(|scope| {
+        let parts: Vec<_> = spans
+            .chunks(per)
+            .map(|part| scope.spawn(move || copy(part)))
+            .collect();
+        parts
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
+}
 
 /// The sensor and pose of one frame, as the shader reads them.
 #[repr(C)]
@@ -489,8 +513,7 @@ impl GpuRenderer {
         if requests.is_empty() {
             return Ok(Vec::new());
         }
-        // Each frame's place in the readback; the frames are copied out on every core (a
-        // large batch's copies, into fresh memory, cost ten times its tracing on one).
+        // Each frame's place in the readback.
         let spans: Vec<(usize, usize)> = requests
             .iter()
             .scan(0, |at, r| {
@@ -500,12 +523,7 @@ impl GpuRenderer {
             })
             .collect();
         let mut out = Vec::new();
-        self.trace(requests, |all| {
-            out = spans
-                .par_iter()
-                .map(|&(at, n)| all[at..at + n].to_vec())
-                .collect();
-        })?;
+        self.trace(requests, |all| out = copy_frames(all, &spans))?;
         Ok(out)
     }
 
