@@ -8,7 +8,7 @@ use omniloop::load_scenario;
 use omniloop::run::render_snapshot;
 use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::optics::HyperbolicMirror;
-use omniloop_sim::render::SensorRays;
+use omniloop_sim::render::{CpuRenderer, SensorRays};
 use omniloop_sim::{
     FloorRect, FrameRequest, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorSpec, Wall,
 };
@@ -238,9 +238,15 @@ fn compared_scenes() -> Vec<(&'static str, Option<Isometry2<f64>>)> {
     v
 }
 
+/// Scenes of every kind of primitive beyond the render examples: striped boards, pillars and
+/// other robots (cylinders), a room's walls.
+const MORE_CPU_SCENES: [&str; 3] = ["heading_room", "omnistereo_arena", "corridor_passing"];
+
 #[test]
 fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
-    for (name, pose) in compared_scenes() {
+    let more = MORE_CPU_SCENES.iter().map(|n| (*n, None));
+    let mut checked = 0;
+    for (name, pose) in compared_scenes().into_iter().chain(more) {
         let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
         let mut bodies = s.robot_bodies();
         if let Some(p) = pose {
@@ -249,21 +255,48 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
         assert!(name != CORNER || !Scene::new(&s.world, &[]).quads.is_empty());
         let world = omniloop_sim::World::new(&s.world, &bodies, 0.002).unwrap();
         let scene = Scene::of_world(&world);
-        let pose = world.robot_state(0).pose;
+        let start = world.robot_state(0).pose;
+        // The start, turned (so that the packets fall across other sectors) and moved.
+        let poses = [
+            start,
+            Isometry2::new(start.translation.vector, start.rotation.angle() + 1.234_567),
+            Isometry2::new(
+                start.translation.vector + Vector2::new(137.0, -61.0),
+                start.rotation.angle() - 2.5,
+            ),
+        ];
         for spec in &s.robot.sensors {
             let sensor = spec.build();
-            let mut r = Renderer::cpu();
-            let culled = r.render_packed(&scene, &sensor, &pose).unwrap().to_vec();
-            let rays = SensorRays::new(&sensor);
-            let reference = omniloop_sim::render::cpu::render_reference(&scene, &rays, &pose);
-            let diff = culled
-                .iter()
-                .zip(&reference)
-                .filter(|(a, b)| a != b)
-                .count();
-            assert_eq!(diff, 0, "{name}/{}", spec.name);
+            let mut rays = SensorRays::new(&sensor);
+            for (k, pose) in poses.iter().enumerate() {
+                // The body must stand where the pose is: move the scene's robot with it.
+                let mut scene = scene.clone();
+                for c in &mut scene.cylinders {
+                    if c.geom[0] == start.translation.x as f32
+                        && c.geom[1] == start.translation.y as f32
+                    {
+                        c.geom[0] = pose.translation.x as f32;
+                        c.geom[1] = pose.translation.y as f32;
+                    }
+                }
+                let reference = omniloop_sim::render::cpu::render_reference(&scene, &rays, pose);
+                let mut vector = CpuRenderer::new();
+                let mut portable = CpuRenderer::portable();
+                for (kind, r) in [("vector", &mut vector), ("portable", &mut portable)] {
+                    let mut pixels = vec![0; reference.len()];
+                    r.render(&scene, &mut rays, pose, &mut pixels);
+                    let diff = pixels
+                        .iter()
+                        .zip(&reference)
+                        .filter(|(a, b)| a != b)
+                        .count();
+                    assert_eq!(diff, 0, "{name}/{} pose {k}, {kind} kernel", spec.name);
+                }
+                checked += 1;
+            }
         }
     }
+    assert!(checked >= 3 * 7, "only {checked} frames checked");
 }
 
 #[test]

@@ -1,24 +1,29 @@
-//! The CPU reference renderer (rayon over image rows).
+//! The CPU reference renderer: packets of eight rays, on every core.
 //!
 //! The mirror half of each pixel's path does not depend on the robot's pose, so it is traced
-//! once per sensor in `f64` and kept; every frame then transforms the cached rays to the world
-//! and traces the scene in `f32` with the functions of [`super::trace`]. Primitives are binned
-//! per frame into azimuth sectors around the sensor's axis and sorted by distance, so a ray
-//! that meets the floor near the robot tests only the few primitives nearer than that. A box's
-//! or quad's distance is that of its part inside the sector's wedge (a long wall is far in the
-//! sectors that look along it). The binning is conservative, and equal distances go to the
-//! primitive first in the scene's order, so the image is the same as tracing every primitive.
+//! once per sensor in `f64` and kept, sorted into packets of eight rays of neighbouring azimuth
+//! and elevation; every frame then transforms a packet's rays to the world and traces the
+//! scene in `f32` eight lanes at a time ([`packet`]), with the operations of [`super::trace`].
+//! Primitives are binned per frame into azimuth sectors around the sensor's axis and sorted by
+//! distance, so a ray that meets the floor near the robot tests only the few primitives nearer
+//! than that. A box's or quad's distance is that of its part inside the sector's wedge (a long
+//! wall is far in the sectors that look along it). The binning is conservative, and equal
+//! distances go to the primitive first in the scene's order, so the image is the same as
+//! tracing every primitive ([`render_reference`]).
 //!
-//! Further savings leave every value as it was: a primitive the ray passes over (above its top
+//! Further savings leave every value as it was: a primitive the rays pass over (above its top
 //! until past its footprint) is not tested, and a ray leaving above everything without going
-//! down is sky at once; the floor's colour is looked up only where nothing hides it; the shaded
-//! colours of the floor's paints, the sky and every face of a quad prism or plain box are
-//! computed once a frame; a quad's four sides are intersected as four lanes.
+//! down is sky at once; the shaded colours of the floor's paints, the sky, a cylinder's top and
+//! every face of a quad prism or plain box are computed once a frame; only the packets whose
+//! rays may meet the robot's own body test it.
+
+mod packet;
 
 use super::scene::Scene;
 use super::trace::{self, BLACK, FloorPaint, Hit, V3};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
+use packet::{FrameRays, LANES, Packet, Scatter};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -52,13 +57,16 @@ impl PixelRay {
 /// Per-sensor cache of pixel rays.
 #[derive(Debug, Clone)]
 pub struct SensorRays {
-    width: u32,
     rays: Vec<PixelRay>,
     axis: [f32; 2],
     max_offset_mm: f32,
     /// The robot body's radius and height (bits) for which each ray's body flag is set: the
     /// body is fixed to the sensor, so the flags hold for every pose.
     body: Option<[u32; 2]>,
+    /// The rays that see the mirror, in packets of neighbouring azimuth and elevation.
+    packets: Vec<Packet>,
+    /// The pixels that see no mirror.
+    blind: Vec<u32>,
 }
 
 /// Whether the ray `o + t d` (`t > 0`) comes within `r` of the vertical axis through the
@@ -110,7 +118,8 @@ impl SensorRays {
                         PixelRay {
                             o: [r.origin.x as f32, r.origin.y as f32, r.origin.z as f32],
                             d,
-                            azimuth: turns(d[1].atan2(d[0]) as f64),
+                            // The body flag's bit clear until the body is known.
+                            azimuth: turns(d[1].atan2(d[0]) as f64) & !1,
                             d_xy: (d[0] * d[0] + d[1] * d[1]).sqrt(),
                         }
                     }
@@ -123,12 +132,14 @@ impl SensorRays {
                 });
             }
         }
+        let (packets, blind) = packets(&rays);
         Self {
-            width: w,
             rays,
             axis: [sensor.mount_mm[0] as f32, sensor.mount_mm[1] as f32],
             max_offset_mm: max_offset as f32,
             body: None,
+            packets,
+            blind,
         }
     }
 
@@ -144,9 +155,54 @@ impl SensorRays {
                 let meets = ray.valid() && may_meet_cylinder(ray.o, ray.d, r, z_top);
                 ray.azimuth = (ray.azimuth & !1) | meets as u32;
             }
+            (self.packets, self.blind) = packets(&self.rays);
             self.body = Some(key);
         }
     }
+}
+
+/// Azimuth buckets (a power of two) of the packets' order: eight to a sector, so that a
+/// bucket's rays fall in at most two sectors whatever the heading.
+const BUCKETS: u32 = 2048;
+
+/// The rays that see the mirror in packets, and the pixels that see no mirror. The rays that
+/// may meet the robot's body come first; each part is ordered by azimuth bucket, then
+/// elevation, so that a packet's rays meet the same primitives.
+fn packets(rays: &[PixelRay]) -> (Vec<Packet>, Vec<u32>) {
+    let (mut seen, mut blind): (Vec<u32>, Vec<u32>) =
+        (0..rays.len() as u32).partition(|&k| rays[k as usize].valid());
+    seen.sort_by(|&a, &b| {
+        let (ra, rb) = (&rays[a as usize], &rays[b as usize]);
+        let bucket = |r: &PixelRay| r.azimuth / (u32::MAX / BUCKETS + 1);
+        (rb.may_meet_body().cmp(&ra.may_meet_body()))
+            .then(bucket(ra).cmp(&bucket(rb)))
+            .then(ra.d[2].total_cmp(&rb.d[2]))
+            .then(a.cmp(&b))
+    });
+    let packets = seen
+        .chunks(LANES)
+        .map(|chunk| {
+            let mut p = Packet::default();
+            for lane in 0..LANES {
+                // A short last packet repeats its last ray (the same pixel, the same colour).
+                let k = chunk[lane.min(chunk.len() - 1)];
+                let r = &rays[k as usize];
+                for axis in 0..3 {
+                    p.o[axis][lane] = r.o[axis];
+                    p.d[axis][lane] = r.d[axis];
+                }
+                p.d_xy[lane] = r.d_xy;
+                p.floor_t[lane] = trace::floor_t(r.o, r.d).unwrap_or(-1.0);
+                p.inv_dz[lane] = 1.0 / r.d[2];
+                p.azimuth[lane] = r.azimuth;
+                p.pixel[lane] = k;
+                p.may_meet_body |= r.may_meet_body();
+            }
+            p
+        })
+        .collect();
+    blind.shrink_to_fit();
+    (packets, blind)
 }
 
 /// Margin (mm) by which a ray must miss the body, in the robot frame, to be left untested.
@@ -199,20 +255,34 @@ struct Sectors {
     /// Each quad prism's sides, prepared once a frame.
     quad_sides: Vec<trace::QuadSides>,
     /// Each quad prism's shaded, packed colour on each face ([`trace::QuadFace::index`]).
-    quad_faces: Vec<[u32; 6]>,
+    quad_faces: Vec<FaceColours>,
     /// Each box's shaded, packed colour on each face ([`trace::BoxFace::index`]); a striped
     /// board's are shaded as it is hit.
-    box_faces: Vec<[u32; 6]>,
+    box_faces: Vec<FaceColours>,
     /// The shaded, packed colour of each floor paint: one per floor rectangle, then outside,
     /// line and bare floor.
     palette: Vec<u32>,
+    /// The palette in one register's lanes, where it fits (up to five floor rectangles).
+    palette_lanes: Option<[u32; LANES]>,
     /// The packed colour of the sky.
     sky: u32,
+    /// Each cylinder's shaded, packed colour on its top.
+    cylinder_tops: Vec<u32>,
     /// The highest top of any primitive plus [`CULL_MARGIN_MM`]: a ray from above it that does
     /// not go down meets nothing.
     top_mm: f32,
     /// The number of boxes and of quads, for [`Sectors::rank`].
     counts: [u32; 2],
+}
+
+/// The shaded, packed colours of a primitive's six faces in the order of their `index`, and two
+/// unused lanes (so that a packet reads them as one register).
+type FaceColours = [u32; LANES];
+
+fn face_colours(faces: [u32; 6]) -> FaceColours {
+    let mut lanes = [0; LANES];
+    lanes[..6].copy_from_slice(&faces);
+    lanes
 }
 
 /// An angle (rad) as a fraction of a turn in 32 bits (wrapping).
@@ -380,23 +450,33 @@ impl Sectors {
         self.box_faces.clear();
         self.box_faces.extend(scene.boxes.iter().map(|b| {
             let rgb = [b.color[0], b.color[1], b.color[2]];
-            trace::BoxFace::ALL.map(|f| shaded(f.normal(b), rgb))
+            face_colours(trace::BoxFace::ALL.map(|f| shaded(f.normal(b), rgb)))
         }));
         self.quad_faces.clear();
         self.quad_faces
             .extend(scene.quads.iter().zip(&self.quad_sides).map(|(q, sides)| {
                 let rgb = [q.color[0], q.color[1], q.color[2]];
-                trace::QuadFace::ALL.map(|f| shaded(f.normal(sides), rgb))
+                face_colours(trace::QuadFace::ALL.map(|f| shaded(f.normal(sides), rgb)))
             }));
         let paints = (0..scene.floor_rects.len()).map(FloorPaint::Mark).chain([
             FloorPaint::Outside,
             FloorPaint::Line,
             FloorPaint::Floor,
         ]);
+        self.cylinder_tops.clear();
+        self.cylinder_tops.extend(
+            (scene.cylinders.iter())
+                .map(|c| shaded([0.0, 0.0, 1.0], [c.top[0], c.top[1], c.top[2]])),
+        );
         self.palette.clear();
         self.palette.extend(
             paints.map(|paint| shaded(trace::FLOOR_NORMAL, trace::paint_color(scene, paint))),
         );
+        self.palette_lanes = (self.palette.len() <= LANES).then(|| {
+            let mut lanes = [0; LANES];
+            lanes[..self.palette.len()].copy_from_slice(&self.palette);
+            lanes
+        });
         let g = &scene.globals;
         self.sky = trace::pack([g.sky_rgb[0], g.sky_rgb[1], g.sky_rgb[2]]);
         let tops = (scene.boxes.iter().map(|b| b.frame[3]))
@@ -562,12 +642,23 @@ impl Sectors {
 #[derive(Debug, Default)]
 pub struct CpuRenderer {
     sectors: Sectors,
+    /// Whether to trace without the processor's vector instructions.
+    portable: bool,
 }
 
 impl CpuRenderer {
-    /// A renderer.
+    /// A renderer, in the widest vector instructions the processor has.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// A renderer that uses no vector instructions chosen at run time: the reference its
+    /// vector kernel is checked against (the images are the same to the bit).
+    pub fn portable() -> Self {
+        Self {
+            portable: true,
+            ..Self::default()
+        }
     }
 
     /// Renders one frame: `rays` of a sensor on a robot at `pose`, into packed RGBA8 pixels
@@ -601,136 +692,25 @@ impl CpuRenderer {
             let [_, _, r, top] = scene.cylinders[i].geom;
             rays.prepare_body(r, top);
         }
-        let rays: &SensorRays = rays;
-        let sectors = &self.sectors;
-        let heading = turns(theta);
-        let width = rays.width as usize;
-        pixels
-            .par_chunks_mut(width)
-            .zip(rays.rays.par_chunks(width))
-            .for_each(|(row, row_rays)| {
-                for (out, r) in row.iter_mut().zip(row_rays) {
-                    if !r.valid() {
-                        *out = BLACK;
-                        continue;
-                    }
-                    let o = [
-                        px + c * r.o[0] - s * r.o[1],
-                        py + s * r.o[0] + c * r.o[1],
-                        r.o[2],
-                    ];
-                    let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
-                    let sector = (r.azimuth.wrapping_add(heading) >> SECTOR_SHIFT) as usize;
-                    let body = body.filter(|_| r.may_meet_body());
-                    *out = trace_culled(scene, sectors, sector, o, d, r.d_xy, rho, body);
-                }
-            });
-    }
-}
-
-/// Traces one world ray against the floor and the primitives of its sector (nearest first,
-/// stopping where none can be nearer), and against cylinder `body` (binned in no sector).
-#[allow(clippy::too_many_arguments)]
-fn trace_culled(
-    scene: &Scene,
-    sectors: &Sectors,
-    sector: usize,
-    o: V3,
-    d: V3,
-    d_xy: f32,
-    rho: f32,
-    body: Option<usize>,
-) -> u32 {
-    // A ray that leaves above everything and does not come down passes over every item.
-    if d[2] >= 0.0 && o[2] > sectors.top_mm {
-        return sectors.sky;
-    }
-    // The floor's colour is looked up only if nothing nearer hides it.
-    let t_floor = trace::floor_t(o, d);
-    let mut best = Best::Nothing;
-    let mut t_max = t_floor.unwrap_or(f32::INFINITY);
-    // Equal distances go to the primitive first in the scene's order (the floor, then boxes,
-    // quads and cylinders), as when every primitive is traced, whatever order they are tested in.
-    let mut best_rank = 0;
-    if let Some(i) = body
-        && let Some(h) = trace::hit_cylinder(&scene.cylinders[i], o, d, t_max)
-    {
-        t_max = h.t;
-        best = Best::Hit(h);
-        best_rank = sectors.rank(Prim::Cylinder(i as u32));
-    }
-    let range = sectors.offsets[sector] as usize..sectors.offsets[sector + 1] as usize;
-    for item in &sectors.items[range] {
-        if item.d_min >= t_max * d_xy + rho + 1.0 {
-            break;
-        }
-        if item.passes_over(o[2], d[2], d_xy) {
-            continue;
-        }
-        let rank = sectors.rank(item.prim);
-        let limit = if rank < best_rank {
-            t_max.next_up()
-        } else {
-            t_max
+        let frame = FrameRays {
+            scene,
+            sectors: &self.sectors,
+            pose: [px, py, c, s],
+            heading: turns(theta),
+            rho,
+            body,
         };
-        let (t, found) = match item.prim {
-            Prim::Box(i) => {
-                let i = i as usize;
-                let b = &scene.boxes[i];
-                if b.color[3] >= 0.0 {
-                    match trace::hit_box(scene, b, o, d, limit) {
-                        Some(h) => (h.t, Best::Hit(h)),
-                        None => continue,
-                    }
-                } else {
-                    match trace::hit_box_face(b, o, d, limit) {
-                        Some((t, face, _)) => (t, Best::Packed(sectors.box_faces[i][face.index()])),
-                        None => continue,
-                    }
-                }
-            }
-            Prim::Quad(i) => {
-                let i = i as usize;
-                let q = &scene.quads[i];
-                match trace::hit_quad_face(q, &sectors.quad_sides[i], o, d, limit) {
-                    Some((t, face)) => (t, Best::Packed(sectors.quad_faces[i][face.index()])),
-                    None => continue,
-                }
-            }
-            Prim::Cylinder(i) => {
-                match trace::hit_cylinder(&scene.cylinders[i as usize], o, d, limit) {
-                    Some(h) => (h.t, Best::Hit(h)),
-                    None => continue,
-                }
-            }
-        };
-        t_max = t;
-        best = found;
-        best_rank = rank;
-    }
-    match (best, t_floor) {
-        (Best::Hit(h), _) => trace::pack(trace::shade(scene, &h)),
-        (Best::Packed(p), _) => p,
-        (Best::Nothing, Some(t)) => {
-            let paint = trace::floor_paint(scene, o[0] + t * d[0], o[1] + t * d[1]);
-            let n = scene.floor_rects.len();
-            sectors.palette[match paint {
-                FloorPaint::Mark(i) => i,
-                FloorPaint::Outside => n,
-                FloorPaint::Line => n + 1,
-                FloorPaint::Floor => n + 2,
-            }]
+        for &k in &rays.blind {
+            pixels[k as usize] = BLACK;
         }
-        (Best::Nothing, None) => sectors.sky,
+        let trace_chunk = packet::trace_chunk_fn(self.portable);
+        let out = Scatter::new(pixels);
+        // Chunks of packets small enough to share out over the cores, large enough to cost
+        // little to hand out.
+        rays.packets
+            .par_chunks(32)
+            .for_each(|chunk| trace_chunk(&frame, chunk, &out));
     }
-}
-
-/// The nearest hit so far: none, one to shade, or one whose shaded colour is known.
-#[derive(Debug, Clone, Copy)]
-enum Best {
-    Nothing,
-    Hit(Hit),
-    Packed(u32),
 }
 
 /// Renders every primitive for every pixel, without binning (the reference of the tests).

@@ -53,7 +53,7 @@ impl FromStr for RendererChoice {
 }
 
 enum Backend {
-    Cpu(CpuRenderer),
+    Cpu(Box<CpuRenderer>),
     Gpu(Box<GpuRenderer>),
     Shared(BatchClient),
 }
@@ -72,7 +72,7 @@ impl Renderer {
     /// these frames slower than the CPU renderer), the CPU, saying why through `notice`.
     pub fn new(choice: RendererChoice, notice: impl FnOnce(&str)) -> Result<Self, RenderError> {
         let backend = match choice {
-            RendererChoice::Cpu => Backend::Cpu(CpuRenderer::new()),
+            RendererChoice::Cpu => Backend::Cpu(Box::default()),
             RendererChoice::Gpu => Backend::Gpu(Box::new(GpuRenderer::new()?)),
             RendererChoice::Auto => match GpuRenderer::adapter() {
                 Ok(a) if a.get_info().device_type == wgpu::DeviceType::Cpu => {
@@ -81,13 +81,13 @@ impl Renderer {
                          renderer, which is faster here (--renderer gpu uses the adapter anyway)",
                         a.get_info().name
                     ));
-                    Backend::Cpu(CpuRenderer::new())
+                    Backend::Cpu(Box::default())
                 }
                 other => match other.and_then(GpuRenderer::with_adapter) {
                     Ok(g) => Backend::Gpu(Box::new(g)),
                     Err(e) => {
                         notice(&format!("renderer: {e}; using the CPU renderer"));
-                        Backend::Cpu(CpuRenderer::new())
+                        Backend::Cpu(Box::default())
                     }
                 },
             },
@@ -119,7 +119,7 @@ impl Renderer {
     /// The CPU renderer.
     pub fn cpu() -> Self {
         Self {
-            backend: Backend::Cpu(CpuRenderer::new()),
+            backend: Backend::Cpu(Box::default()),
             name: cpu_name(),
             rays: Vec::new(),
             pixels: Vec::new(),
