@@ -163,7 +163,7 @@ impl SensorRays {
 
 /// Azimuth buckets (a power of two) of the packets' order: eight to a sector, so that a
 /// bucket's rays fall in at most two sectors whatever the heading.
-const BUCKETS: u32 = 2048;
+const BUCKETS: u32 = 256;
 
 /// The rays that see the mirror in packets, and the pixels that see no mirror. The rays that
 /// may meet the robot's body come first; each part is ordered by azimuth bucket, then
@@ -174,9 +174,16 @@ fn packets(rays: &[PixelRay]) -> (Vec<Packet>, Vec<u32>) {
     seen.sort_by(|&a, &b| {
         let (ra, rb) = (&rays[a as usize], &rays[b as usize]);
         let bucket = |r: &PixelRay| r.azimuth / (u32::MAX / BUCKETS + 1);
+        // Up in even buckets, down in odd ones: a packet across two buckets joins their
+        // ends of the same elevation.
+        let elevation = if bucket(ra) % 2 == 0 {
+            ra.d[2].total_cmp(&rb.d[2])
+        } else {
+            rb.d[2].total_cmp(&ra.d[2])
+        };
         (rb.may_meet_body().cmp(&ra.may_meet_body()))
             .then(bucket(ra).cmp(&bucket(rb)))
-            .then(ra.d[2].total_cmp(&rb.d[2]))
+            .then(elevation)
             .then(a.cmp(&b))
     });
     let packets = seen
