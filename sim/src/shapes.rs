@@ -145,6 +145,54 @@ impl SolidShape {
         }
     }
 
+    /// A circle that holds the footprint: its centre and radius (mm). The signed distance
+    /// from a point `p` to the footprint is at least `|p - centre| - radius`.
+    pub fn bounding_circle(&self) -> (Point2<f64>, f64) {
+        match *self {
+            SolidShape::Box {
+                center_mm,
+                half_extents_mm,
+                ..
+            } => (center_mm, half_extents_mm.norm()),
+            SolidShape::Cylinder {
+                center_mm,
+                radius_mm,
+            } => (center_mm, radius_mm),
+            SolidShape::Quad { corners_mm } => {
+                let sum = corners_mm
+                    .iter()
+                    .fold(Vector2::zeros(), |s, c| s + c.coords);
+                let centre = Point2::from(sum / 4.0);
+                let radius = corners_mm
+                    .iter()
+                    .map(|c| (c - centre).norm())
+                    .fold(0.0, f64::max);
+                (centre, radius)
+            }
+        }
+    }
+
+    /// Whether a ray from `origin` along the unit direction `dir` may meet the footprint
+    /// within `max_mm`, judged by its bounding circle `bounds` ([`Self::bounding_circle`],
+    /// widened by a micrometre for rounding): false only where [`Self::ray_cast_mm`] finds
+    /// nothing.
+    pub fn ray_may_meet(
+        bounds: (Point2<f64>, f64),
+        origin: Point2<f64>,
+        dir: Vector2<f64>,
+        max_mm: f64,
+    ) -> bool {
+        let (centre, radius) = (bounds.0, bounds.1 + 1e-3);
+        let m = origin - centre;
+        let c = m.norm_squared() - radius * radius;
+        if c <= 0.0 {
+            return true;
+        }
+        let b = m.dot(&dir);
+        let disc = b * b - c;
+        b < 0.0 && disc >= 0.0 && -b - disc.sqrt() <= max_mm + 1e-3
+    }
+
     /// Distance along the unit direction `dir` from `origin` to the first point of the
     /// footprint, if it is hit within `max_mm`. An origin inside the footprint gives 0.
     pub fn ray_cast_mm(&self, origin: Point2<f64>, dir: Vector2<f64>, max_mm: f64) -> Option<f64> {
@@ -212,6 +260,59 @@ mod tests {
             half_extents_mm: Vector2::new(10.0, 20.0),
             angle_rad: std::f64::consts::FRAC_PI_2,
         }
+    }
+
+    #[test]
+    fn no_point_or_ray_meets_a_footprint_nearer_than_its_bounding_circle_allows() {
+        let shapes = [
+            unit_box(),
+            SolidShape::Cylinder {
+                center_mm: Point2::new(-40.0, 25.0),
+                radius_mm: 35.0,
+            },
+            SolidShape::Quad {
+                corners_mm: [
+                    Point2::new(0.0, 0.0),
+                    Point2::new(90.0, -30.0),
+                    Point2::new(60.0, 40.0),
+                    Point2::new(60.0, 40.0),
+                ],
+            },
+        ];
+        let (mut inside, mut tight, mut spared, mut hits) = (0, 0, 0, 0);
+        for shape in &shapes {
+            let (centre, radius) = shape.bounding_circle();
+            for k in 0..4000 {
+                // A spiral of points in and around every footprint.
+                let a = k as f64 * 2.399_963;
+                let rho = 0.06 * k as f64;
+                let p = Point2::new(20.0 + rho * a.cos(), rho * a.sin());
+                let d = shape.distance_mm(p);
+                let bound = (p - centre).norm() - radius;
+                assert!(d >= bound - 1e-9, "{shape:?} at {p}: {d} < {bound}");
+                // Rays from the point: none meets the footprint where the circle says none can.
+                for j in 0..8 {
+                    let a = j as f64 * 0.785_398 + 0.1;
+                    let dir = Vector2::new(a.cos(), a.sin());
+                    let max = 20.0 + (k % 7) as f64 * 15.0;
+                    let may = SolidShape::ray_may_meet((centre, radius), p, dir, max);
+                    let hit = shape.ray_cast_mm(p, dir, max);
+                    assert!(
+                        may || hit.is_none(),
+                        "{shape:?} from {p} along {dir}: {hit:?}"
+                    );
+                    spared += usize::from(!may);
+                    hits += usize::from(hit.is_some());
+                }
+                inside += usize::from(d < 0.0);
+                tight += usize::from(d - bound < 5.0);
+            }
+        }
+        assert!(
+            inside > 100 && tight > 100,
+            "inside {inside}, tight {tight}"
+        );
+        assert!(spared > 1000 && hits > 1000, "spared {spared}, hits {hits}");
     }
 
     #[test]

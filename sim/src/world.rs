@@ -116,6 +116,9 @@ pub struct World {
     physics: PhysicsWorld,
     layout: Layout,
     solids: Vec<Solid>,
+    /// Each solid's bounding circle (centre, radius in mm), which spares the clearance most
+    /// distances.
+    solid_bounds: Vec<(Point2<f64>, f64)>,
     robots: Vec<Robot>,
     events: ChannelEventCollector,
     collisions: Receiver<CollisionEvent>,
@@ -207,6 +210,7 @@ impl World {
         Ok(Self {
             physics,
             layout: layout.clone(),
+            solid_bounds: solids.iter().map(|s| s.shape.bounding_circle()).collect(),
             solids,
             robots: out,
             events: ChannelEventCollector::new(ctx, ftx, ttx),
@@ -315,7 +319,12 @@ impl World {
         let p = Point2::from(me.pose.translation.vector);
         let r = self.robots[i].spec.radius_mm;
         let mut solids = f64::INFINITY;
-        for s in &self.solids {
+        for (s, (centre, radius)) in self.solids.iter().zip(&self.solid_bounds) {
+            // A solid is no nearer than its bounding circle: one that cannot be nearer than
+            // the nearest so far (with a micrometre for rounding) leaves the minimum as it is.
+            if (p - centre).norm() - radius - r - 1e-3 > solids {
+                continue;
+            }
             solids = solids.min(s.shape.distance_mm(p) - r);
         }
         let mut robots = f64::INFINITY;
@@ -378,10 +387,13 @@ impl World {
         max_mm: f64,
         except: Option<usize>,
     ) -> Option<f64> {
-        self.solids
-            .iter()
-            .chain(self.robot_solids(except).iter())
-            .filter_map(|s| s.shape.ray_cast_mm(origin, dir, max_mm))
+        let robots = self.robot_solids(except);
+        let bounded = (self.solids.iter().zip(self.solid_bounds.iter().copied()))
+            .chain(robots.iter().map(|s| (s, s.shape.bounding_circle())));
+        // A solid whose bounding circle the ray misses within `max_mm` is not cast against.
+        bounded
+            .filter(|(_, bounds)| SolidShape::ray_may_meet(*bounds, origin, dir, max_mm))
+            .filter_map(|(s, _)| s.shape.ray_cast_mm(origin, dir, max_mm))
             .min_by(f64::total_cmp)
     }
 
