@@ -267,7 +267,12 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
         ];
         for spec in &s.robot.sensors {
             let sensor = spec.build();
-            let mut rays = SensorRays::new(&sensor);
+            // Packets ordered by elevation too (a sensor traced once), and by azimuth alone (one
+            // traced again each frame), each traced by both kernels.
+            let mut orders = [
+                ("by elevation", SensorRays::new(&sensor)),
+                ("by azimuth", SensorRays::retraced(&sensor)),
+            ];
             for (k, pose) in poses.iter().enumerate() {
                 // The body must stand where the pose is: move the scene's robot with it.
                 let mut scene = scene.clone();
@@ -279,18 +284,26 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
                         c.geom[1] = pose.translation.y as f32;
                     }
                 }
-                let reference = omniloop_sim::render::cpu::render_reference(&scene, &rays, pose);
-                let mut vector = CpuRenderer::new();
-                let mut portable = CpuRenderer::portable();
-                for (kind, r) in [("vector", &mut vector), ("portable", &mut portable)] {
-                    let mut pixels = vec![0; reference.len()];
-                    r.render(&scene, &mut rays, pose, &mut pixels);
-                    let diff = pixels
-                        .iter()
-                        .zip(&reference)
-                        .filter(|(a, b)| a != b)
-                        .count();
-                    assert_eq!(diff, 0, "{name}/{} pose {k}, {kind} kernel", spec.name);
+                let reference =
+                    omniloop_sim::render::cpu::render_reference(&scene, &orders[0].1, pose);
+                for (order, rays) in &mut orders {
+                    for (kind, mut r) in [
+                        ("vector", CpuRenderer::new()),
+                        ("portable", CpuRenderer::portable()),
+                    ] {
+                        let mut pixels = vec![0; reference.len()];
+                        r.render(&scene, rays, pose, &mut pixels);
+                        let diff = pixels
+                            .iter()
+                            .zip(&reference)
+                            .filter(|(a, b)| a != b)
+                            .count();
+                        assert_eq!(
+                            diff, 0,
+                            "{name}/{} pose {k}, {kind} kernel, packets {order}",
+                            spec.name
+                        );
+                    }
                 }
                 checked += 1;
             }

@@ -63,8 +63,11 @@ pub struct SensorRays {
     /// The robot body's radius and height (bits) for which each ray's body flag is set: the
     /// body is fixed to the sensor, so the flags hold for every pose.
     body: Option<[u32; 2]>,
-    /// The rays that see the mirror, in packets of neighbouring azimuth and elevation.
+    /// The rays that see the mirror, in packets of neighbouring azimuth (and elevation), made
+    /// at the first frame that needs them.
     packets: Vec<Packet>,
+    /// Whether the packets are ordered by elevation within their azimuth bucket too.
+    by_elevation: bool,
     /// The pixels that see no mirror.
     blind: Vec<u32>,
 }
@@ -102,6 +105,17 @@ fn may_meet_cylinder(o: V3, d: V3, r: f32, top: f32) -> bool {
 impl SensorRays {
     /// Traces the mirror half of every pixel of `sensor`.
     pub fn new(sensor: &Sensor) -> Self {
+        Self::traced(sensor, true)
+    }
+
+    /// [`SensorRays::new`] for a sensor traced again at every frame (a camera on a pan unit):
+    /// its packets are ordered by azimuth alone, in one pass over the rays, not sorted by
+    /// elevation too (a little slower to trace, much quicker to make).
+    pub fn retraced(sensor: &Sensor) -> Self {
+        Self::traced(sensor, false)
+    }
+
+    fn traced(sensor: &Sensor, by_elevation: bool) -> Self {
         let (w, h) = (sensor.width_px, sensor.height_px);
         let mut rays = Vec::with_capacity((w * h) as usize);
         // The farthest a ray starts from the axis: the optics' bound, or beyond it where a
@@ -132,14 +146,22 @@ impl SensorRays {
                 });
             }
         }
-        let (packets, blind) = packets(&rays);
         Self {
             rays,
             axis: [sensor.mount_mm[0] as f32, sensor.mount_mm[1] as f32],
             max_offset_mm: max_offset as f32,
             body: None,
-            packets,
-            blind,
+            packets: Vec::new(),
+            by_elevation,
+            blind: Vec::new(),
+        }
+    }
+
+    /// Makes the packets if they are not made (at the first frame, or after the body's flags
+    /// changed).
+    fn prepare_packets(&mut self) {
+        if self.packets.is_empty() {
+            (self.packets, self.blind) = packets(&self.rays, self.by_elevation);
         }
     }
 
@@ -155,7 +177,7 @@ impl SensorRays {
                 let meets = ray.valid() && may_meet_cylinder(ray.o, ray.d, r, z_top);
                 ray.azimuth = (ray.azimuth & !1) | meets as u32;
             }
-            (self.packets, self.blind) = packets(&self.rays);
+            self.packets.clear();
             self.body = Some(key);
         }
     }
@@ -168,24 +190,21 @@ const BUCKETS: u32 = 256;
 /// The rays that see the mirror in packets, and the pixels that see no mirror. The rays that
 /// may meet the robot's body come first; each part is ordered by azimuth bucket, then
 /// elevation, so that a packet's rays meet the same primitives.
-fn packets(rays: &[PixelRay]) -> (Vec<Packet>, Vec<u32>) {
-    let (mut seen, mut blind): (Vec<u32>, Vec<u32>) =
-        (0..rays.len() as u32).partition(|&k| rays[k as usize].valid());
-    seen.sort_by(|&a, &b| {
-        let (ra, rb) = (&rays[a as usize], &rays[b as usize]);
-        let bucket = |r: &PixelRay| r.azimuth / (u32::MAX / BUCKETS + 1);
-        // Up in even buckets, down in odd ones: a packet across two buckets joins their
-        // ends of the same elevation.
-        let elevation = if bucket(ra) % 2 == 0 {
-            ra.d[2].total_cmp(&rb.d[2])
-        } else {
-            rb.d[2].total_cmp(&ra.d[2])
-        };
-        (rb.may_meet_body().cmp(&ra.may_meet_body()))
-            .then(bucket(ra).cmp(&bucket(rb)))
-            .then(elevation)
-            .then(a.cmp(&b))
-    });
+fn packets(rays: &[PixelRay], by_elevation: bool) -> (Vec<Packet>, Vec<u32>) {
+    let blind: Vec<u32> = (0..rays.len() as u32)
+        .filter(|&k| !rays[k as usize].valid())
+        .collect();
+    let seen = if by_elevation {
+        let mut keys: Vec<u128> = (0..rays.len() as u32)
+            .filter(|&k| rays[k as usize].valid())
+            .map(|k| packet_order(&rays[k as usize], k))
+            .collect();
+        // The keys are distinct (each holds its pixel), so an unstable sort gives one order.
+        keys.sort_unstable();
+        keys.iter().map(|&key| key as u32).collect()
+    } else {
+        by_bucket(rays)
+    };
     let packets = seen
         .chunks(LANES)
         .map(|chunk| {
@@ -208,8 +227,43 @@ fn packets(rays: &[PixelRay]) -> (Vec<Packet>, Vec<u32>) {
             p
         })
         .collect();
-    blind.shrink_to_fit();
     (packets, blind)
+}
+
+/// The rays that see the mirror, those that may meet the body first, then by azimuth bucket,
+/// each class in pixel order (a counting sort).
+fn by_bucket(rays: &[PixelRay]) -> Vec<u32> {
+    let class = |r: &PixelRay| {
+        let bucket = (r.azimuth / (u32::MAX / BUCKETS + 1)) as usize;
+        usize::from(!r.may_meet_body()) * BUCKETS as usize + bucket
+    };
+    let mut start = vec![0usize; 2 * BUCKETS as usize + 1];
+    for r in rays.iter().filter(|r| r.valid()) {
+        start[class(r) + 1] += 1;
+    }
+    for k in 1..start.len() {
+        start[k] += start[k - 1];
+    }
+    let mut seen = vec![0; start[start.len() - 1]];
+    for (k, r) in rays.iter().enumerate().filter(|(_, r)| r.valid()) {
+        let c = class(r);
+        seen[start[c]] = k as u32;
+        start[c] += 1;
+    }
+    seen
+}
+
+/// A ray's place in the packets' order, as one number: first the rays that may meet the body,
+/// then by azimuth bucket, then by elevation (`d_z`), up in even buckets and down in odd ones
+/// (so that a packet across two buckets joins their ends of the same elevation), then by pixel.
+fn packet_order(r: &PixelRay, pixel: u32) -> u128 {
+    let bucket = r.azimuth / (u32::MAX / BUCKETS + 1);
+    // `f32::total_cmp`'s order as an unsigned number.
+    let z = r.d[2].to_bits();
+    let up = if z >> 31 == 1 { !z } else { z | 1 << 31 };
+    let elevation = if bucket % 2 == 0 { up } else { !up };
+    let body = u128::from(!r.may_meet_body());
+    body << 72 | u128::from(bucket) << 64 | u128::from(elevation) << 32 | u128::from(pixel)
 }
 
 /// Margin (mm) by which a ray must miss the body, in the robot frame, to be left untested.
@@ -699,6 +753,7 @@ impl CpuRenderer {
             let [_, _, r, top] = scene.cylinders[i].geom;
             rays.prepare_body(r, top);
         }
+        rays.prepare_packets();
         let frame = FrameRays {
             scene,
             sectors: &self.sectors,

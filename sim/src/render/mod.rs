@@ -175,7 +175,7 @@ impl Renderer {
                 let k = match self.rays.iter().position(|(s, _)| s.name == sensor.name) {
                     Some(k) => {
                         if self.rays[k].0 != *sensor {
-                            self.rays[k] = (sensor.clone(), SensorRays::new(sensor));
+                            self.rays[k] = (sensor.clone(), SensorRays::retraced(sensor));
                         }
                         k
                     }
