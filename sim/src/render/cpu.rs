@@ -261,7 +261,7 @@ fn packet_order(r: &PixelRay, pixel: u32) -> u128 {
     // `f32::total_cmp`'s order as an unsigned number.
     let z = r.d[2].to_bits();
     let up = if z >> 31 == 1 { !z } else { z | 1 << 31 };
-    let elevation = if bucket % 2 == 0 { up } else { !up };
+    let elevation = if bucket.is_multiple_of(2) { up } else { !up };
     let body = u128::from(!r.may_meet_body());
     body << 72 | u128::from(bucket) << 64 | u128::from(elevation) << 32 | u128::from(pixel)
 }
