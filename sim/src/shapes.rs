@@ -292,7 +292,7 @@ mod tests {
                 assert!(d >= bound - 1e-9, "{shape:?} at {p}: {d} < {bound}");
                 // Rays from the point: none meets the footprint where the circle says none can.
                 for j in 0..8 {
-                    let a = j as f64 * 0.785_398 + 0.1;
+                    let a = j as f64 * std::f64::consts::FRAC_PI_4 + 0.1;
                     let dir = Vector2::new(a.cos(), a.sin());
                     let max = 20.0 + (k % 7) as f64 * 15.0;
                     let may = SolidShape::ray_may_meet((centre, radius), p, dir, max);

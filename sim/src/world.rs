@@ -135,6 +135,28 @@ fn vec(v: Vector2<f64>) -> Vector {
     Vector::new(v.x as Real, v.y as Real)
 }
 
+/// The collider of a solid's footprint.
+fn solid_collider(shape: &SolidShape) -> Result<ColliderBuilder, SimError> {
+    Ok(match *shape {
+        SolidShape::Box {
+            center_mm,
+            half_extents_mm,
+            angle_rad,
+        } => ColliderBuilder::cuboid(half_extents_mm.x as Real, half_extents_mm.y as Real)
+            .translation(vec(center_mm.coords))
+            .rotation(angle_rad as Real),
+        SolidShape::Cylinder {
+            center_mm,
+            radius_mm,
+        } => ColliderBuilder::ball(radius_mm as Real).translation(vec(center_mm.coords)),
+        SolidShape::Quad { corners_mm } => {
+            let points: Vec<Vector> = corners_mm.iter().map(|c| vec(c.coords)).collect();
+            ColliderBuilder::convex_hull(&points)
+                .ok_or_else(|| SimError::Invalid(format!("degenerate wall piece {corners_mm:?}")))?
+        }
+    })
+}
+
 impl World {
     /// Builds the world from its layout and robots, stepping physics every `physics_step_s`.
     pub fn new(
@@ -155,25 +177,7 @@ impl World {
         let solids = layout.solids();
         let mut owners = Vec::with_capacity(solids.len() + robots.len());
         for s in &solids {
-            let collider = match s.shape {
-                SolidShape::Box {
-                    center_mm,
-                    half_extents_mm,
-                    angle_rad,
-                } => ColliderBuilder::cuboid(half_extents_mm.x as Real, half_extents_mm.y as Real)
-                    .translation(vec(center_mm.coords))
-                    .rotation(angle_rad as Real),
-                SolidShape::Cylinder {
-                    center_mm,
-                    radius_mm,
-                } => ColliderBuilder::ball(radius_mm as Real).translation(vec(center_mm.coords)),
-                SolidShape::Quad { corners_mm } => {
-                    let points: Vec<Vector> = corners_mm.iter().map(|c| vec(c.coords)).collect();
-                    ColliderBuilder::convex_hull(&points).ok_or_else(|| {
-                        SimError::Invalid(format!("degenerate wall piece {corners_mm:?}"))
-                    })?
-                }
-            };
+            let collider = solid_collider(&s.shape)?;
             let h = physics.insert_collider(collider.friction(0.0).restitution(0.0), None);
             owners.push((h, Owner::Solid(owners.len())));
         }
