@@ -46,7 +46,7 @@ pub(super) struct Packet {
     pub azimuth: U,
     /// The pixel each lane colours (a short packet repeats its last ray).
     pub pixel: U,
-    /// Whether a lane's ray may meet the robot's body.
+    /// Whether any lane's ray may meet the robot's body.
     pub may_meet_body: bool,
 }
 
