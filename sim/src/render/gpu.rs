@@ -63,6 +63,43 @@ struct SensorParams {
 
 impl SensorParams {
     fn new(s: &Sensor, pose: &Isometry2<f64>, sigma: f32) -> Self {
+        let OpticsSlots {
+            kind,
+            focal,
+            p: [p0, p1, p2, p3],
+            model,
+        } = OpticsSlots::of(s);
+        let theta = pose.rotation.angle();
+        Self {
+            size: [s.width_px, s.height_px, kind, 0],
+            intr: [s.cx_px as f32, s.cy_px as f32, focal as f32, sigma],
+            p0,
+            p1,
+            p2,
+            p3,
+            model,
+            mount: [s.mount_mm[0] as f32, s.mount_mm[1] as f32, 0.0, 0.0],
+            pose: [
+                pose.translation.x as f32,
+                pose.translation.y as f32,
+                theta.cos() as f32,
+                theta.sin() as f32,
+            ],
+        }
+    }
+}
+
+/// A sensor's optics in the slots `trace.wgsl` reads: its kind, focal length (px), four
+/// parameter rows and the intrinsics' (or a tilted mirror's) rows.
+struct OpticsSlots {
+    kind: u32,
+    focal: f64,
+    p: [[f32; 4]; 4],
+    model: [[f32; 4]; 3],
+}
+
+impl OpticsSlots {
+    fn of(s: &Sensor) -> Self {
         let mut p1 = [0.0f32; 4];
         let mut p2 = [0.0f32; 4];
         let mut p3 = [0.0f32; 4];
@@ -123,38 +160,32 @@ impl SensorParams {
                 (kind, 0.0)
             }
         };
-        // A mirror off its place: its frame in p3 (pivot, pinhole and frame heights, the
-        // flag) and the tilt's rows with the offset in the intrinsics' slots.
+        Self {
+            kind,
+            focal,
+            p: [p0, p1, p2, p3],
+            model,
+        }
+        .mounted(s)
+    }
+
+    /// The slots of a mirror off its place: its frame in the fourth row (pivot, pinhole and
+    /// frame heights, the flag) and the tilt's rows with the offset in the intrinsics' slots.
+    fn mounted(mut self, s: &Sensor) -> Self {
         if let Some(frame) = s.optics.mirror_frame().filter(|_| !s.mounting.is_nominal()) {
             let r = s.mounting.rotation();
             let o = s.mounting.mirror_offset_mm;
-            p3 = [
+            self.p[3] = [
                 frame.pivot_mm as f32,
                 frame.pinhole_mm as f32,
                 frame.z0_mm as f32,
                 1.0,
             ];
-            for (i, row) in model.iter_mut().enumerate() {
+            for (i, row) in self.model.iter_mut().enumerate() {
                 *row = [r[(i, 0)], r[(i, 1)], r[(i, 2)], o[i]].map(|v| v as f32);
             }
         }
-        let theta = pose.rotation.angle();
-        Self {
-            size: [s.width_px, s.height_px, kind, 0],
-            intr: [s.cx_px as f32, s.cy_px as f32, focal as f32, sigma],
-            p0,
-            p1,
-            p2,
-            p3,
-            model,
-            mount: [s.mount_mm[0] as f32, s.mount_mm[1] as f32, 0.0, 0.0],
-            pose: [
-                pose.translation.x as f32,
-                pose.translation.y as f32,
-                theta.cos() as f32,
-                theta.sin() as f32,
-            ],
-        }
+        self
     }
 }
 
@@ -387,39 +418,7 @@ impl GpuRenderer {
             ..Default::default()
         }))
         .map_err(|e| RenderError::Device(e.to_string()))?;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("trace.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("trace.wgsl").into()),
-        });
-        use wgpu::BufferBindingType as B;
-        let ro = B::Storage { read_only: true };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("trace"),
-            entries: &[
-                entry(0, ro),
-                entry(2, ro),
-                entry(3, ro),
-                entry(4, ro),
-                entry(5, ro),
-                entry(6, ro),
-                entry(7, B::Storage { read_only: false }),
-                entry(8, ro),
-                entry(9, ro),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("trace"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("trace"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let (pipeline, layout) = Self::trace_pipeline(&device);
         let frames = Storage::new(
             &device,
             "frames",
@@ -460,6 +459,44 @@ impl GpuRenderer {
             pixel_capacity: 256 * 256 * 4,
             bind_group: None,
         })
+    }
+
+    /// The compute pipeline of `trace.wgsl` and the layout of its bindings.
+    fn trace_pipeline(device: &wgpu::Device) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("trace.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("trace.wgsl").into()),
+        });
+        use wgpu::BufferBindingType as B;
+        let ro = B::Storage { read_only: true };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("trace"),
+            entries: &[
+                entry(0, ro),
+                entry(2, ro),
+                entry(3, ro),
+                entry(4, ro),
+                entry(5, ro),
+                entry(6, ro),
+                entry(7, B::Storage { read_only: false }),
+                entry(8, ro),
+                entry(9, ro),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("trace"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("trace"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        (pipeline, layout)
     }
 
     fn pixel_buffers(device: &wgpu::Device, bytes: u64) -> (wgpu::Buffer, wgpu::Buffer) {
