@@ -284,8 +284,8 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
                         c.geom[1] = pose.translation.y as f32;
                     }
                 }
-                let reference =
-                    omniloop_sim::render::cpu::render_reference(&scene, &orders[0].1, pose);
+                let traced = omniloop_sim::render::cpu::trace_reference(&scene, &orders[0].1, pose);
+                let reference: Vec<u32> = traced.iter().map(|r| r.colour).collect();
                 for (order, rays) in &mut orders {
                     for (kind, mut r) in [
                         ("vector", CpuRenderer::new()),
@@ -301,6 +301,24 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
                         assert_eq!(
                             diff, 0,
                             "{name}/{} pose {k}, {kind} kernel, packets {order}",
+                            spec.name
+                        );
+                        // With the truth: the same colours, and each pixel's distance (to the
+                        // bit) and what it meets as tracing every primitive gives them.
+                        let n = reference.len();
+                        let (mut t, mut codes) = (vec![0.0; n], vec![0; n]);
+                        r.render_truth(&scene, rays, pose, &mut pixels, (&mut t, &mut codes));
+                        let differ = (0..n)
+                            .filter(|&i| {
+                                let want = &traced[i];
+                                pixels[i] != want.colour
+                                    || t[i].to_bits() != want.t.to_bits()
+                                    || codes[i] != want.code
+                            })
+                            .count();
+                        assert_eq!(
+                            differ, 0,
+                            "{name}/{} pose {k}, {kind} kernel with truth, packets {order}",
                             spec.name
                         );
                     }

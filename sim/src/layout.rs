@@ -6,6 +6,7 @@ use crate::color::Rgb;
 use crate::corridor::Corridor;
 use crate::floor_marks::{FloorMark, MarkScatter};
 use crate::floor_rect::FloorRect;
+use crate::labels::{Class, ObjectId};
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Point2, Vector2};
 use serde::{Deserialize, Serialize};
@@ -92,6 +93,11 @@ impl FieldSpec {
 
     /// Field walls and goal walls as wall segments whose inner faces lie on the floor boundary.
     pub fn walls(&self) -> Vec<Wall> {
+        self.labelled_walls().into_iter().map(|(w, _)| w).collect()
+    }
+
+    /// [`FieldSpec::walls`], each with what it is: a field wall or goal 0 (+x) or 1 (-x).
+    pub fn labelled_walls(&self) -> Vec<(Wall, ObjectId)> {
         let a1 = self.half_length_mm;
         let a2 = self.floor_half_length_mm();
         let b = self.half_width_mm;
@@ -112,24 +118,26 @@ impl FieldSpec {
             height_mm: self.goal_wall_height_mm,
             rgb,
         };
+        let wall = ObjectId::of(Class::FieldWall);
         let mut walls = vec![
             // Long sides, running over the corners so that no gap is left.
-            field([-a1 - t, b + h], [a1 + t, b + h]),
-            field([-a1 - t, -b - h], [a1 + t, -b - h]),
+            (field([-a1 - t, b + h], [a1 + t, b + h]), wall),
+            (field([-a1 - t, -b - h], [a1 + t, -b - h]), wall),
         ];
-        for s in [1.0, -1.0] {
+        for (k, s) in [1.0, -1.0].into_iter().enumerate() {
             // End walls beside each goal mouth.
-            walls.push(field([s * (a1 + h), g], [s * (a1 + h), b]));
-            walls.push(field([s * (a1 + h), -g], [s * (a1 + h), -b]));
+            walls.push((field([s * (a1 + h), g], [s * (a1 + h), b]), wall));
+            walls.push((field([s * (a1 + h), -g], [s * (a1 + h), -b]), wall));
             let rgb = if s > 0.0 {
                 self.goal_pos_x_rgb
             } else {
                 self.goal_neg_x_rgb
             };
             // Goal back and sides.
-            walls.push(goal([s * (a2 + h), -g - t], [s * (a2 + h), g + t], rgb));
-            walls.push(goal([s * a1, g + h], [s * (a2 + t), g + h], rgb));
-            walls.push(goal([s * a1, -g - h], [s * (a2 + t), -g - h], rgb));
+            let id = ObjectId::new(Class::Goal, k as u32);
+            walls.push((goal([s * (a2 + h), -g - t], [s * (a2 + h), g + t], rgb), id));
+            walls.push((goal([s * a1, g + h], [s * (a2 + t), g + h], rgb), id));
+            walls.push((goal([s * a1, -g - h], [s * (a2 + t), -g - h], rgb), id));
         }
         walls
     }
@@ -358,12 +366,14 @@ impl Layout {
     /// coordinates.
     pub fn solids(&self) -> Vec<Solid> {
         let mut out = crate::corridor::walls(&self.corridors);
-        for w in self.all_walls() {
+        let field_walls = self.field.iter().flat_map(|f| f.labelled_walls());
+        let free_walls = (self.walls.iter().cloned()).map(|w| (w, ObjectId::of(Class::Wall)));
+        for (w, object) in field_walls.chain(free_walls) {
             let a = Vector2::from(w.from_mm);
             let b = Vector2::from(w.to_mm);
             let d = b - a;
             let len = d.norm();
-            out.push(Solid::standing(
+            let solid = Solid::standing(
                 SolidShape::Box {
                     center_mm: Point2::from((a + b) / 2.0),
                     half_extents_mm: Vector2::new(len / 2.0, w.thickness_mm / 2.0),
@@ -371,10 +381,11 @@ impl Layout {
                 },
                 w.height_mm,
                 w.rgb,
-            ));
+            );
+            out.push(solid.as_object(object));
         }
-        for c in &self.cubes {
-            out.push(Solid::standing(
+        for (i, c) in self.cubes.iter().enumerate() {
+            let cube = Solid::standing(
                 SolidShape::Box {
                     center_mm: Point2::from(c.center_mm),
                     half_extents_mm: Vector2::new(c.size_mm / 2.0, c.size_mm / 2.0),
@@ -382,17 +393,19 @@ impl Layout {
                 },
                 c.size_mm,
                 c.rgb,
-            ));
+            );
+            out.push(cube.as_object(ObjectId::new(Class::Cube, i as u32)));
         }
-        for p in &self.pillars {
-            out.push(Solid::standing(
+        for (i, p) in self.pillars.iter().enumerate() {
+            let pillar = Solid::standing(
                 SolidShape::Cylinder {
                     center_mm: Point2::from(p.center_mm),
                     radius_mm: p.radius_mm,
                 },
                 p.height_mm,
                 p.rgb,
-            ));
+            );
+            out.push(pillar.as_object(ObjectId::new(Class::Pillar, i as u32)));
         }
         for (i, b) in self.boards.iter().enumerate() {
             let a = Vector2::from(b.from_mm);
@@ -409,6 +422,7 @@ impl Layout {
                 rgb: b.rgb_a,
                 top_rgb: None,
                 board: Some(i),
+                object: ObjectId::new(Class::Board, i as u32),
             });
         }
         out

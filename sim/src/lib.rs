@@ -7,6 +7,7 @@ pub mod color;
 pub mod corridor;
 pub mod floor_marks;
 pub mod floor_rect;
+pub mod labels;
 pub mod layout;
 pub mod optics;
 pub mod reachability;

@@ -3,6 +3,7 @@
 //! ground truth.
 
 use crate::color::Rgb;
+use crate::labels::{Class, ObjectId};
 use nalgebra::{Point2, Vector2};
 
 /// The footprint of a solid.
@@ -96,10 +97,13 @@ pub struct Solid {
     pub top_rgb: Option<Rgb>,
     /// Index of the stripe board in [`crate::Layout::boards`] it carries, if any.
     pub board: Option<usize>,
+    /// What it is, for the per-pixel labels.
+    pub object: ObjectId,
 }
 
 impl Solid {
-    /// A solid standing on the floor, plain-coloured.
+    /// A solid standing on the floor, plain-coloured: a wall until [`Solid::as_object`] says
+    /// otherwise.
     pub fn standing(shape: SolidShape, height_mm: f64, rgb: Rgb) -> Self {
         Self {
             shape,
@@ -108,7 +112,14 @@ impl Solid {
             rgb,
             top_rgb: None,
             board: None,
+            object: ObjectId::of(Class::Wall),
         }
+    }
+
+    /// The same solid as `object`.
+    pub fn as_object(mut self, object: ObjectId) -> Self {
+        self.object = object;
+        self
     }
 
     /// The same solid with its top face painted `top_rgb` (a robot's marking).

@@ -11,6 +11,7 @@
 
 use crate::SimError;
 use crate::color::Rgb;
+use crate::labels::{Class, ObjectId};
 use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -378,6 +379,7 @@ impl World {
                     spec.rgb,
                 )
                 .with_top(spec.marking_rgb)
+                .as_object(ObjectId::new(Class::Robot, j as u32))
             })
             .collect()
     }

@@ -142,6 +142,7 @@ impl CalibratedCamera {
         Some(Ray {
             origin: Point3::new(tx, ty, tz),
             dir: self.rotation_matrix() * d,
+            path_mm: 0.0,
         })
     }
 

@@ -70,6 +70,7 @@ impl ConicalMirror {
         Some(Ray {
             origin: Point3::new(p.x, p.y, p.z + self.lens_height_mm),
             dir: reflect(d, n),
+            path_mm: t,
         })
     }
 

@@ -113,6 +113,7 @@ impl HyperbolicMirror {
         Some(Ray {
             origin: Point3::new(p.x, p.y, p.z + self.centre_height_mm()),
             dir: r,
+            path_mm: t,
         })
     }
 

@@ -134,6 +134,7 @@ impl MirrorFrame {
         Some(Ray {
             origin: Point3::from(r * (s - pivot) + pivot + offset),
             dir: r * reflected,
+            path_mm: (p.coords - o).norm(),
         })
     }
 }

@@ -68,6 +68,7 @@ impl PinholeCamera {
         Some(Ray {
             origin: Point3::new(0.0, 0.0, self.height_mm),
             dir,
+            path_mm: 0.0,
         })
     }
 }

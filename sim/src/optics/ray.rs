@@ -9,6 +9,9 @@ pub struct Ray {
     pub origin: Point3<f64>,
     /// Unit direction.
     pub dir: Vector3<f64>,
+    /// How far light travels from the camera's viewpoint (its lens centre) to `origin`, mm:
+    /// the camera ray to the mirror (0 where the ray starts at the lens, a pinhole's).
+    pub path_mm: f64,
 }
 
 impl Ray {

@@ -23,7 +23,7 @@ use super::scene::Scene;
 use super::trace::{self, BLACK, FloorPaint, Hit, V3};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
-use packet::{FrameRays, LANES, Packet, Scatter};
+use packet::{FrameRays, LANES, Outputs, Packet, Scatter};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -731,6 +731,35 @@ impl CpuRenderer {
         pose: &Isometry2<f64>,
         pixels: &mut [u32],
     ) {
+        self.trace(scene, rays, pose, pixels, None);
+    }
+
+    /// [`CpuRenderer::render`] with each pixel's truth: the distance along its scene ray to
+    /// what it meets (mm; infinity for the sky, NaN where it sees no mirror) into `t`, and
+    /// what that is ([`trace::Code`]) into `code`. The colours are those `render` gives.
+    pub fn render_truth(
+        &mut self,
+        scene: &Scene,
+        rays: &mut SensorRays,
+        pose: &Isometry2<f64>,
+        pixels: &mut [u32],
+        (t, code): (&mut [f32], &mut [u32]),
+    ) {
+        assert!(t.len() == pixels.len() && code.len() == pixels.len());
+        for &k in &rays.blind {
+            (t[k as usize], code[k as usize]) = (f32::NAN, trace::CODE_NOTHING);
+        }
+        self.trace(scene, rays, pose, pixels, Some((t, code)));
+    }
+
+    fn trace(
+        &mut self,
+        scene: &Scene,
+        rays: &mut SensorRays,
+        pose: &Isometry2<f64>,
+        pixels: &mut [u32],
+        truth: Option<(&mut [f32], &mut [u32])>,
+    ) {
         assert_eq!(pixels.len(), rays.rays.len());
         let px = pose.translation.x as f32;
         let py = pose.translation.y as f32;
@@ -766,7 +795,10 @@ impl CpuRenderer {
             pixels[k as usize] = BLACK;
         }
         let trace_chunk = packet::trace_chunk_fn(self.portable);
-        let out = Scatter::new(pixels);
+        let out = Outputs {
+            colour: Scatter::new(pixels),
+            truth: truth.map(|(t, code)| (Scatter::new(t), Scatter::new(code))),
+        };
         // Chunks of packets small enough to share out over the cores, large enough to cost
         // little to hand out.
         rays.packets
@@ -777,6 +809,19 @@ impl CpuRenderer {
 
 /// Renders every primitive for every pixel, without binning (the reference of the tests).
 pub fn render_reference(scene: &Scene, rays: &SensorRays, pose: &Isometry2<f64>) -> Vec<u32> {
+    trace_reference(scene, rays, pose)
+        .iter()
+        .map(|r| r.colour)
+        .collect()
+}
+
+/// [`render_reference`] with each pixel's distance and what it meets, as
+/// [`CpuRenderer::render_truth`] gives them.
+pub fn trace_reference(
+    scene: &Scene,
+    rays: &SensorRays,
+    pose: &Isometry2<f64>,
+) -> Vec<trace::Traced> {
     let px = pose.translation.x as f32;
     let py = pose.translation.y as f32;
     let theta = pose.rotation.angle();
@@ -786,7 +831,11 @@ pub fn render_reference(scene: &Scene, rays: &SensorRays, pose: &Isometry2<f64>)
         .iter()
         .map(|r| {
             if !r.valid() {
-                return BLACK;
+                return trace::Traced {
+                    colour: BLACK,
+                    t: f32::NAN,
+                    code: trace::CODE_NOTHING,
+                };
             }
             let o = [
                 px + c * r.o[0] - s * r.o[1],
@@ -794,7 +843,7 @@ pub fn render_reference(scene: &Scene, rays: &SensorRays, pose: &Isometry2<f64>)
                 r.o[2],
             ];
             let d = [c * r.d[0] - s * r.d[1], s * r.d[0] + c * r.d[1], r.d[2]];
-            trace::trace_all(scene, o, d)
+            trace::trace_ray(scene, o, d)
         })
         .collect()
 }

@@ -9,6 +9,7 @@ pub mod gpu;
 pub mod noise;
 pub mod scene;
 pub mod trace;
+pub mod truth;
 
 pub use batch::{BatchClient, BatchHandle, BatchServer};
 pub use cpu::{CpuRenderer, SensorRays};
@@ -17,6 +18,7 @@ pub use error::RenderError;
 pub use gpu::{FrameRequest, GpuRenderer};
 pub use noise::{FrameNoise, SensorNoise};
 pub use scene::Scene;
+pub use truth::{TruthFrame, TruthRays};
 
 use crate::sensor::Sensor;
 use image::RgbaImage;
@@ -64,6 +66,31 @@ pub struct Renderer {
     name: String,
     rays: Vec<(Sensor, SensorRays)>,
     pixels: Vec<u32>,
+    truth: Truth,
+}
+
+/// The truth's per-sensor caches and the last frame's distances and codes.
+#[derive(Default)]
+struct Truth {
+    rays: Vec<(Sensor, TruthRays)>,
+    t: Vec<f32>,
+    codes: Vec<u32>,
+}
+
+impl Truth {
+    /// The truth of the frame last traced with truth, of `sensor` at `pose` in `scene`.
+    fn frame(&mut self, scene: &Scene, sensor: &Sensor, pose: &Isometry2<f64>) -> TruthFrame {
+        let k = match self.rays.iter().position(|(s, _)| s == sensor) {
+            Some(k) => k,
+            None => {
+                // One entry a sensor name: a camera on a pan unit replaces its own.
+                self.rays.retain(|(s, _)| s.name != sensor.name);
+                self.rays.push((sensor.clone(), TruthRays::new(sensor)));
+                self.rays.len() - 1
+            }
+        };
+        truth::truth_frame(scene, sensor, &self.rays[k].1, pose, &self.t, &self.codes)
+    }
 }
 
 impl Renderer {
@@ -102,6 +129,7 @@ impl Renderer {
             name,
             rays: Vec::new(),
             pixels: Vec::new(),
+            truth: Truth::default(),
         })
     }
 
@@ -113,6 +141,7 @@ impl Renderer {
             name: server.name().to_string(),
             rays: Vec::new(),
             pixels: Vec::new(),
+            truth: Truth::default(),
         }
     }
 
@@ -123,6 +152,7 @@ impl Renderer {
             name: cpu_name(),
             rays: Vec::new(),
             pixels: Vec::new(),
+            truth: Truth::default(),
         }
     }
 
@@ -151,21 +181,27 @@ impl Renderer {
         sensor: &Sensor,
         pose: &Isometry2<f64>,
     ) -> Result<&[u32], RenderError> {
-        self.trace(scene, sensor, pose, None)?;
+        self.trace(scene, sensor, pose, None, false)?;
         Ok(&self.pixels)
     }
 
     /// Traces a frame into the scratch buffer: on a GPU with `noise` drawn by the shader
     /// (returns true), on the CPU clean (returns false: the noise is the caller's to draw).
+    /// With `truth`, each pixel's distance and what it meets go to the truth's buffers too.
     fn trace(
         &mut self,
         scene: &Scene,
         sensor: &Sensor,
         pose: &Isometry2<f64>,
         noise: Option<FrameNoise>,
+        truth: bool,
     ) -> Result<bool, RenderError> {
         let n = (sensor.width_px * sensor.height_px) as usize;
         self.pixels.resize(n, 0);
+        if truth {
+            self.truth.t.resize(n, 0.0);
+            self.truth.codes.resize(n, 0);
+        }
         match &mut self.backend {
             Backend::Gpu(g) => g.render(scene, sensor, pose, noise, &mut self.pixels)?,
             Backend::Shared(client) => self.pixels = client.render(scene, sensor, pose, noise)?,
@@ -184,7 +220,13 @@ impl Renderer {
                         self.rays.len() - 1
                     }
                 };
-                c.render(scene, &mut self.rays[k].1, pose, &mut self.pixels);
+                let rays = &mut self.rays[k].1;
+                if truth {
+                    let buffers = (&mut self.truth.t[..], &mut self.truth.codes[..]);
+                    c.render_truth(scene, rays, pose, &mut self.pixels, buffers);
+                } else {
+                    c.render(scene, rays, pose, &mut self.pixels);
+                }
                 return Ok(false);
             }
         }
@@ -202,7 +244,7 @@ impl Renderer {
         }
         let mut out = Vec::with_capacity(requests.len());
         for r in requests {
-            let drawn = self.trace(r.scene, r.sensor, r.pose, r.noise)?;
+            let drawn = self.trace(r.scene, r.sensor, r.pose, r.noise, false)?;
             match r.noise {
                 Some(n) if !drawn => {
                     let mut rgba = vec![0u8; self.pixels.len() * 4];
@@ -241,6 +283,42 @@ impl Renderer {
         poses: &[Isometry2<f64>],
         noise: Option<&mut SensorNoise>,
     ) -> Result<RgbaImage, RenderError> {
+        self.exposed(scene, sensor, poses, noise, false)
+    }
+
+    /// [`Renderer::render_exposed`] with the truth of the frame at the exposure's first pose
+    /// (the frame's own pose): the images are the same.
+    pub fn render_exposed_truth(
+        &mut self,
+        scene: &Scene,
+        sensor: &Sensor,
+        poses: &[Isometry2<f64>],
+        noise: Option<&mut SensorNoise>,
+    ) -> Result<(RgbaImage, TruthFrame), RenderError> {
+        let img = self.exposed(scene, sensor, poses, noise, true)?;
+        let pose = poses.first().copied().unwrap_or_else(Isometry2::identity);
+        Ok((img, self.truth.frame(scene, sensor, &pose)))
+    }
+
+    /// The truth of a frame of `sensor` at `pose` in `scene`, without its image.
+    pub fn render_truth(
+        &mut self,
+        scene: &Scene,
+        sensor: &Sensor,
+        pose: &Isometry2<f64>,
+    ) -> Result<TruthFrame, RenderError> {
+        self.trace(scene, sensor, pose, None, true)?;
+        Ok(self.truth.frame(scene, sensor, pose))
+    }
+
+    fn exposed(
+        &mut self,
+        scene: &Scene,
+        sensor: &Sensor,
+        poses: &[Isometry2<f64>],
+        noise: Option<&mut SensorNoise>,
+        truth: bool,
+    ) -> Result<RgbaImage, RenderError> {
         let Some(pose) = poses.first() else {
             return Err(RenderError::Invalid("a frame needs a pose".into()));
         };
@@ -248,8 +326,8 @@ impl Renderer {
         if !sensor.effects.is_off() {
             let used = &poses[..poses.len().min(sensor.effects.sub_frames())];
             let mut sub_frames = Vec::with_capacity(used.len());
-            for p in used {
-                self.trace(scene, sensor, p, None)?;
+            for (i, p) in used.iter().enumerate() {
+                self.trace(scene, sensor, p, None, truth && i == 0)?;
                 sub_frames.push(self.pixels.clone());
             }
             let size = [sensor.width_px, sensor.height_px];
@@ -268,7 +346,7 @@ impl Renderer {
             return effects::compress(img, sensor.effects.jpeg_quality);
         }
         let mut img = RgbaImage::new(sensor.width_px, sensor.height_px);
-        let drawn = self.trace(scene, sensor, pose, frame_noise)?;
+        let drawn = self.trace(scene, sensor, pose, frame_noise, truth)?;
         match frame_noise {
             Some(fnz) if !drawn => noise::apply(&self.pixels, fnz, &mut img),
             _ => {

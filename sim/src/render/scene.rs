@@ -6,6 +6,7 @@
 
 use crate::color::Rgb;
 use crate::floor_marks::MarkShape;
+use crate::labels::{Legend, ObjectId};
 use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use crate::world::World;
@@ -134,6 +135,9 @@ pub struct Scene {
     pub stripe_edges: Vec<f32>,
     /// Floor-region rectangles.
     pub floor_rects: Vec<FloorRectPrim>,
+    /// What each box, quad prism and cylinder is, in that order (a primitive's rank in the
+    /// scene's order less one): the per-pixel labels' source.
+    pub objects: Vec<ObjectId>,
 }
 
 fn unit_frame(angle_deg: f64, kind: f32) -> [f32; 4] {
@@ -172,7 +176,14 @@ impl Scene {
         let mut boxes = Vec::new();
         let mut cylinders = Vec::new();
         let mut quads = Vec::new();
+        let mut objects: [Vec<ObjectId>; 3] = Default::default();
         for s in solids {
+            let kind = match s.shape {
+                SolidShape::Box { .. } => 0,
+                SolidShape::Quad { .. } => 1,
+                SolidShape::Cylinder { .. } => 2,
+            };
+            objects[kind].push(s.object);
             match s.shape {
                 SolidShape::Box {
                     center_mm,
@@ -294,6 +305,12 @@ impl Scene {
             boards,
             stripe_edges,
             floor_rects,
+            objects: objects.concat(),
         }
+    }
+
+    /// The legend of the labels of this scene's things.
+    pub fn legend(&self) -> Legend {
+        Legend::new(self.objects.iter().copied())
     }
 }

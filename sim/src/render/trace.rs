@@ -449,37 +449,105 @@ pub fn pack(c: V3) -> u32 {
     q(c[0]) | (q(c[1]) << 8) | (q(c[2]) << 16) | (255 << 24)
 }
 
-/// The colour of a world ray traced against every primitive (the reference the culled CPU
-/// path and the GPU must agree with).
-pub fn trace_all(s: &Scene, o: V3, d: V3) -> u32 {
+/// What a ray shows, as a number: a primitive's rank in the scene's order (boxes from 1, then
+/// quad prisms, then cylinders), [`CODE_FLOOR`] with the floor paint's index
+/// ([`paint_index`]), or [`CODE_SKY`].
+pub type Code = u32;
+
+/// [`Code`] of a ray that meets nothing.
+pub const CODE_SKY: Code = u32::MAX;
+
+/// [`Code`] of a pixel that sees no mirror.
+pub const CODE_NOTHING: Code = u32::MAX - 1;
+
+/// [`Code`] of the floor: this bit with the paint's index below it.
+pub const CODE_FLOOR: Code = 1 << 31;
+
+/// The index of a floor paint among the floor's colours: mark `i` is `i`, then outside the
+/// region, a line and the bare floor (the CPU renderer's palette order).
+pub fn paint_index(s: &Scene, paint: FloorPaint) -> u32 {
+    let n = s.floor_rects.len() as u32;
+    match paint {
+        FloorPaint::Mark(i) => i as u32,
+        FloorPaint::Outside => n,
+        FloorPaint::Line => n + 1,
+        FloorPaint::Floor => n + 2,
+    }
+}
+
+/// The floor paint of index `k` ([`paint_index`]'s inverse).
+pub fn paint_of_index(s: &Scene, k: u32) -> FloorPaint {
+    let n = s.floor_rects.len() as u32;
+    match k.checked_sub(n) {
+        None => FloorPaint::Mark(k as usize),
+        Some(0) => FloorPaint::Outside,
+        Some(1) => FloorPaint::Line,
+        Some(_) => FloorPaint::Floor,
+    }
+}
+
+/// A world ray traced against every primitive: its packed colour, the distance along it to
+/// what it meets (infinity for the sky) and what that is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Traced {
+    /// Packed RGBA8.
+    pub colour: u32,
+    /// Distance along the (unit) ray, mm.
+    pub t: f32,
+    /// What it meets.
+    pub code: Code,
+}
+
+/// [`trace_all`] with the distance and what the ray meets.
+pub fn trace_ray(s: &Scene, o: V3, d: V3) -> Traced {
     let mut best = hit_floor(s, o, d);
+    let mut code = best.map_or(CODE_SKY, |h| {
+        let paint = floor_paint(s, o[0] + h.t * d[0], o[1] + h.t * d[1]);
+        CODE_FLOOR | paint_index(s, paint)
+    });
     let mut t_max = best.map_or(f32::INFINITY, |h| h.t);
-    for b in &s.boxes {
-        if let Some(h) = hit_box(s, b, o, d, t_max) {
-            t_max = h.t;
-            best = Some(h);
+    let mut rank = 1;
+    let mut keep = |hit: Option<Hit>, t_max: &mut f32, best: &mut Option<Hit>, rank: &mut u32| {
+        if let Some(h) = hit {
+            *t_max = h.t;
+            *best = Some(h);
+            code = *rank;
         }
+        *rank += 1;
+    };
+    for b in &s.boxes {
+        keep(hit_box(s, b, o, d, t_max), &mut t_max, &mut best, &mut rank);
     }
     for q in &s.quads {
-        if let Some(h) = hit_quad(q, o, d, t_max) {
-            t_max = h.t;
-            best = Some(h);
-        }
+        keep(hit_quad(q, o, d, t_max), &mut t_max, &mut best, &mut rank);
     }
     for c in &s.cylinders {
-        if let Some(h) = hit_cylinder(c, o, d, t_max) {
-            t_max = h.t;
-            best = Some(h);
-        }
+        keep(
+            hit_cylinder(c, o, d, t_max),
+            &mut t_max,
+            &mut best,
+            &mut rank,
+        );
     }
-    match best {
+    let colour = match best {
         Some(h) => pack(shade(s, &h)),
         None => pack([
             s.globals.sky_rgb[0],
             s.globals.sky_rgb[1],
             s.globals.sky_rgb[2],
         ]),
+    };
+    Traced {
+        colour,
+        t: t_max,
+        code,
     }
+}
+
+/// The colour of a world ray traced against every primitive (the reference the culled CPU
+/// path and the GPU must agree with).
+pub fn trace_all(s: &Scene, o: V3, d: V3) -> u32 {
+    trace_ray(s, o, d).colour
 }
 
 /// The packed value of a pixel that sees no mirror.

@@ -65,38 +65,64 @@ pub(super) struct FrameRays<'a> {
     pub body: Option<usize>,
 }
 
-/// A frame's pixels, written at the places of the packets' lanes.
+/// A frame's pixels (colours, or one of the truth's values), written at the places of the
+/// packets' lanes.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Scatter {
-    ptr: *mut u32,
+pub(super) struct Scatter<T> {
+    ptr: *mut T,
     len: usize,
 }
 
 // SAFETY: a `Scatter` is only written through `Scatter::write`, whose callers write each pixel
 // from one packet only (the packets' pixels are a permutation of the frame's).
-unsafe impl Send for Scatter {}
+unsafe impl<T: Send> Send for Scatter<T> {}
 // SAFETY: as for `Send`.
-unsafe impl Sync for Scatter {}
+unsafe impl<T: Send> Sync for Scatter<T> {}
 
-impl Scatter {
-    pub(super) fn new(pixels: &mut [u32]) -> Self {
+impl<T: Copy> Scatter<T> {
+    pub(super) fn new(pixels: &mut [T]) -> Self {
         Self {
             ptr: pixels.as_mut_ptr(),
             len: pixels.len(),
         }
     }
 
-    /// Writes `colours` at the packet's pixels.
+    /// Writes `values` at the packet's pixels.
     ///
     /// # Safety
     /// No other thread reads or writes these pixels meanwhile, and the slice this was made
     /// from outlives the call.
-    unsafe fn write(&self, p: &Packet, colours: &U) {
-        for (&k, &c) in p.pixel.iter().zip(colours) {
+    unsafe fn write(&self, p: &Packet, values: &[T; LANES]) {
+        for (&k, &c) in p.pixel.iter().zip(values) {
             let k = k as usize;
             assert!(k < self.len, "a packet's pixel lies outside the frame");
             // SAFETY: in bounds (just asserted); exclusive by the caller's contract.
             unsafe { self.ptr.add(k).write(c) };
+        }
+    }
+}
+
+/// Where a frame's packets write: the colours and, where the truth is asked for, each pixel's
+/// distance along its scene ray and what it meets ([`trace::Code`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Outputs {
+    pub colour: Scatter<u32>,
+    pub truth: Option<(Scatter<f32>, Scatter<u32>)>,
+}
+
+impl Outputs {
+    /// Writes a packet's colours, and its truth where asked for.
+    ///
+    /// # Safety
+    /// As [`Scatter::write`]: this packet alone writes its pixels.
+    unsafe fn write(&self, p: &Packet, colours: &U, t: &F, code: &U) {
+        // SAFETY: the caller's contract.
+        unsafe {
+            self.colour.write(p, colours);
+            if let Some((ts, codes)) = &self.truth {
+                ts.write(p, t);
+                codes.write(p, code);
+            }
         }
     }
 }
@@ -106,7 +132,7 @@ mod avx2;
 
 /// Traces a chunk of a frame's packets, each pixel written once: `out` must be the frame the
 /// packets were made for, and no other chunk may hold these packets.
-pub(super) type TraceChunk = fn(&FrameRays, &[Packet], &Scatter);
+pub(super) type TraceChunk = fn(&FrameRays, &[Packet], &Outputs);
 
 /// The chunk tracer in the widest vector instructions this processor has (AVX2, chosen at run
 /// time), or the portable one where `portable` asks for it.
@@ -122,12 +148,12 @@ pub(super) fn trace_chunk_fn(portable: bool) -> TraceChunk {
 }
 
 /// The portable chunk tracer: eight lanes as arrays.
-fn trace_chunk(frame: &FrameRays, packets: &[Packet], out: &Scatter) {
+fn trace_chunk(frame: &FrameRays, packets: &[Packet], out: &Outputs) {
     for p in packets {
-        let colours = trace_packet(frame, p);
+        let (colours, t, code) = trace_packet(frame, p);
         // SAFETY: the packets' pixels are a permutation of the frame's and each packet is in
         // one chunk only, so this chunk alone writes these pixels.
-        unsafe { out.write(p, &colours) };
+        unsafe { out.write(p, &colours, &t, &code) };
     }
 }
 
@@ -174,9 +200,10 @@ impl Nearest {
     }
 }
 
-/// The colour of each lane of `p`: [`super`]'s per-ray tracing, eight rays at once.
+/// The colour of each lane of `p`, its distance along the ray to what it meets and what that
+/// is: [`super`]'s per-ray tracing, eight rays at once.
 #[inline(always)]
-fn trace_packet(frame: &FrameRays, p: &Packet) -> U {
+fn trace_packet(frame: &FrameRays, p: &Packet) -> (U, F, U) {
     let [px, py, c, s] = frame.pose;
     let sectors = frame.sectors;
     let (mut o, mut d) = (p.o, p.d);
@@ -226,17 +253,22 @@ fn trace_packet(frame: &FrameRays, p: &Packet) -> U {
         trace_sector(frame, sector[first], &lanes, &sky, p, &o, &d, &mut near);
     }
     let paint = floor_paint(frame.scene, &o, &d, &near.t_max);
-    let mut out = [0; LANES];
+    let (mut out, mut t, mut code) = ([0; LANES], near.t_max, [0; LANES]);
     for i in 0..LANES {
-        out[i] = if sky[i] || !(near.hit[i] || floor[i]) {
-            sectors.sky
+        let nothing = sky[i] || !(near.hit[i] || floor[i]);
+        (out[i], code[i]) = if nothing {
+            t[i] = f32::INFINITY;
+            (sectors.sky, trace::CODE_SKY)
         } else if near.hit[i] {
-            near.colour[i]
+            (near.colour[i], near.rank[i])
         } else {
-            sectors.palette[paint[i] as usize]
+            (
+                sectors.palette[paint[i] as usize],
+                trace::CODE_FLOOR | paint[i],
+            )
         };
     }
-    out
+    (out, t, code)
 }
 
 /// Traces the primitives of `sector` (nearest first) for the packet, until none can be nearer

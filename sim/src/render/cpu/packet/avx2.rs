@@ -6,10 +6,10 @@
 //! comparison's complement, and `min`/`max` are taken only where neither side can be NaN (where
 //! `_mm256_min_ps` and `f32::min` agree).
 
-use super::{FrameRays, LANES, Packet, Scatter, U};
+use super::{FrameRays, LANES, Outputs, Packet, U};
 use crate::render::cpu::{Item, Prim, SECTOR_SHIFT};
 use crate::render::scene::{FLOOR_REGION, SQUARE_MARK, Scene};
-use crate::render::trace::T_EPS;
+use crate::render::trace::{CODE_FLOOR, CODE_SKY, T_EPS};
 use std::arch::x86_64::*;
 
 type V = __m256;
@@ -17,11 +17,21 @@ type I = __m256i;
 
 /// Traces `packets` as [`super::trace_chunk`] does.
 #[target_feature(enable = "avx2")]
-pub(super) fn trace_chunk(frame: &FrameRays, packets: &[Packet], out: &Scatter) {
+pub(super) fn trace_chunk(frame: &FrameRays, packets: &[Packet], out: &Outputs) {
+    if out.truth.is_some() {
+        trace_packets::<true>(frame, packets, out);
+    } else {
+        trace_packets::<false>(frame, packets, out);
+    }
+}
+
+/// [`trace_chunk`] with the truth computed (`TRUTH`) or not.
+#[target_feature(enable = "avx2")]
+fn trace_packets<const TRUTH: bool>(frame: &FrameRays, packets: &[Packet], out: &Outputs) {
     for p in packets {
-        let colours = trace_packet(frame, p);
-        // SAFETY: as in `super::trace_chunk_lanes`: this chunk alone writes these pixels.
-        unsafe { out.write(p, &colours) };
+        let (colours, t, code) = trace_packet::<TRUTH>(frame, p);
+        // SAFETY: as in `super::trace_chunk`: this chunk alone writes these pixels.
+        unsafe { out.write(p, &lanes_u(colours), &lanes_f(t), &lanes_u(code)) };
     }
 }
 
@@ -228,9 +238,11 @@ impl Nearest {
     }
 }
 
+/// The colour of each lane and, with `TRUTH`, its distance along the ray and what it meets
+/// (else zeros).
 #[inline]
 #[target_feature(enable = "avx2")]
-fn trace_packet(frame: &FrameRays, p: &Packet) -> U {
+fn trace_packet<const TRUTH: bool>(frame: &FrameRays, p: &Packet) -> (I, V, I) {
     let [px, py, c, s] = frame.pose;
     let (px, py, c, s) = (splat(px), splat(py), splat(c), splat(s));
     let sectors = frame.sectors;
@@ -249,7 +261,11 @@ fn trace_packet(frame: &FrameRays, p: &Packet) -> U {
     let zero = splat(0.0);
     let sky = and(ge(dz, zero), gt(oz, splat(sectors.top_mm)));
     if _mm256_movemask_ps(sky) == 0xff {
-        return [sectors.sky; LANES];
+        return (
+            splat_u(sectors.sky),
+            splat(f32::INFINITY),
+            splat_u(CODE_SKY),
+        );
     }
     let floor_t = load(&p.floor_t);
     let floor = gt(floor_t, zero);
@@ -283,15 +299,29 @@ fn trace_packet(frame: &FrameRays, p: &Packet) -> U {
     }
     // The floor's colour where nothing hides it.
     let bare = _mm256_andnot_ps(or(sky, near.hit), floor);
-    let floor_colour = if any(bare) {
+    let (floor_colour, paint) = if any(bare) {
         let paint = floor_paint(frame.scene, &r, near.t_max);
-        palette_colours(&sectors.palette, sectors.palette_lanes.as_ref(), paint)
+        let colours = palette_colours(&sectors.palette, sectors.palette_lanes.as_ref(), paint);
+        (colours, paint)
     } else {
-        splat_u(0)
+        (splat_u(0), splat_u(0))
     };
     let nothing = or(sky, not(or(near.hit, floor)));
     let seen = select_u(near.hit, near.colour, floor_colour);
-    lanes_u(select_u(nothing, splat_u(sectors.sky), seen))
+    let colour = select_u(nothing, splat_u(sectors.sky), seen);
+    if !TRUTH {
+        return (colour, splat(0.0), splat_u(0));
+    }
+    let met = select_u(
+        near.hit,
+        near.rank,
+        _mm256_or_si256(splat_u(CODE_FLOOR), paint),
+    );
+    (
+        colour,
+        select(nothing, splat(f32::INFINITY), near.t_max),
+        select_u(nothing, splat_u(CODE_SKY), met),
+    )
 }
 
 /// The palette's colours at `paint`: permuted within a register where the palette fits one

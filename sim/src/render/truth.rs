@@ -1,0 +1,180 @@
+//! The truth beside a frame, pixel by pixel: how far the light travelled to the camera, where
+//! it left the floor and what it came from.
+//!
+//! The tracers give each pixel the distance along its scene ray to what the ray meets and what
+//! that is (a [`Code`]: a primitive's rank, the floor's paint or the sky). This module adds the
+//! mirror half of the path, traced once per sensor in `f64` ([`TruthRays`]), and turns the codes
+//! into the labels of the scene's [`Legend`]. It is the simulator's side only: none of it
+//! reaches the robot's software.
+
+use super::scene::Scene;
+use super::trace::{self, CODE_FLOOR, CODE_NOTHING, CODE_SKY, Code, FloorPaint};
+use crate::labels::{self, Legend};
+use crate::sensor::Sensor;
+use nalgebra::Isometry2;
+
+/// The truth of one frame, row-major like the image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TruthFrame {
+    /// Image width, px.
+    pub width: u32,
+    /// Image height, px.
+    pub height: u32,
+    /// How far the light travelled from what the pixel shows to the camera's viewpoint: the
+    /// scene ray to the mirror plus the camera ray from the mirror to the lens (mm). Infinity
+    /// for the sky, NaN where the pixel sees no mirror.
+    pub depth_mm: Vec<f32>,
+    /// Where the pixel shows the floor, the floor point's horizontal distance from the robot's
+    /// centre (mm); NaN elsewhere.
+    pub floor_mm: Vec<f32>,
+    /// What the pixel shows: a label of [`TruthFrame::legend`].
+    pub labels: Vec<u16>,
+    /// The labels' legend.
+    pub legend: Legend,
+}
+
+impl TruthFrame {
+    /// The label of pixel `(u, v)`.
+    pub fn label(&self, u: u32, v: u32) -> u16 {
+        self.labels[(v * self.width + u) as usize]
+    }
+
+    /// Whether the pixel shows the floor region: bare floor or a line painted on it (marks and
+    /// floor outside the region left out).
+    pub fn is_floor_region(&self, k: usize) -> bool {
+        matches!(self.labels[k], labels::FLOOR_REGION | labels::FLOOR_LINE)
+    }
+}
+
+/// The mirror half of each pixel's path for the truth, in the robot frame: the camera ray's
+/// length to the mirror and the scene ray (`f64`, the same for every pose).
+#[derive(Debug, Clone)]
+pub struct TruthRays {
+    /// Per pixel: the camera ray's length (mm), the scene ray's origin and direction; `None`
+    /// where the pixel sees no mirror.
+    rays: Vec<Option<(f64, [f64; 3], [f64; 3])>>,
+}
+
+impl TruthRays {
+    /// Traces the mirror half of every pixel of `sensor`.
+    pub fn new(sensor: &Sensor) -> Self {
+        let (w, h) = (sensor.width_px, sensor.height_px);
+        let rays = (0..h)
+            .flat_map(|v| (0..w).map(move |u| (u, v)))
+            .map(|(u, v)| {
+                sensor.pixel_ray(u, v).map(|r| {
+                    let o = [r.origin.x, r.origin.y, r.origin.z];
+                    (r.path_mm, o, [r.dir.x, r.dir.y, r.dir.z])
+                })
+            })
+            .collect();
+        Self { rays }
+    }
+
+    /// How many pixels.
+    pub fn len(&self) -> usize {
+        self.rays.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.rays.is_empty()
+    }
+}
+
+/// The cylinder of `scene` that is the robot's own body at `pose`: the one standing at its
+/// centre.
+pub fn own_body(scene: &Scene, pose: &Isometry2<f64>) -> Option<usize> {
+    let (px, py) = (pose.translation.x as f32, pose.translation.y as f32);
+    scene
+        .cylinders
+        .iter()
+        .position(|cy| cy.geom[0] == px && cy.geom[1] == py)
+}
+
+/// The label of each [`Code`] a frame of `scene` can hold, for a robot whose body is cylinder
+/// `body`.
+struct Labeller {
+    /// By rank less one.
+    ranks: Vec<u16>,
+    /// By floor paint index.
+    paints: Vec<u16>,
+}
+
+impl Labeller {
+    fn new(scene: &Scene, legend: &Legend, body: Option<usize>) -> Self {
+        let first_cylinder = scene.boxes.len() + scene.quads.len();
+        let ranks = (scene.objects.iter().enumerate())
+            .map(|(k, &o)| match body {
+                Some(b) if k == first_cylinder + b => labels::OWN_BODY,
+                _ => legend.label(o),
+            })
+            .collect();
+        let paints = (0..scene.floor_rects.len() as u32 + 3)
+            .map(|k| match trace::paint_of_index(scene, k) {
+                FloorPaint::Mark(_) => labels::FLOOR_MARK,
+                FloorPaint::Outside => labels::FLOOR_OUTSIDE,
+                FloorPaint::Line => labels::FLOOR_LINE,
+                FloorPaint::Floor => labels::FLOOR_REGION,
+            })
+            .collect();
+        Self { ranks, paints }
+    }
+
+    fn label(&self, code: Code) -> u16 {
+        match code {
+            CODE_NOTHING => labels::NOTHING,
+            CODE_SKY => labels::SKY,
+            c if c & CODE_FLOOR != 0 => {
+                let k = (c & !CODE_FLOOR) as usize;
+                self.paints.get(k).copied().unwrap_or(labels::FLOOR_REGION)
+            }
+            rank => (rank as usize)
+                .checked_sub(1)
+                .and_then(|k| self.ranks.get(k).copied())
+                .unwrap_or(labels::NOTHING),
+        }
+    }
+}
+
+/// The truth of a frame of `sensor` (its mirror half in `rays`) on a robot at `pose` in
+/// `scene`, from each pixel's distance `t` along its scene ray and what it meets, `codes`.
+pub fn truth_frame(
+    scene: &Scene,
+    sensor: &Sensor,
+    rays: &TruthRays,
+    pose: &Isometry2<f64>,
+    t: &[f32],
+    codes: &[Code],
+) -> TruthFrame {
+    let legend = scene.legend();
+    let labeller = Labeller::new(scene, &legend, own_body(scene, pose));
+    let n = rays.len();
+    let (mut depth_mm, mut floor_mm, mut labels) =
+        (vec![f32::NAN; n], vec![f32::NAN; n], vec![0; n]);
+    for k in 0..n.min(t.len()).min(codes.len()) {
+        let label = labeller.label(codes[k]);
+        labels[k] = label;
+        let Some((path, o, d)) = rays.rays[k] else {
+            labels[k] = labels::NOTHING;
+            continue;
+        };
+        depth_mm[k] = match codes[k] {
+            CODE_SKY => f32::INFINITY,
+            CODE_NOTHING => f32::NAN,
+            _ => (path + t[k] as f64) as f32,
+        };
+        if legend.object(label).is_some_and(|o| o.class.is_floor()) {
+            let tk = t[k] as f64;
+            floor_mm[k] = (o[0] + tk * d[0]).hypot(o[1] + tk * d[1]) as f32;
+        }
+    }
+    TruthFrame {
+        width: sensor.width_px,
+        height: sensor.height_px,
+        depth_mm,
+        floor_mm,
+        labels,
+        legend,
+    }
+}
