@@ -46,13 +46,16 @@ impl TruthFrame {
     }
 }
 
+/// A pixel's mirror half: the camera ray's length (mm), the scene ray's origin and direction.
+type MirrorPath = (f64, [f64; 3], [f64; 3]);
+
 /// The mirror half of each pixel's path for the truth, in the robot frame: the camera ray's
 /// length to the mirror and the scene ray (`f64`, the same for every pose).
 #[derive(Debug, Clone)]
 pub struct TruthRays {
     /// Per pixel: the camera ray's length (mm), the scene ray's origin and direction; `None`
     /// where the pixel sees no mirror.
-    rays: Vec<Option<(f64, [f64; 3], [f64; 3])>>,
+    rays: Vec<Option<MirrorPath>>,
 }
 
 impl TruthRays {
