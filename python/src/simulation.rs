@@ -572,7 +572,8 @@ fn last_line(state: &State, k: usize) -> Option<String> {
     let agent = &state.session().simulation().robots()[k];
     let estimates = agent.estimates();
     let i = estimates.len().checked_sub(1)?;
-    Some(estimates_line(&agent.trajectory()[i], &estimates[i]))
+    let floor = agent.floor_scores().get(i).and_then(Option::as_ref);
+    Some(estimates_line(&agent.trajectory()[i], &estimates[i], floor))
 }
 
 /// Robot `k`'s last `estimates.jsonl` record as a dict (truth included), if a cycle ran.

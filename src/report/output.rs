@@ -26,7 +26,7 @@ pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Re
     std::fs::write(&summary_path, text + "\n")
         .with_context(|| format!("writing {}", summary_path.display()))?;
     if out.robots.is_empty() {
-        write_records(dir, &out.trajectory, &out.estimates)?;
+        write_records(dir, &out.trajectory, &out.estimates, &out.floor_scores)?;
     } else {
         write_team_records(dir, out)?;
     }
@@ -43,6 +43,7 @@ fn write_records(
     dir: &Path,
     trajectory: &[crate::run::TrajectoryRow],
     estimates: &[omniloop_robot::Estimates],
+    floor_scores: &[Option<crate::run::score::FloorRegionScore>],
 ) -> anyhow::Result<()> {
     let traj_path = dir.join("trajectory.csv");
     let f = File::create(&traj_path).with_context(|| format!("writing {}", traj_path.display()))?;
@@ -50,7 +51,7 @@ fn write_records(
         .with_context(|| format!("writing {}", traj_path.display()))?;
     let est_path = dir.join("estimates.jsonl");
     let f = File::create(&est_path).with_context(|| format!("writing {}", est_path.display()))?;
-    write_estimates_jsonl(trajectory, estimates, BufWriter::new(f))
+    write_estimates_jsonl(trajectory, estimates, floor_scores, BufWriter::new(f))
         .with_context(|| format!("writing {}", est_path.display()))
 }
 
@@ -60,7 +61,7 @@ fn write_team_records(dir: &Path, out: &RunOutput) -> anyhow::Result<()> {
     for r in &out.robots {
         let own = dir.join("robots").join(&r.name);
         std::fs::create_dir_all(&own).with_context(|| format!("creating {}", own.display()))?;
-        write_records(&own, &r.trajectory, &r.estimates)?;
+        write_records(&own, &r.trajectory, &r.estimates, &r.floor_scores)?;
     }
     let traj_path = dir.join("trajectory.csv");
     let f = File::create(&traj_path).with_context(|| format!("writing {}", traj_path.display()))?;

@@ -75,6 +75,21 @@ pub const ESTIMATORS: &[Estimator] = &[
         },
     },
     Estimator {
+        name: "floor_region",
+        title: "Floor region, pixel by pixel (E1)",
+        scenario: (corner::SCENARIOS[1].1, corner::SCENARIOS[1].2),
+        error_label: "1 - median floor-region IoU, %",
+        target: "the floor region's median IoU with the truth at least 0.9 (spec)",
+        bound: Some(10.0),
+        score: |s| {
+            let loss = 100.0 * (1.0 - s.floor_region_iou?);
+            Some(Score::new(
+                loss,
+                &[(loss > 10.0, format!("median IoU {:.3}", 1.0 - loss / 100.0))],
+            ))
+        },
+    },
+    Estimator {
         name: "floor_localization",
         title: "Floor localization (E2)",
         scenario: places::SCENARIO,

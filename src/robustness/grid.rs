@@ -216,7 +216,11 @@ fn run_all(
     progress: &mut impl FnMut(usize, usize),
 ) -> Vec<Option<crate::sweep::Outcome>> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let sweep = SweepOptions::new(options.workers, cores, options.renderer);
+    // The truth beside every frame: the floor region's estimator scores pixels.
+    let sweep = SweepOptions {
+        truth: true,
+        ..SweepOptions::new(options.workers, cores, options.renderer)
+    };
     let stop = AtomicBool::new(false);
     let finished = AtomicUsize::new(0);
     let total = plan.jobs.len();

@@ -10,7 +10,7 @@ use super::odometry::WheelOdometry;
 use super::outcome::{GoalFigures, GoalOutcome, ProgressSample, made_progress, route_reachability};
 use super::pilot::Pilot;
 use super::record::{RobotSummary, TrajectoryRow};
-use super::score::TruthScore;
+use super::score::{FloorRegionScore, TruthScore};
 use crate::scenario::calibrate::calibrate_sensor;
 use crate::scenario::{PilotChoice, Scenario};
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
@@ -26,6 +26,14 @@ use omniloop_vision::resection::ColumnCalibration;
 use std::collections::VecDeque;
 use std::path::Path;
 
+/// What a robot's run recorded: its trajectory, its estimates, and (with the truth kept) each
+/// cycle's floor-region score.
+pub(crate) type Records = (
+    Vec<TrajectoryRow>,
+    Vec<Estimates>,
+    Vec<Option<FloorRegionScore>>,
+);
+
 /// Builds a robot's software from what the robot is told.
 pub type SoftwareBuilder<'a> =
     dyn FnMut(&RobotConfig) -> Result<Box<dyn RobotSoftware>, RobotError> + 'a;
@@ -39,6 +47,9 @@ pub struct CameraSetup<'a> {
     pub shared_gpu: Option<&'a BatchHandle>,
     /// Render every camera, whatever the software reads.
     pub all: bool,
+    /// Trace each frame's truth beside it (depth, labels) and score the free space pixel by
+    /// pixel.
+    pub truth: bool,
 }
 
 /// A robot with software in the loop (see the module's documentation).
@@ -54,6 +65,9 @@ pub struct Agent {
     truth: TruthScore,
     trajectory: Vec<TrajectoryRow>,
     estimates: Vec<Estimates>,
+    /// With the truth kept: each recorded cycle's pixel-level score of the floor region, where
+    /// the free-space stage judged that cycle's frame.
+    floor_scores: Vec<Option<FloorRegionScore>>,
     last_odometry: Option<OdometryReading>,
     /// Commands on their way to the drive: when each is due, and the command.
     commands: VecDeque<(f64, VelocityCommand)>,
@@ -102,7 +116,8 @@ impl Agent {
             )?),
             None => None,
         };
-        let cameras = Cameras::open(
+        let truth = cameras.truth;
+        let mut cameras = Cameras::open(
             scenario,
             &software.cameras(),
             cameras.all || takes_frames,
@@ -110,6 +125,9 @@ impl Agent {
             cameras.shared_gpu,
             |m| notice(m),
         )?;
+        if let Some(c) = cameras.as_mut().filter(|_| truth) {
+            c.keep_truth();
+        }
         Ok(Self {
             name: name.to_string(),
             body,
@@ -122,6 +140,7 @@ impl Agent {
             truth: TruthScore::new(scenario.goal.as_ref()),
             trajectory: Vec::new(),
             estimates: Vec::new(),
+            floor_scores: Vec::new(),
             last_odometry: None,
             commands: VecDeque::new(),
             heading_for: None,
@@ -248,7 +267,12 @@ impl Agent {
     /// by the true heading, or the pilot's with `run.pilot = "truth"`) queued for the drive,
     /// the actuator commands to its pan units; scores the free space against `world` and
     /// records the cycle.
-    pub(crate) fn apply(&mut self, world: &World, t_s: f64, out: Outputs) -> Result<(), RunError> {
+    pub(crate) fn apply(
+        &mut self,
+        world: &World,
+        t_s: f64,
+        mut out: Outputs,
+    ) -> Result<(), RunError> {
         let state = world.robot_state(self.body);
         let (command, heading_for) = match &mut self.pilot {
             Some(p) => (
@@ -268,14 +292,43 @@ impl Agent {
         if let Some(c) = &mut self.cameras {
             c.command(&out.actuators)?;
         }
-        if let Some(fs) = &out.estimates.freespace {
+        let floor = out.estimates.freespace.as_mut().and_then(|fs| {
             let mount = self.vision_mount_mm();
-            self.truth
-                .freespace(world, self.body, &state.pose, mount, fs);
+            let free_true = (self.truth).freespace(world, self.body, &state.pose, mount, fs);
+            // The judged pixels are scored now and not kept in the record.
+            let pixels = fs.pixels.take()?;
+            let truth = self.vision_truth()?;
+            Some(FloorRegionScore::of(&pixels, truth, free_true))
+        });
+        if let Some(score) = &floor {
+            self.truth.floor_region(score);
+        }
+        if self.cameras.as_ref().is_some_and(Cameras::keeps_truth) {
+            self.floor_scores.push(floor);
         }
         self.heading_for = heading_for;
         self.record(world, t_s, command, out.estimates);
         Ok(())
+    }
+
+    /// The truth of the frame of vision's camera the software got this cycle, when kept.
+    fn vision_truth(&self) -> Option<&omniloop_sim::render::TruthFrame> {
+        let i = self.scenario.vision_sensor_index().ok()?;
+        let name = &self.scenario.robot.sensors[i].name;
+        self.cameras.as_ref()?.truth(name)
+    }
+
+    /// The truth of every frame its software got this cycle, by camera, when kept.
+    pub fn truth_frames(&self) -> Vec<(&str, &omniloop_sim::render::TruthFrame)> {
+        self.cameras
+            .as_ref()
+            .map(Cameras::truth_frames)
+            .unwrap_or_default()
+    }
+
+    /// With the truth kept: each recorded cycle's pixel-level score of the floor region.
+    pub fn floor_scores(&self) -> &[Option<FloorRegionScore>] {
+        &self.floor_scores
     }
 
     /// When its next queued command is due, if one is.
@@ -440,6 +493,7 @@ impl Agent {
             peak_speed_mm_s: stats.peak_speed_mm_s,
             peak_accel_mm_s2: stats.peak_accel_mm_s2,
             freespace_error_mm: self.truth.freespace_error_mm(),
+            floor_region_iou: self.truth.floor_region_iou(),
             pose_error_mm: self.truth.pose_error_mm(),
             targets_reached: self.truth.targets_reached(),
             localization_fixes: localization_fixes(&self.estimates),
@@ -466,9 +520,9 @@ impl Agent {
         })
     }
 
-    /// Ends its run: its trajectory and estimates.
-    pub(crate) fn into_records(self) -> (Vec<TrajectoryRow>, Vec<Estimates>) {
-        (self.trajectory, self.estimates)
+    /// Ends its run: its trajectory, estimates and floor-region scores.
+    pub(crate) fn into_records(self) -> Records {
+        (self.trajectory, self.estimates, self.floor_scores)
     }
 }
 

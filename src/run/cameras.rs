@@ -2,13 +2,14 @@
 //! noise, and the pan units of pinhole cameras, which the robot commands.
 
 use super::error::RunError;
+use super::truth_files;
 use crate::scenario::Scenario;
 use crate::scenario::TimingSpec;
 use image::RgbaImage;
 use omniloop_robot::{ActuatorCommand, ActuatorState, Frame};
 use omniloop_sim::optics::Optics;
-use omniloop_sim::render::BatchHandle;
 use omniloop_sim::render::effects::{exposure_poses, pose_after};
+use omniloop_sim::render::{BatchHandle, TruthFrame};
 use omniloop_sim::{Renderer, RendererChoice, RobotState, Scene, Sensor, SensorNoise, World};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -102,13 +103,18 @@ pub struct Cameras {
     delivery: Delivery,
     /// Captures on their way to the software.
     queue: VecDeque<Capture>,
+    /// Whether each frame's truth is traced beside it (the simulator's side only).
+    keep_truth: bool,
+    /// The truth of each frame of the capture the software gets now.
+    truth: Vec<Option<TruthFrame>>,
 }
 
-/// A capture on its way: when it was taken, the cycle it arrives, its frames.
+/// A capture on its way: when it was taken, the cycle it arrives, its frames and their truth.
 struct Capture {
     t_s: f64,
     arrives_s: f64,
     images: Vec<Option<RgbaImage>>,
+    truth: Vec<Option<TruthFrame>>,
 }
 
 /// `[robot.timing]`'s frame latency as whole control periods `periods` plus the capture's
@@ -185,7 +191,19 @@ impl Cameras {
                 scenario.seed,
             ),
             queue: VecDeque::new(),
+            keep_truth: false,
+            truth: Vec::new(),
         }))
+    }
+
+    /// Traces each frame's truth beside it from now on ([`Cameras::truth`]).
+    pub fn keep_truth(&mut self) {
+        self.keep_truth = true;
+    }
+
+    /// Whether each frame's truth is traced beside it.
+    pub fn keeps_truth(&self) -> bool {
+        self.keep_truth
     }
 
     /// The renderer's name.
@@ -216,6 +234,7 @@ impl Cameras {
         let offset = self.delivery.offset_s;
         state.pose = pose_after(&state.pose, state.velocity_mm_s, state.omega_rad_s, offset);
         let mut images = Vec::with_capacity(self.cameras.len());
+        let mut truth = Vec::with_capacity(self.cameras.len());
         for c in &mut self.cameras {
             let take = c.live && wanted.is_none_or(|w| w.contains(&c.sensor.name));
             let img = if take && !self.delivery.lost() {
@@ -230,11 +249,18 @@ impl Cameras {
                     turned_to(&c.sensor, unit.pan_rad())
                 });
                 let sensor = turned.as_ref().unwrap_or(&c.sensor);
-                Some(
-                    self.renderer
-                        .render_exposed(scene, sensor, &poses, Some(&mut c.noise))?,
-                )
+                let noise = Some(&mut c.noise);
+                if self.keep_truth {
+                    let (img, t) =
+                        (self.renderer).render_exposed_truth(scene, sensor, &poses, noise)?;
+                    truth.push(Some(t));
+                    Some(img)
+                } else {
+                    truth.push(None);
+                    Some(self.renderer.render_exposed(scene, sensor, &poses, noise)?)
+                }
             } else {
+                truth.push(None);
                 None
             };
             images.push(img);
@@ -243,8 +269,10 @@ impl Cameras {
             t_s: now + offset,
             arrives_s: now + f64::from(self.delivery.periods) * self.delivery.period_s,
             images,
+            truth,
         });
         self.images = vec![None; self.cameras.len()];
+        self.truth = vec![None; self.cameras.len()];
         while let Some(first) = self.queue.front() {
             if first.arrives_s > now + 1e-9 {
                 break;
@@ -253,6 +281,7 @@ impl Cameras {
                 break;
             };
             self.images = arrived.images;
+            self.truth = arrived.truth;
             self.images_t_s = arrived.t_s;
         }
         Ok(())
@@ -272,6 +301,21 @@ impl Cameras {
                     image,
                 })
             })
+            .collect()
+    }
+
+    /// The truth of the frame of camera `name` the software gets now, when the truth is kept
+    /// (the simulator's side: for scoring and recording, never for the software).
+    pub fn truth(&self, name: &str) -> Option<&TruthFrame> {
+        (self.cameras.iter().zip(&self.truth))
+            .find(|(c, _)| c.sensor.name == name)
+            .and_then(|(_, t)| t.as_ref())
+    }
+
+    /// The truth of every frame the software gets now, by camera name.
+    pub fn truth_frames(&self) -> Vec<(&str, &TruthFrame)> {
+        (self.cameras.iter().zip(&self.truth))
+            .filter_map(|(c, t)| t.as_ref().map(|t| (c.sensor.name.as_str(), t)))
             .collect()
     }
 
@@ -331,13 +375,22 @@ impl Cameras {
         }
     }
 
-    /// Writes the last capture to `dir` as `<camera>_<cycle>.png`.
+    /// Writes the last capture to `dir` as `<camera>_<cycle>.png`, with its truth where kept
+    /// (`<camera>_<cycle>_depth.png`, `_labels.png`, and the folder's `legend.json` once).
     pub fn save(&self, dir: &std::path::Path, cycle: u64) -> Result<(), RunError> {
-        for (c, img) in self.cameras.iter().zip(&self.images) {
+        for (k, (c, img)) in self.cameras.iter().zip(&self.images).enumerate() {
             let Some(img) = img else { continue };
-            let path = dir.join(format!("{}_{:06}.png", c.sensor.name, cycle));
+            let stem = format!("{}_{:06}", c.sensor.name, cycle);
+            let path = dir.join(format!("{stem}.png"));
             img.save(&path)
                 .map_err(|source| RunError::Frame { path, source })?;
+            if let Some(truth) = self.truth.get(k).and_then(Option::as_ref) {
+                truth_files::write_truth(dir, &stem, truth)?;
+                let legend = dir.join("legend.json");
+                if !legend.exists() {
+                    truth_files::write_legend(&legend, truth)?;
+                }
+            }
         }
         Ok(())
     }

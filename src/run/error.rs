@@ -51,6 +51,9 @@ pub enum RunError {
     /// robot's, a robot left without software).
     #[error("{0}")]
     Team(String),
+    /// A frame's truth could not be written.
+    #[error("writing a frame's truth: {0}")]
+    Truth(#[from] super::truth_files::TruthFileError),
     /// A frame could not be written.
     #[error("writing frame {path}: {source}")]
     Frame {

@@ -15,6 +15,7 @@ pub mod pilot;
 pub mod record;
 pub mod score;
 pub mod simulation;
+pub mod truth_files;
 
 pub use agent::{Agent, Truth};
 pub use error::RunError;
@@ -22,5 +23,5 @@ pub use outcome::{GoalFigures, GoalOutcome};
 pub use record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};
 pub use simulation::{
     OutputFile, RobotOutput, RunOptions, RunOutput, Simulation, builtin_software, render_snapshot,
-    straight_line_time_s,
+    render_snapshot_truth, straight_line_time_s,
 };

@@ -4,8 +4,10 @@
 //! without one, bit for bit. `omniloop run --mcap` and `--gif` are observers.
 
 use super::record::TrajectoryRow;
+use super::score::FloorRegionScore;
 use omniloop_robot::{Estimates, Frame};
 use omniloop_sim::World;
+use omniloop_sim::render::TruthFrame;
 use std::sync::{Arc, Mutex};
 
 /// One control cycle as an observer sees it.
@@ -26,6 +28,10 @@ pub struct RobotCycle<'a> {
     pub estimates: &'a Estimates,
     /// The frames it got this cycle, stamped with when they were taken.
     pub frames: Vec<Frame<'a>>,
+    /// With the truth traced: the truth of each of those frames, by camera.
+    pub truth: Vec<(&'a str, &'a TruthFrame)>,
+    /// With the truth traced: its floor region scored pixel by pixel, when it judged one.
+    pub floor: Option<&'a FloorRegionScore>,
 }
 
 /// Something that watches a run: a log, a live view.

@@ -1,6 +1,7 @@
 //! What a run leaves behind: the trajectory (one row a control cycle) and the summary.
 
 use super::outcome::GoalFigures;
+use super::score::FloorRegionScore;
 use nalgebra::{Isometry2, Point2};
 use omniloop_robot::{Estimates, Fix, FixOutcome, Measurement, NavigationReport};
 use omniloop_vision::{LocalizationMode, LocalizationQuality};
@@ -129,6 +130,10 @@ pub struct Summary {
     /// (truth ray-cast in the world, clipped at the template's range).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub freespace_error_mm: Option<f64>,
+    /// With the truth traced (`--truth`): median over the run's cycles of the intersection over
+    /// union of the free-space stage's floor region and the true one, pixel by pixel.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub floor_region_iou: Option<f64>,
     /// Median over the run of the distance between the controller's pose estimate and the
     /// truth.
     #[serde(skip_serializing_if = "Option::is_none", default)]
@@ -200,6 +205,9 @@ pub struct RobotSummary {
     /// Median error of its free distances (with the free-space stage).
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub freespace_error_mm: Option<f64>,
+    /// Median intersection over union of its floor region with the truth's (with `--truth`).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub floor_region_iou: Option<f64>,
     /// Median error of its pose estimate.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub pose_error_mm: Option<f64>,
@@ -385,6 +393,9 @@ struct EstimateLine<'a> {
     motion: Option<MotionRecord>,
     #[serde(skip_serializing_if = "Option::is_none")]
     plan: Option<PlanRecord>,
+    /// With the truth traced: the free-space stage's floor region scored pixel by pixel.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    floor_region: Option<&'a FloorRegionScore>,
 }
 
 /// What the planner did in one cycle: its plan, the point the controller headed for, the way
@@ -448,14 +459,17 @@ struct MotionRecord {
     inliers: usize,
 }
 
-/// Writes one JSON line a control cycle ([`estimates_line`]).
+/// Writes one JSON line a control cycle ([`estimates_line`]), with the cycle's floor-region
+/// score where `floor_scores` has one.
 pub fn write_estimates_jsonl(
     rows: &[TrajectoryRow],
     estimates: &[Estimates],
+    floor_scores: &[Option<FloorRegionScore>],
     mut w: impl Write,
 ) -> std::io::Result<()> {
-    for (r, e) in rows.iter().zip(estimates) {
-        serde_json::to_writer(&mut w, &EstimateLine::of(r, e))?;
+    for (k, (r, e)) in rows.iter().zip(estimates).enumerate() {
+        let floor = floor_scores.get(k).and_then(Option::as_ref);
+        serde_json::to_writer(&mut w, &EstimateLine::of(r, e, floor))?;
         writeln!(w)?;
     }
     Ok(())
@@ -464,14 +478,19 @@ pub fn write_estimates_jsonl(
 /// One line of `estimates.jsonl` (without its newline): time, true pose, the robot's pose
 /// estimate, the target it headed for, its fixes with their outcomes, the stages that found
 /// nothing (with why), its free distances, and (omnistereo) the landmarks it ranged and the
-/// motion it read, and (with a planner) its plan.
-pub fn estimates_line(row: &TrajectoryRow, e: &Estimates) -> String {
+/// motion it read, (with a planner) its plan, and (with the truth traced) its floor region
+/// scored pixel by pixel.
+pub fn estimates_line(
+    row: &TrajectoryRow,
+    e: &Estimates,
+    floor: Option<&FloorRegionScore>,
+) -> String {
     // Serializing plain records of numbers, strings and options cannot fail.
-    serde_json::to_string(&EstimateLine::of(row, e)).unwrap_or_default()
+    serde_json::to_string(&EstimateLine::of(row, e, floor)).unwrap_or_default()
 }
 
 impl<'a> EstimateLine<'a> {
-    fn of(r: &TrajectoryRow, e: &'a Estimates) -> Self {
+    fn of(r: &TrajectoryRow, e: &'a Estimates, floor: Option<&'a FloorRegionScore>) -> Self {
         EstimateLine {
             t_s: e.t_s,
             truth: PoseRecord {
@@ -504,6 +523,7 @@ impl<'a> EstimateLine<'a> {
                 inliers: m.inliers,
             }),
             plan: e.navigation.as_ref().map(PlanRecord::of),
+            floor_region: floor,
         }
     }
 }

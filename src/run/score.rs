@@ -5,7 +5,9 @@ use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::wrap_pi;
 use omniloop_robot::GoalSpec;
 use omniloop_sim::World;
-use omniloop_vision::FreeSpace;
+use omniloop_sim::render::TruthFrame;
+use omniloop_vision::{FloorPixels, FreeSpace};
+use serde::Serialize;
 
 /// The truth-side record of a run.
 #[derive(Debug, Clone, Default)]
@@ -21,6 +23,63 @@ pub struct TruthScore {
     /// The heading error at the last cycle of the visit in progress, if one is.
     visit: Option<f64>,
     visit_errors_deg: Vec<f64>,
+    floor_ious: Vec<f64>,
+}
+
+/// The free-space stage's floor region against the truth's, pixel by pixel, in one cycle: over
+/// the template's pixels, the stage's cleaned floor mask (step 1 of Sect. 3.1 of the corner
+/// paper) against the pixels whose truth is the floor region (bare floor or its lines).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FloorRegionScore {
+    /// |estimated AND true| / |estimated OR true| (1 where both are empty).
+    pub iou: f64,
+    /// Share of the template's pixels judged floor that are not the floor region.
+    pub false_free: f64,
+    /// Share of the template's pixels of the floor region judged not floor.
+    pub false_blocked: f64,
+    /// Per direction, the free distance (mm from the sensor axis) that eqs. (5)-(7) give on the
+    /// true floor region: what the stage would say were its step 1 perfect.
+    pub free_label_mm: Vec<f64>,
+    /// Per direction, the free distance in the world (ray cast from the sensor axis, clipped at
+    /// the template's range): the geometric truth.
+    pub free_true_mm: Vec<f64>,
+}
+
+impl FloorRegionScore {
+    /// Scores `pixels` (the stage's judgement of a frame) against `truth` (the same frame's),
+    /// with the geometric truth `free_true_mm` beside.
+    pub fn of(pixels: &FloorPixels, truth: &TruthFrame, free_true_mm: Vec<f64>) -> Self {
+        let (w, h) = (truth.width as usize, truth.height as usize);
+        let mut true_floor = vec![0u8; pixels.floor.len()];
+        let [mut both, mut est_only, mut true_only, mut n] = [0usize; 4];
+        for (k, u, v) in pixels.template_pixels() {
+            if u >= w || v >= h {
+                continue;
+            }
+            let t = truth.is_floor_region(v * w + u);
+            let e = pixels.floor[k] != 0;
+            true_floor[k] = u8::from(t);
+            n += 1;
+            both += usize::from(t && e);
+            est_only += usize::from(e && !t);
+            true_only += usize::from(t && !e);
+        }
+        let union = both + est_only + true_only;
+        let share = |c: usize| c as f64 / n.max(1) as f64;
+        let (_, a) = pixels.template.judge(&true_floor, pixels.r_th);
+        let edges = pixels.template.edges_mm();
+        Self {
+            iou: if union == 0 {
+                1.0
+            } else {
+                both as f64 / union as f64
+            },
+            false_free: share(est_only),
+            false_blocked: share(true_only),
+            free_label_mm: a.iter().map(|&i| edges[i]).collect(),
+            free_true_mm,
+        }
+    }
 }
 
 impl TruthScore {
@@ -113,7 +172,7 @@ impl TruthScore {
 
     /// Compares detected free distances with the world's, direction by direction, for robot
     /// `body` at `pose` whose camera axis sits at `mount_mm` (truth clipped at the template's
-    /// range; every other robot is an obstacle).
+    /// range; every other robot is an obstacle). Returns the true distances.
     pub fn freespace(
         &mut self,
         world: &World,
@@ -121,16 +180,29 @@ impl TruthScore {
         pose: &Isometry2<f64>,
         mount_mm: [f64; 2],
         fs: &FreeSpace,
-    ) {
+    ) -> Vec<f64> {
         let axis = pose * Point2::new(mount_mm[0], mount_mm[1]);
         let heading = pose.rotation.angle();
+        let mut truths = Vec::with_capacity(fs.free_mm.len());
         for (a, free) in fs.direction_rad.iter().zip(&fs.free_mm) {
             let dir = Vector2::new((heading + a).cos(), (heading + a).sin());
             let truth = world
                 .ray_cast_mm(axis, dir, fs.range_mm, Some(body))
                 .unwrap_or(fs.range_mm);
             self.freespace_errors_mm.push((free - truth).abs());
+            truths.push(truth);
         }
+        truths
+    }
+
+    /// Records a cycle's pixel-level score of the floor region.
+    pub fn floor_region(&mut self, score: &FloorRegionScore) {
+        self.floor_ious.push(score.iou);
+    }
+
+    /// Median over the run of the floor region's intersection over union.
+    pub fn floor_region_iou(&self) -> Option<f64> {
+        median(&self.floor_ious)
     }
 
     /// Records the distance of a pose estimate from the true position.

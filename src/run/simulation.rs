@@ -12,6 +12,7 @@ use super::observer::{CycleView, ObserverHandle, RobotCycle};
 use super::outcome::{GoalFigures, GoalOutcome};
 use super::pilot::Pilot;
 use super::record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};
+use super::score::FloorRegionScore;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::AccelLimitedDrive;
@@ -19,7 +20,7 @@ use omniloop_robot::{
     ActuatorState, Estimates, Frame, OdometryReading, Outputs, Robot, RobotConfig, RobotError,
     RobotSoftware,
 };
-use omniloop_sim::render::{BatchHandle, BatchServer};
+use omniloop_sim::render::{BatchHandle, BatchServer, TruthFrame};
 use omniloop_sim::{Renderer, RendererChoice, Scene, SensorNoise, SimError, World};
 use omniloop_vision::RadialCalibration;
 use rayon::prelude::*;
@@ -35,6 +36,9 @@ pub struct RunOptions {
     pub save_frames_every: Option<u64>,
     /// Where saved frames go.
     pub frames_dir: Option<PathBuf>,
+    /// Trace each frame's truth beside it (depth, labels; saved with the frames, recorded, and
+    /// the free space scored pixel by pixel). The robot's software never gets it.
+    pub truth: bool,
     /// A GPU shared with other runs, its frames traced in batches (overrides `renderer`).
     pub shared_gpu: Option<BatchHandle>,
     /// The experimenter takes frames of vision's camera (the camera is rendered and calibrated
@@ -53,6 +57,9 @@ pub struct RunOutput {
     pub trajectory: Vec<TrajectoryRow>,
     /// What the robot believed, one record a control cycle.
     pub estimates: Vec<Estimates>,
+    /// With the truth traced: each cycle's floor-region score, pixel by pixel (empty
+    /// otherwise).
+    pub floor_scores: Vec<Option<FloorRegionScore>>,
     /// The paths of the other robots, one point a control cycle.
     pub other_paths: Vec<Vec<Point2<f64>>>,
     /// Files of the experiment's own (tables, figures), written beside the run's.
@@ -73,6 +80,8 @@ pub struct RobotOutput {
     pub trajectory: Vec<TrajectoryRow>,
     /// What it believed, one record a control cycle.
     pub estimates: Vec<Estimates>,
+    /// With the truth traced: each cycle's floor-region score (empty otherwise).
+    pub floor_scores: Vec<Option<FloorRegionScore>>,
     /// The map its software built, when it builds one.
     pub map: Option<omniloop_robot::MapSnapshot>,
 }
@@ -150,6 +159,7 @@ impl Simulation {
                 renderer,
                 shared_gpu: shared.as_ref(),
                 all: options.save_frames_every.is_some(),
+                truth: options.truth,
             };
             let build: &mut SoftwareBuilder<'_> = &mut software;
             let agent = Agent::new(
@@ -446,6 +456,8 @@ impl Simulation {
                 row,
                 estimates,
                 frames: a.frames(),
+                truth: a.truth_frames(),
+                floor: a.floor_scores().last().and_then(Option::as_ref),
             });
         }
         let view = CycleView {
@@ -484,6 +496,7 @@ impl Simulation {
             map: None,
             trajectory: Vec::new(),
             estimates: Vec::new(),
+            floor_scores: Vec::new(),
             other_paths: self.other_paths,
             files: Vec::new(),
             robots: Vec::new(),
@@ -491,16 +504,18 @@ impl Simulation {
         for a in self.agents {
             let map = a.software().map();
             let name = a.name().to_string();
-            let (trajectory, estimates) = a.into_records();
+            let (trajectory, estimates, floor_scores) = a.into_records();
             if team {
                 out.robots.push(RobotOutput {
                     name,
                     trajectory,
                     estimates,
+                    floor_scores,
                     map,
                 });
             } else {
                 (out.trajectory, out.estimates, out.map) = (trajectory, estimates, map);
+                out.floor_scores = floor_scores;
             }
         }
         out
@@ -527,6 +542,11 @@ impl Simulation {
             } else {
                 first.estimates().to_vec()
             },
+            floor_scores: if team {
+                Vec::new()
+            } else {
+                first.floor_scores().to_vec()
+            },
             other_paths,
             files: Vec::new(),
             robots: if team {
@@ -536,6 +556,7 @@ impl Simulation {
                         name: a.name().to_string(),
                         trajectory: a.trajectory().to_vec(),
                         estimates: a.estimates().to_vec(),
+                        floor_scores: a.floor_scores().to_vec(),
                         map: a.software().map(),
                     })
                     .collect()
@@ -576,6 +597,7 @@ impl Simulation {
             path_length_mm: r.path_length_mm,
             renderer: first.renderer_name().map(str::to_string),
             freespace_error_mm: r.freespace_error_mm,
+            floor_region_iou: r.floor_region_iou,
             pose_error_mm: r.pose_error_mm,
             targets_reached: r.targets_reached,
             localization_fixes: r.localization_fixes,
@@ -616,6 +638,7 @@ impl Simulation {
                 .fold(f64::INFINITY, f64::min),
             path_length_mm: rows.iter().map(|r| r.path_length_mm).sum(),
             freespace_error_mm: None,
+            floor_region_iou: None,
             pose_error_mm: None,
             targets_reached: None,
             localization_fixes: None,
@@ -794,8 +817,8 @@ pub fn builtin_software(config: &RobotConfig) -> Result<Box<dyn RobotSoftware>, 
 
 /// Renders what sensor `sensor` of the robot under test (a team's first robot) sees when the
 /// robot stands at `pose` (the scenario's start when `None`) and every other robot at its
-/// start, with the sensor's
-/// noise drawn as the first frame of a run would be, or clean when `noise` is false.
+/// start, with the sensor's noise drawn as the first frame of a run would be, or clean when
+/// `noise` is false.
 pub fn render_snapshot(
     scenario: &Scenario,
     renderer: &mut Renderer,
@@ -803,22 +826,53 @@ pub fn render_snapshot(
     pose: Option<Isometry2<f64>>,
     noise: bool,
 ) -> Result<image::RgbaImage, RunError> {
-    let own = scenario.member(0);
-    let index = own
-        .sensor_index(sensor)
-        .map_err(|e| SimError::Invalid(format!("scenario {:?}: {e}", scenario.name)))?;
-    let mut bodies = scenario.robot_bodies();
-    if let Some(p) = pose {
-        bodies[0].start = p;
+    let shot = Snapshot::of(scenario, sensor, pose)?;
+    let mut noise_source = noise.then(|| SensorNoise::new(shot.noise_seed));
+    Ok(renderer.render(&shot.scene, &shot.sensor, &shot.pose, noise_source.as_mut())?)
+}
+
+/// [`render_snapshot`] with the frame's truth beside it (depth, floor distance, labels).
+pub fn render_snapshot_truth(
+    scenario: &Scenario,
+    renderer: &mut Renderer,
+    sensor: Option<&str>,
+    pose: Option<Isometry2<f64>>,
+    noise: bool,
+) -> Result<(image::RgbaImage, TruthFrame), RunError> {
+    let shot = Snapshot::of(scenario, sensor, pose)?;
+    let mut noise_source = noise.then(|| SensorNoise::new(shot.noise_seed));
+    let poses = [shot.pose];
+    Ok(renderer.render_exposed_truth(&shot.scene, &shot.sensor, &poses, noise_source.as_mut())?)
+}
+
+/// What a snapshot shows: the scene, the sensor, the robot's pose and the sensor's noise seed.
+struct Snapshot {
+    scene: Scene,
+    sensor: omniloop_sim::Sensor,
+    pose: Isometry2<f64>,
+    noise_seed: u64,
+}
+
+impl Snapshot {
+    fn of(
+        scenario: &Scenario,
+        sensor: Option<&str>,
+        pose: Option<Isometry2<f64>>,
+    ) -> Result<Self, RunError> {
+        let own = scenario.member(0);
+        let index = own
+            .sensor_index(sensor)
+            .map_err(|e| SimError::Invalid(format!("scenario {:?}: {e}", scenario.name)))?;
+        let mut bodies = scenario.robot_bodies();
+        if let Some(p) = pose {
+            bodies[0].start = p;
+        }
+        let world = World::new(&scenario.world, &bodies, scenario.run.physics_step_s)?;
+        Ok(Self {
+            scene: Scene::of_world(&world),
+            sensor: own.robot.sensors[index].build(),
+            pose: world.robot_state(0).pose,
+            noise_seed: sensor_noise_seed(own.seed, index),
+        })
     }
-    let world = World::new(&scenario.world, &bodies, scenario.run.physics_step_s)?;
-    let sensor = own.robot.sensors[index].build();
-    let scene = Scene::of_world(&world);
-    let mut noise_source = noise.then(|| SensorNoise::new(sensor_noise_seed(own.seed, index)));
-    Ok(renderer.render(
-        &scene,
-        &sensor,
-        &world.robot_state(0).pose,
-        noise_source.as_mut(),
-    )?)
 }

@@ -29,6 +29,8 @@ pub struct SweepOptions {
     pub keep_runs: Option<PathBuf>,
     /// The GPU every run's frames go to, traced in batches across runs (see [`shared_gpu`]).
     pub shared_gpu: Option<BatchHandle>,
+    /// Trace each frame's truth and score the free space pixel by pixel in every run.
+    pub truth: bool,
 }
 
 /// A batch server on the GPU for a sweep with `choice`: with `gpu`, the first adapter; with
@@ -60,6 +62,7 @@ impl SweepOptions {
             renderer,
             keep_runs: None,
             shared_gpu: None,
+            truth: false,
         }
     }
 }
@@ -139,6 +142,7 @@ fn run_one(plan: &Plan, job: &Job, options: &SweepOptions) -> Result<Summary, St
     let run_options = RunOptions {
         renderer: options.renderer,
         shared_gpu: options.shared_gpu.clone(),
+        truth: options.truth,
         ..RunOptions::default()
     };
     let keep = options

@@ -90,6 +90,7 @@ fn up_to(out: &RunOutput, n: usize) -> RunOutput {
         summary: out.summary.clone(),
         trajectory: out.trajectory[..n.min(out.trajectory.len())].to_vec(),
         estimates: Vec::new(),
+        floor_scores: Vec::new(),
         other_paths: out.other_paths.iter().map(|p| head(p)).collect(),
         files: Vec::new(),
         map: out.map.clone(),
@@ -100,6 +101,7 @@ fn up_to(out: &RunOutput, n: usize) -> RunOutput {
                 name: r.name.clone(),
                 trajectory: r.trajectory[..n.min(r.trajectory.len())].to_vec(),
                 estimates: Vec::new(),
+                floor_scores: Vec::new(),
                 map: None,
             })
             .collect(),

@@ -54,6 +54,8 @@ mod tests {
                 row: &r,
                 estimates: &estimates,
                 frames: Vec::new(),
+                truth: Vec::new(),
+                floor: None,
             }];
             let view = CycleView {
                 cycle: cycle as u64,

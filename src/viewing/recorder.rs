@@ -4,17 +4,20 @@
 
 use super::scene::{free_space, path, pose_in, stamp, transform, world_scene};
 use crate::run::observer::CycleView;
-use foxglove::messages::{CompressedImage, FrameTransform, PoseInFrame, SceneUpdate};
+use foxglove::messages::{CompressedImage, FrameTransform, PoseInFrame, RawImage, SceneUpdate};
 use foxglove::{Channel, ChannelBuilder, Context, PartialMetadata, RawChannel};
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_robot::Frame;
 use omniloop_sim::World;
+use omniloop_sim::render::TruthFrame;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
 /// The channels of a run: for the one robot `/camera/NAME`, `/truth/pose`, `/truth/tf`,
 /// `/estimate/pose`, `/estimate/tf`, `/estimate/error`, `/estimate/free_space`,
-/// `/estimate/path`, `/command`, `/estimate/record` (a team's robots each under its name:
+/// `/estimate/path`, `/command`, `/estimate/record`, and with the truth traced
+/// `/truth/camera/NAME/depth` (16UC1, mm) and `/truth/camera/NAME/labels` (rgb8, the legend's
+/// colours) with the legend on `/truth/legend` (a team's robots each under its name:
 /// `/ROBOT/camera/NAME`, `/ROBOT/truth/pose`, ..., in frames `ROBOT/truth/base_link`,
 /// `ROBOT/estimate/base_link`); and `/world`, `/summary`.
 pub struct Recorder {
@@ -31,6 +34,10 @@ struct RobotChannels {
     /// The topics' and frames' prefix: empty for the one robot, `ROBOT/` in a team.
     prefix: String,
     cameras: BTreeMap<String, Channel<CompressedImage>>,
+    /// Each camera's truth channels: depth and labels.
+    truth_images: BTreeMap<String, [Channel<RawImage>; 2]>,
+    /// The labels' legend, once.
+    legend: Option<Arc<RawChannel>>,
     truth_pose: Channel<PoseInFrame>,
     truth_tf: Channel<FrameTransform>,
     estimate_pose: Channel<PoseInFrame>,
@@ -89,6 +96,8 @@ impl RobotChannels {
                 .iter()
                 .map(|s| (s.clone(), camera_channel(ctx, &prefix, s)))
                 .collect(),
+            truth_images: BTreeMap::new(),
+            legend: None,
             truth_pose: typed("truth/pose").build(),
             truth_tf: typed("truth/tf").build(),
             estimate_pose: typed("estimate/pose").build(),
@@ -169,6 +178,48 @@ impl Recorder {
         );
     }
 
+    /// A frame's truth on robot `k`'s `/truth/camera/NAME/depth` and `/labels` (the legend on
+    /// `/truth/legend` with the first).
+    fn truth(&mut self, k: usize, t_s: f64, sensor: &str, truth: &TruthFrame) {
+        let ctx = &self.ctx;
+        let robot = &mut self.robots[k];
+        let prefix = robot.prefix.clone();
+        if robot.legend.is_none() {
+            let legend = json(ctx, &format!("/{prefix}truth/legend")).ok();
+            let entries = serde_json::to_string(&truth.legend.entries()).unwrap_or_default();
+            if let Some(c) = &legend {
+                c.log_with_meta(entries.as_bytes(), at(t_s));
+            }
+            robot.legend = legend;
+        }
+        let channels = robot
+            .truth_images
+            .entry(sensor.to_string())
+            .or_insert_with(|| {
+                let topic = |kind: &str| format!("/{prefix}truth/camera/{sensor}/{kind}");
+                let channel = |kind: &str| ChannelBuilder::new(topic(kind)).context(ctx).build();
+                [channel("depth"), channel("labels")]
+            });
+        let depth: Vec<u8> = (truth.depth_mm.iter())
+            .flat_map(|&d| crate::run::truth_files::depth_level(d).to_le_bytes())
+            .collect();
+        let palette = truth.legend.entries();
+        let colours: Vec<u8> = (truth.labels.iter())
+            .flat_map(|&l| palette.get(l as usize).map_or([0; 3], |e| e.rgb))
+            .collect();
+        let image = |encoding: &str, bytes: usize, data: Vec<u8>| RawImage {
+            timestamp: Some(stamp(t_s)),
+            frame_id: format!("{prefix}camera/{sensor}"),
+            width: truth.width,
+            height: truth.height,
+            encoding: encoding.into(),
+            step: truth.width * bytes as u32,
+            data: data.into(),
+        };
+        channels[0].log_with_meta(&image("16UC1", 2, depth), at(t_s));
+        channels[1].log_with_meta(&image("rgb8", 3, colours), at(t_s));
+    }
+
     /// The world's static scene on `/world`.
     pub fn world(&self, scene: &SceneUpdate) {
         self.world.log_with_meta(scene, at(0.0));
@@ -184,6 +235,9 @@ impl Recorder {
         for (k, robot) in c.robots.iter().enumerate().take(self.robots.len()) {
             for f in &robot.frames {
                 self.frame(k, robot.row.t_s, f);
+            }
+            for (sensor, truth) in &robot.truth {
+                self.truth(k, robot.row.t_s, sensor, truth);
             }
             self.robots[k].log(robot);
         }
@@ -258,6 +312,8 @@ pub struct RobotCycleOwned {
     pub row: crate::run::TrajectoryRow,
     /// The frames the software got.
     pub frames: Vec<OwnedFrame>,
+    /// With the truth traced: each frame's truth, by camera.
+    pub truth: Vec<(String, TruthFrame)>,
     /// The pose the robot believed.
     pub estimate: Option<Isometry2<f64>>,
     /// The free space it saw.
@@ -285,10 +341,13 @@ impl Cycle {
                         image: f.image.clone(),
                     })
                     .collect(),
+                truth: (r.truth.iter())
+                    .map(|(s, t)| (s.to_string(), (*t).clone()))
+                    .collect(),
                 estimate: r.estimates.pose,
                 freespace: r.estimates.freespace.clone(),
                 path: r.estimates.navigation.as_ref().map(|n| n.path_mm.clone()),
-                record: crate::run::record::estimates_line(r.row, r.estimates),
+                record: crate::run::record::estimates_line(r.row, r.estimates, r.floor),
             })
             .collect();
         Self { robots }

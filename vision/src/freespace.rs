@@ -23,6 +23,7 @@ use image::RgbaImage;
 use nalgebra::{Isometry2, Point2, Vector2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
+use std::sync::Arc;
 
 /// How the ring edges are spaced between `inner_mm` and `outer_mm`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -136,6 +137,34 @@ pub struct FreeSpace {
     /// Where the sensor axis stands in the robot frame, mm: the origin of every direction's
     /// distances.
     pub axis_mm: Point2<f64>,
+    /// The floor region judged pixel by pixel in the image this came from (none once moved to
+    /// another pose, [`FreeSpace::moved`]).
+    pub pixels: Option<Arc<FloorPixels>>,
+}
+
+/// The floor region a detector judged in one image, pixel by pixel: step 1's cleaned floor mask
+/// on the template's pixels, with the template, to be scored against a truth of the same
+/// pixels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloorPixels {
+    /// The template laid on the image.
+    pub template: Arc<PolarTemplate>,
+    /// Per pixel of the template's bounding box, row-major: non-zero where judged floor.
+    pub floor: Vec<u8>,
+    /// r_th of eq. (6).
+    pub r_th: f64,
+}
+
+impl FloorPixels {
+    /// Every pixel of the template (cell boundaries left out): its index in the bounding box,
+    /// its image column and row.
+    pub fn template_pixels(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+        let [x0, y0, x1, _] = self.template.bbox;
+        let bw = x1 - x0;
+        (self.template.cells.iter().enumerate())
+            .filter(|(_, c)| **c != NONE)
+            .map(move |(k, _)| (k, x0 + k % bw, y0 + k / bw))
+    }
 }
 
 impl FreeSpace {
@@ -173,6 +202,7 @@ impl FreeSpace {
             clear_points,
             front_mm,
             axis_mm: self.axis_mm,
+            pixels: None,
         }
     }
 
@@ -213,7 +243,7 @@ impl FreeSpace {
 const NONE: u16 = u16::MAX;
 
 /// The polar template laid on the image.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PolarTemplate {
     rings: usize,
     directions: usize,
@@ -399,13 +429,44 @@ impl PolarTemplate {
     pub fn edges_mm(&self) -> &[f64] {
         &self.edges_mm
     }
+
+    /// Bounding box of the template in the image, `[x0, y0, x1, y1)` in pixels.
+    pub fn bbox(&self) -> [usize; 4] {
+        self.bbox
+    }
+
+    /// Steps 2-4 with the count method on a floor mask of the template's bounding box (non-zero where
+    /// floor): each cell's floor pixels over its area, eq. (5) as counted; eq. (6) against
+    /// `r_th`; eq. (7)'s a_j per direction.
+    pub fn judge(&self, floor: &[u8], r_th: f64) -> (Vec<f64>, Vec<usize>) {
+        let mut counts = vec![0u32; self.rings * self.directions];
+        for (&c, &m) in self.cells.iter().zip(floor) {
+            if c != NONE && m != 0 {
+                counts[c as usize] += 1;
+            }
+        }
+        let ratio: Vec<f64> = (counts.iter().zip(&self.area))
+            .map(|(&n, &a)| n as f64 / a as f64)
+            .collect();
+        let a = self.first_blocked(&ratio, r_th);
+        (ratio, a)
+    }
+
+    /// Eq. (7): per direction j, the number of free cells from the inside before the first cell
+    /// whose ratio is below `r_th` (I where none is).
+    pub fn first_blocked(&self, ratio: &[f64], r_th: f64) -> Vec<usize> {
+        let (i_n, j_n) = (self.rings, self.directions);
+        (0..j_n)
+            .map(|j| (0..i_n).find(|&i| ratio[i * j_n + j] < r_th).unwrap_or(i_n))
+            .collect()
+    }
 }
 
 /// Detects free space in images of one calibrated sensor.
 #[derive(Debug, Clone)]
 pub struct FreeSpaceDetector {
     config: FreeSpaceConfig,
-    template: PolarTemplate,
+    template: Arc<PolarTemplate>,
     /// Per ring, how far it is surely free when eq. (6) judges it free (see
     /// [`FreeSpace::clear_mm`]).
     surely_free_mm: Vec<f64>,
@@ -427,7 +488,7 @@ impl FreeSpaceDetector {
                 rule: "must lie in (0, 1]",
             });
         }
-        let template = PolarTemplate::new(&config, cal)?;
+        let template = Arc::new(PolarTemplate::new(&config, cal)?);
         let surely_free_mm = template
             .edges_px
             .windows(2)
@@ -485,25 +546,18 @@ impl FreeSpaceDetector {
             .clean(self.config.morphology_iterations, &mut self.scratch);
 
         // Steps 2-3.
-        let n_cells = self.config.rings * self.config.directions;
-        self.counts.clear();
-        self.counts.resize(n_cells, 0);
-        match self.config.method {
-            FreeSpaceMethod::Count => {
-                for (&c, &m) in self.template.cells.iter().zip(&self.mask.data) {
-                    if c != NONE && m != 0 {
-                        self.counts[c as usize] += 1;
-                    }
-                }
+        let ratio = match self.config.method {
+            FreeSpaceMethod::Count => self.template.judge(&self.mask.data, self.config.r_th).0,
+            FreeSpaceMethod::Labeling => {
+                let n_cells = self.config.rings * self.config.directions;
+                self.counts.clear();
+                self.counts.resize(n_cells, 0);
+                self.label_areas();
+                (self.counts.iter().zip(&self.template.area))
+                    .map(|(&n, &a)| n as f64 / a as f64)
+                    .collect()
             }
-            FreeSpaceMethod::Labeling => self.label_areas(),
-        }
-        let ratio: Vec<f64> = self
-            .counts
-            .iter()
-            .zip(&self.template.area)
-            .map(|(&n, &a)| n as f64 / a as f64)
-            .collect();
+        };
 
         // Step 4.
         let (i_n, j_n) = (self.config.rings, self.config.directions);
@@ -520,12 +574,15 @@ impl FreeSpaceDetector {
             clear_points: Vec::new(),
             front_mm: vec![self.template.edges_mm[i_n]; j_n],
             axis_mm: Point2::from(self.template.mount_mm),
+            pixels: Some(Arc::new(FloorPixels {
+                template: self.template.clone(),
+                floor: self.mask.data.clone(),
+                r_th: self.config.r_th,
+            })),
         };
+        let blocked = self.template.first_blocked(&out.ratio, self.config.r_th);
         let [mx, my] = self.template.mount_mm;
-        for j in 0..j_n {
-            let a = (0..i_n)
-                .find(|&i| out.ratio[i * j_n + j] < self.config.r_th)
-                .unwrap_or(i_n);
+        for (j, &a) in blocked.iter().enumerate() {
             out.a[j] = a;
             let d = self.template.edges_mm[a];
             out.free_mm[j] = d;
@@ -659,6 +716,7 @@ mod tests {
             clear_points: Vec::new(),
             front_mm: free_mm,
             axis_mm: Point2::origin(),
+            pixels: None,
         }
     }
 

@@ -20,7 +20,7 @@ pub use floor_localization::{
     ColorClass, FieldModel, FloorLocalizer, Localization, LocalizationConfig, LocalizationMethod,
     LocalizationMode, LocalizationQuality, PoseEstimate,
 };
-pub use freespace::{FreeSpace, FreeSpaceConfig, FreeSpaceDetector, FreeSpaceMethod};
+pub use freespace::{FloorPixels, FreeSpace, FreeSpaceConfig, FreeSpaceDetector, FreeSpaceMethod};
 pub use mask::{FloorColor, Mask};
 
 /// Errors of the vision crate.

@@ -9,12 +9,13 @@ use omniloop::experiments::{ReplayContext, parse_scenario, run_dyn};
 use omniloop::replays::{REPLAYS, replay};
 use omniloop::report::output::{default_out_dir, write_run};
 use omniloop::run::observer::ObserverHandle;
-use omniloop::run::{RunOptions, render_snapshot};
+use omniloop::run::{RunOptions, render_snapshot, render_snapshot_truth, truth_files};
 use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
 use omniloop::sweep::Seeds;
 use omniloop::viewing::{FoxgloveLog, GifLog, LiveOptions, RealTime, RobotCameras, Sinks};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
+use omniloop_sim::render::TruthFrame;
 use omniloop_sim::{Renderer, RendererChoice, SensorSpec};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -71,6 +72,13 @@ enum Command {
         #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "1",
               value_parser = clap::value_parser!(u64).range(1..))]
         save_frames: Option<u64>,
+        /// Trace each frame's truth beside it (the simulator's side; the robot never gets it):
+        /// score the free space pixel by pixel (`floor_region` in estimates.jsonl,
+        /// `floor_region_iou` in summary.json); with --save-frames, `<sensor>_<cycle>_depth.png`
+        /// (16-bit, mm) and `_labels.png` (indexed, `legend.json`); with --mcap, the truth's
+        /// channels.
+        #[arg(long)]
+        truth: bool,
         /// Record the run as MCAP (camera frames, true and estimated poses, the world, free
         /// space, commands, estimates) for Foxglove: into FILE, or OUT/run.mcap.
         #[arg(long, value_name = "FILE", num_args = 0..=1)]
@@ -123,6 +131,10 @@ enum Command {
         /// Leave out the sensor noise.
         #[arg(long)]
         no_noise: bool,
+        /// Write the frame's truth beside it: OUT's stem with `_depth.png` (16-bit, mm),
+        /// `_labels.png` (indexed) and `_legend.json`.
+        #[arg(long)]
+        truth: bool,
     },
     /// Replay an experiment of the papers (`--list` shows them).
     Replay {
@@ -432,6 +444,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             seed,
             renderer,
             save_frames,
+            truth,
             mcap,
             live,
             live_wait,
@@ -482,6 +495,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 renderer,
                 save_frames_every: save_frames,
                 frames_dir: save_frames.map(|_| dir.join("frames")),
+                truth,
                 observers,
                 ..RunOptions::default()
             };
@@ -522,17 +536,32 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             sensor,
             renderer,
             no_noise,
+            truth,
         } => {
             let s = load(&scenario)?;
             let pose = pose.as_deref().map(parse_pose).transpose()?;
             let mut r = Renderer::new(renderer, |msg| eprintln!("{msg}"))?;
-            let img = render_snapshot(&s, &mut r, sensor.as_deref(), pose, !no_noise)?;
+            let (img, truth) = if truth {
+                let (img, t) =
+                    render_snapshot_truth(&s, &mut r, sensor.as_deref(), pose, !no_noise)?;
+                (img, Some(t))
+            } else {
+                (
+                    render_snapshot(&s, &mut r, sensor.as_deref(), pose, !no_noise)?,
+                    None,
+                )
+            };
             if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
                 std::fs::create_dir_all(parent)
                     .with_context(|| format!("creating {}", parent.display()))?;
             }
             img.save(&out)
                 .with_context(|| format!("writing {}", out.display()))?;
+            if let Some(t) = &truth {
+                for file in write_snapshot_truth(&out, t)? {
+                    println!("truth -> {}", file.display());
+                }
+            }
             println!(
                 "{}: {}x{} rendered by {} -> {}",
                 s.name,
@@ -729,4 +758,21 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Writes a snapshot's truth beside its image `out`: `STEM_depth.png`, `STEM_labels.png` and
+/// `STEM_legend.json`; returns the files.
+fn write_snapshot_truth(out: &Path, truth: &TruthFrame) -> anyhow::Result<Vec<PathBuf>> {
+    let dir = out.parent().unwrap_or(Path::new(""));
+    let stem = out
+        .file_stem()
+        .map_or("frame".into(), |s| s.to_string_lossy().into_owned());
+    truth_files::write_truth(dir, &stem, truth)?;
+    let legend = dir.join(format!("{stem}_legend.json"));
+    truth_files::write_legend(&legend, truth)?;
+    Ok(["depth.png", "labels.png"]
+        .iter()
+        .map(|k| dir.join(format!("{stem}_{k}")))
+        .chain([legend])
+        .collect())
 }
