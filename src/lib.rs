@@ -11,12 +11,14 @@
 //!   [`run_scenario`], [`Runner`] and [`load_scenario`];
 //! - [`sweep`]: many runs over a grid of values and seeds;
 //! - [`robustness`]: every estimator against each knob of realism, as one sweep;
+//! - [`dataset`]: frames of a camera with their truth (depth, labels, poses) for training;
 //! - [`replays`]: the registry of `omniloop replay`;
 //! - [`viewing`]: a run on Foxglove's channels, into an MCAP file.
 //!
 //! The robot's software is anything that implements [`robot::RobotSoftware`]; the world lives
 //! in `omniloop-sim`, image processing in [`vision`], motion and avoidance in [`control`].
 
+pub mod dataset;
 pub mod experiments;
 pub mod replays;
 pub mod report;

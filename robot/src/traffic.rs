@@ -388,6 +388,7 @@ mod tests {
             axis_mm: Point2::origin(),
             direction_rad: dirs,
             free_mm: free,
+            pixels: None,
         }
     }
 
@@ -459,6 +460,7 @@ mod tests {
             axis_mm: Point2::origin(),
             direction_rad: dirs,
             free_mm: free,
+            pixels: None,
         }
     }
 

@@ -4,6 +4,7 @@ use anyhow::{Context, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use nalgebra::{Isometry2, Vector2};
+use omniloop::dataset::{DatasetOptions, PoseMode, write_dataset};
 use omniloop::experiments::registry::setup_of;
 use omniloop::experiments::{ReplayContext, parse_scenario, run_dyn};
 use omniloop::replays::{REPLAYS, replay};
@@ -202,6 +203,34 @@ enum Command {
         /// (mm) count for success, the others for honesty (reached or reported unreachable).
         #[arg(long, value_name = "MM", default_value_t = omniloop::sweep::DEFAULT_REACHABLE_MARGIN_MM, value_parser = margin_mm)]
         reachable_margin_mm: f64,
+    },
+    /// Write frames of a camera with their truth (depth, labels, poses) and the camera model,
+    /// for training and evaluating perception (docs/truth.md).
+    Dataset {
+        /// Scenario file.
+        scenario: PathBuf,
+        /// Frames to write.
+        #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
+        samples: u64,
+        /// Where the poses come from: random (over the floor, clear of everything) or
+        /// along-run (the scenario's own run).
+        #[arg(long, default_value = "random")]
+        poses: PoseMode,
+        /// Camera (default: the one vision uses, else the robot's first).
+        #[arg(long)]
+        sensor: Option<String>,
+        /// Output folder (default: runs/<scenario name>/dataset).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Seed overriding the scenario's.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Renderer: auto, gpu or cpu.
+        #[arg(long, default_value = "cpu")]
+        renderer: RendererChoice,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate;
     /// with --format, fit a standard camera model to its rays and write that tool's file.
@@ -654,6 +683,51 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 reachable_margin_mm,
             },
         }),
+        Command::Dataset {
+            scenario,
+            samples,
+            poses,
+            sensor,
+            out,
+            seed,
+            renderer,
+            quiet,
+        } => {
+            let mut s = load(&scenario)?;
+            if let Some(seed) = seed {
+                s.seed = seed;
+            }
+            let dir = out.unwrap_or_else(|| default_out_dir(&s).join("dataset"));
+            let options = DatasetOptions {
+                samples: samples as usize,
+                poses,
+                sensor,
+                renderer,
+            };
+            let bar = styled_bar(
+                samples,
+                quiet,
+                "{prefix} [{bar:40}] {pos}/{len} samples {per_sec} eta {eta}",
+            );
+            bar.set_prefix(s.name.clone());
+            let started = std::time::Instant::now();
+            let info = write_dataset(&s, &options, &dir, |k, _| bar.set_position(k as u64))
+                .with_context(|| format!("writing the dataset of {}", scenario.display()))?;
+            bar.finish_and_clear();
+            println!(
+                "{}: {} samples of camera {:?} ({}x{}, poses {}) in {:.1} s, {:.1} MB -> {}",
+                info.scenario,
+                info.samples,
+                info.sensor,
+                info.size_px[0],
+                info.size_px[1],
+                info.poses.name(),
+                started.elapsed().as_secs_f64(),
+                folder_bytes(&dir) as f64 / 1e6,
+                dir.display()
+            );
+            Ok(())
+        }
         Command::Calibrate {
             scenario,
             sensor,
@@ -775,4 +849,18 @@ fn write_snapshot_truth(out: &Path, truth: &TruthFrame) -> anyhow::Result<Vec<Pa
         .map(|k| dir.join(format!("{stem}_{k}")))
         .chain([legend])
         .collect())
+}
+
+/// The bytes of every file under `dir`.
+fn folder_bytes(dir: &Path) -> u64 {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
+            _ => e.metadata().map_or(0, |m| m.len()),
+        })
+        .sum()
 }
