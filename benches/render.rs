@@ -1,7 +1,8 @@
 //! Renderer benchmark: median time per frame (and frames per second) of the field scene seen
 //! through the corner paper's hyperbolic mirror, at 256x220 and 512x512, on the CPU (one core,
 //! then all cores) and, when an adapter exists, the GPU (readback and the sensor noise included,
-//! as a run draws them); then batches of 1, 16, 256 and 1024 noisy frames (the GPU traces a
+//! as a run draws them); the extra cost of the truth beside a frame (depth, labels), frames with
+//! and without it in turn; then batches of 1, 16, 256 and 1024 noisy frames (the GPU traces a
 //! batch in one dispatch).
 //!
 //!     cargo bench --bench render
@@ -60,6 +61,7 @@ fn main() {
         let mut cpu = Renderer::cpu();
         frame_times(&mut cpu, &scene, &[&small, &big], &pose);
         clean_frame_time(&mut cpu, &scene, &small, &pose);
+        truth_cost(&mut cpu, &scene, &small, &pose);
     });
     let mut renderers = vec![Renderer::cpu()];
     match Renderer::new(RendererChoice::Gpu, |_| {}) {
@@ -68,6 +70,9 @@ fn main() {
     }
     for r in renderers.iter_mut() {
         frame_times(r, &scene, &[&small, &big], &pose);
+    }
+    for r in renderers.iter_mut().filter(|r| r.is_gpu()) {
+        truth_cost(r, &scene, &small, &pose);
     }
     batches(&mut renderers, &scene, &small, &pose);
 }
@@ -121,6 +126,50 @@ fn clean_frame_time(
         format!("{}x{}", sensor.width_px, sensor.height_px),
         m,
         1e3 / m
+    );
+}
+
+/// The median time of a noisy frame with its truth and without, taken in turn, and the truth's
+/// extra cost as a share of the frame.
+fn truth_cost(
+    r: &mut Renderer,
+    scene: &Scene,
+    sensor: &omniloop_sim::Sensor,
+    pose: &nalgebra::Isometry2<f64>,
+) {
+    let mut noise = SensorNoise::new(1);
+    let poses = [*pose];
+    let (mut without, mut with) = (Vec::new(), Vec::new());
+    for k in 0..405 {
+        let t = Instant::now();
+        if k % 2 == 0 {
+            r.render_exposed(scene, sensor, &poses, Some(&mut noise))
+                .expect("render");
+        } else {
+            r.render_exposed_truth(scene, sensor, &poses, Some(&mut noise))
+                .expect("render with truth");
+        }
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        // The first frames of each warm the caches.
+        if k >= 5 {
+            if k % 2 == 0 { &mut without } else { &mut with }.push(ms);
+        }
+    }
+    let (a, b) = (median(without), median(with));
+    for (what, m) in [("noisy", a), ("noisy, with truth", b)] {
+        println!(
+            "{:<48} {:>10} {:>12.3} {:>10.1}",
+            format!("{} {what}", r.name()),
+            format!("{}x{}", sensor.width_px, sensor.height_px),
+            m,
+            1e3 / m
+        );
+    }
+    println!(
+        "{:<48} {:>10} {:>11.0}%",
+        format!("{}: the truth's extra cost", r.name()),
+        "",
+        100.0 * (b - a) / a
     );
 }
 

@@ -3,6 +3,7 @@
 mod common;
 
 use common::scenario;
+use omniloop::run::truth_files;
 use omniloop_sim::labels::{self, Class, ObjectId};
 use omniloop_sim::optics::Optics;
 use omniloop_sim::{Renderer, Scene, World};
@@ -155,4 +156,135 @@ fn another_robot_is_robot_k_and_the_observer_its_own_body() {
         assert!(own > 100, "robot {robot} sees its body in {own} pixels");
     }
     assert!(saw_other, "robot 0 sees robot 1 down the corridor");
+}
+
+#[test]
+fn render_truth_writes_a_depth_png_in_mm_a_label_png_and_its_legend() {
+    let dir = common::tmp("render_truth");
+    let out = dir.join("h.png");
+    let status = common::bin()
+        .args([
+            "render",
+            "scenarios/render_hyperbolic.toml",
+            "--renderer",
+            "cpu",
+        ])
+        .args(["--no-noise", "--truth", "--out"])
+        .arg(&out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    // The files hold what the renderer gives.
+    let s = scenario("render_hyperbolic.toml");
+    let sensor = s.robot.sensors[0].build();
+    let (world, pose) = world_of(&s);
+    let truth = Renderer::cpu()
+        .render_truth(&Scene::of_world(&world), &sensor, &pose)
+        .unwrap();
+    let depth = truth_files::read_levels(&dir.join("h_depth.png")).unwrap();
+    let labels = truth_files::read_levels(&dir.join("h_labels.png")).unwrap();
+    assert_eq!((depth.width, depth.height), (256, 220));
+    for k in 0..truth.labels.len() {
+        assert_eq!(labels.values[k], truth.labels[k], "label of pixel {k}");
+        assert_eq!(depth.values[k], truth_files::depth_level(truth.depth_mm[k]));
+    }
+    let legend: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("h_legend.json")).unwrap()).unwrap();
+    assert_eq!(legend.len(), truth.legend.len());
+    assert_eq!(legend[11]["name"], "cube 0");
+}
+
+#[test]
+fn a_run_with_truth_scores_the_floor_region_every_cycle_and_its_median() {
+    let dir = common::tmp("run_truth");
+    let status = common::bin()
+        .args([
+            "run",
+            "scenarios/corner55_velocity_aware.toml",
+            "--renderer",
+            "cpu",
+        ])
+        .args(["--truth", "-q", "--out"])
+        .arg(&dir)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(dir.join("estimates.jsonl")).unwrap();
+    let mut ious = Vec::new();
+    for line in text.lines() {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        let f = &v["floor_region"];
+        let iou = f["iou"].as_f64().expect("a floor-region score every cycle");
+        let shares = [f["false_free"].as_f64(), f["false_blocked"].as_f64()];
+        assert!(
+            shares
+                .iter()
+                .all(|s| s.is_some_and(|s| (0.0..=1.0).contains(&s)))
+        );
+        assert_eq!(f["free_label_mm"].as_array().unwrap().len(), 32);
+        assert_eq!(f["free_true_mm"].as_array().unwrap().len(), 32);
+        ious.push(iou);
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let median = summary["floor_region_iou"].as_f64().unwrap();
+    ious.sort_by(f64::total_cmp);
+    assert!(ious.len() > 100);
+    assert!((ious[0]..=1.0).contains(&median));
+    // The floor colour is far from the walls' and the outside's: the stage's floor region
+    // agrees with the truth's but for a few edge pixels.
+    assert!(ious[0] > 0.98, "worst cycle's IoU {}", ious[0]);
+}
+
+#[test]
+fn a_dataset_holds_frames_depth_labels_poses_and_the_camera_model() {
+    let dir = common::tmp("dataset");
+    let s = scenario("corner55_velocity_aware.toml");
+    let options = omniloop::dataset::DatasetOptions {
+        samples: 4,
+        ..Default::default()
+    };
+    let info = omniloop::dataset::write_dataset(&s, &options, &dir, |_, _| {}).unwrap();
+    assert_eq!(info.samples, 4);
+    for k in 0..4 {
+        let name = format!("{k:06}.png");
+        let img = image::open(dir.join("images").join(&name)).unwrap();
+        assert_eq!((img.width(), img.height()), (256, 220));
+        let labels = truth_files::read_levels(&dir.join("labels").join(&name)).unwrap();
+        let depth = truth_files::read_levels(&dir.join("depth").join(&name)).unwrap();
+        // Every labelled pixel of the floor or a wall has a depth; the sky has none.
+        for (l, d) in labels.values.iter().zip(&depth.values) {
+            match *l {
+                labels::NOTHING | labels::SKY => assert_eq!(*d, 0),
+                _ => assert!(*d > 0),
+            }
+        }
+        assert!(labels.values.iter().any(|&l| l == labels::FLOOR_REGION));
+    }
+    let poses = std::fs::read_to_string(dir.join("poses.csv")).unwrap();
+    assert_eq!(poses.lines().count(), 5);
+    for f in [
+        "dataset.json",
+        "legend.json",
+        "calibration.json",
+        "camera.yaml",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    // The same scenario and seed, the same dataset.
+    let again = common::tmp("dataset_again");
+    omniloop::dataset::write_dataset(&s, &options, &again, |_, _| {}).unwrap();
+    for f in [
+        "poses.csv",
+        "images/000003.png",
+        "labels/000003.png",
+        "depth/000003.png",
+    ] {
+        assert_eq!(
+            std::fs::read(dir.join(f)).unwrap(),
+            std::fs::read(again.join(f)).unwrap()
+        );
+    }
 }
