@@ -382,7 +382,7 @@ impl<'a> FreePlaces<'a> {
             radius_mm,
             bounds,
             others,
-            rng: StdRng::seed_from_u64(scenario.seed ^ 0xDA7A_5E7_0000_0001),
+            rng: StdRng::seed_from_u64(scenario.seed ^ 0xDA7A_5E70_0000_0001),
         }
     }
 
