@@ -303,19 +303,7 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
                             "{name}/{} pose {k}, {kind} kernel, packets {order}",
                             spec.name
                         );
-                        // With the truth: the same colours, and each pixel's distance (to the
-                        // bit) and what it meets as tracing every primitive gives them.
-                        let n = reference.len();
-                        let (mut t, mut codes) = (vec![0.0; n], vec![0; n]);
-                        r.render_truth(&scene, rays, pose, &mut pixels, (&mut t, &mut codes));
-                        let differ = (0..n)
-                            .filter(|&i| {
-                                let want = &traced[i];
-                                pixels[i] != want.colour
-                                    || t[i].to_bits() != want.t.to_bits()
-                                    || codes[i] != want.code
-                            })
-                            .count();
+                        let differ = truth_differs(&mut r, &scene, rays, pose, &traced);
                         assert_eq!(
                             differ, 0,
                             "{name}/{} pose {k}, {kind} kernel with truth, packets {order}",
@@ -328,6 +316,26 @@ fn the_culled_cpu_renderer_equals_tracing_every_primitive() {
         }
     }
     assert!(checked >= 3 * 7, "only {checked} frames checked");
+}
+
+/// The pixels whose colour, distance (to the bit) or what they meet, traced with the truth,
+/// differ from tracing every primitive.
+fn truth_differs(
+    r: &mut CpuRenderer,
+    scene: &Scene,
+    rays: &mut SensorRays,
+    pose: &Isometry2<f64>,
+    traced: &[omniloop_sim::render::trace::Traced],
+) -> usize {
+    let n = traced.len();
+    let (mut pixels, mut t, mut codes) = (vec![0; n], vec![0.0; n], vec![0; n]);
+    r.render_truth(scene, rays, pose, &mut pixels, (&mut t, &mut codes));
+    (0..n)
+        .filter(|&i| {
+            let want = &traced[i];
+            pixels[i] != want.colour || t[i].to_bits() != want.t.to_bits() || codes[i] != want.code
+        })
+        .count()
 }
 
 #[test]

@@ -156,6 +156,84 @@ const DIFFUSE: f32 = 0.55;
 const LIGHT_DIR: [f32; 3] = [0.35, 0.25, 0.9];
 const SKY_RGB: Rgb = Rgb([150, 160, 175]);
 
+/// The floor's rectangles of `layout`: its floor region's, then its marks; and whether it has a
+/// floor region.
+fn floor_rects(layout: &Layout) -> (Vec<FloorRectPrim>, bool) {
+    let regions = layout.all_floor_rects();
+    let any_region = !regions.is_empty();
+    let mut floor_rects: Vec<FloorRectPrim> = regions
+        .iter()
+        .map(|r| FloorRectPrim {
+            geom: [
+                r.center_mm[0] as f32,
+                r.center_mm[1] as f32,
+                (r.size_mm[0] / 2.0) as f32,
+                (r.size_mm[1] / 2.0) as f32,
+            ],
+            frame: unit_frame(r.angle_deg, FLOOR_REGION),
+            color: [0.0; 4],
+        })
+        .collect();
+    floor_rects.extend(layout.all_floor_marks().iter().map(|m| {
+        let h = (m.size_mm / 2.0) as f32;
+        let kind = match m.shape {
+            MarkShape::Square => SQUARE_MARK,
+            MarkShape::Disc => DISC_MARK,
+        };
+        FloorRectPrim {
+            geom: [m.center_mm[0] as f32, m.center_mm[1] as f32, h, h],
+            frame: unit_frame(m.angle_deg, kind),
+            color: rgb4(m.rgb, 0.0),
+        }
+    }));
+    (floor_rects, any_region)
+}
+
+/// What each solid is, in the order of the primitives' ranks: boxes, quad prisms, cylinders.
+fn objects_by_rank(solids: &[&Solid]) -> Vec<ObjectId> {
+    let rank = |s: &&&Solid| match s.shape {
+        SolidShape::Box { .. } => 0,
+        SolidShape::Quad { .. } => 1,
+        SolidShape::Cylinder { .. } => 2,
+    };
+    (0..3)
+        .flat_map(|k| solids.iter().filter(move |s| rank(s) == k))
+        .map(|s| s.object)
+        .collect()
+}
+
+impl SceneGlobals {
+    /// The scalars of a scene of `layout` (`any_region`: whether it has floor-region
+    /// rectangles) with `[boxes, cylinders, floor rectangles and marks, boards, quads]`.
+    fn of(layout: &Layout, any_region: bool, counts: [u32; 5]) -> Self {
+        let [boxes, cylinders, floor_rects, boards, quads] = counts;
+        let n = (LIGHT_DIR[0] * LIGHT_DIR[0]
+            + LIGHT_DIR[1] * LIGHT_DIR[1]
+            + LIGHT_DIR[2] * LIGHT_DIR[2])
+            .sqrt();
+        let l = [LIGHT_DIR[0] / n, LIGHT_DIR[1] / n, LIGHT_DIR[2] / n];
+        let field = layout.field.as_ref();
+        Self {
+            field: field.map_or([0.0; 4], |f| {
+                [
+                    f.half_length_mm as f32,
+                    f.half_width_mm as f32,
+                    f.line_width_mm as f32,
+                    f.centre_circle_radius_mm as f32,
+                ]
+            }),
+            flags: [field.is_some() as u32, any_region as u32, boxes, cylinders],
+            counts: [floor_rects, boards, quads, 0],
+            floor_rgb: rgb4(layout.floor_rgb, 0.0),
+            outside_rgb: rgb4(layout.outside_rgb, 0.0),
+            line_rgb: rgb4(layout.line_rgb, 0.0),
+            sky_rgb: rgb4(SKY_RGB, 0.0),
+            light: [l[0], l[1], l[2], AMBIENT],
+            light2: [DIFFUSE, 1.0 / (AMBIENT + DIFFUSE * l[2]), 0.0, 0.0],
+        }
+    }
+}
+
 impl Scene {
     /// The scene of a layout with extra solids (robots, the observer's body).
     pub fn new(layout: &Layout, extra: &[Solid]) -> Self {
@@ -176,14 +254,8 @@ impl Scene {
         let mut boxes = Vec::new();
         let mut cylinders = Vec::new();
         let mut quads = Vec::new();
-        let mut objects: [Vec<ObjectId>; 3] = Default::default();
-        for s in solids {
-            let kind = match s.shape {
-                SolidShape::Box { .. } => 0,
-                SolidShape::Quad { .. } => 1,
-                SolidShape::Cylinder { .. } => 2,
-            };
-            objects[kind].push(s.object);
+        let solids: Vec<&Solid> = solids.collect();
+        for s in &solids {
             match s.shape {
                 SolidShape::Box {
                     center_mm,
@@ -236,67 +308,15 @@ impl Scene {
             });
             stripe_edges.extend(edges.iter().map(|&e| e as f32));
         }
-        let regions = layout.all_floor_rects();
-        let any_region = !regions.is_empty();
-        let mut floor_rects: Vec<FloorRectPrim> = regions
-            .iter()
-            .map(|r| FloorRectPrim {
-                geom: [
-                    r.center_mm[0] as f32,
-                    r.center_mm[1] as f32,
-                    (r.size_mm[0] / 2.0) as f32,
-                    (r.size_mm[1] / 2.0) as f32,
-                ],
-                frame: unit_frame(r.angle_deg, FLOOR_REGION),
-                color: [0.0; 4],
-            })
-            .collect();
-        floor_rects.extend(layout.all_floor_marks().iter().map(|m| {
-            let h = (m.size_mm / 2.0) as f32;
-            let kind = match m.shape {
-                MarkShape::Square => SQUARE_MARK,
-                MarkShape::Disc => DISC_MARK,
-            };
-            FloorRectPrim {
-                geom: [m.center_mm[0] as f32, m.center_mm[1] as f32, h, h],
-                frame: unit_frame(m.angle_deg, kind),
-                color: rgb4(m.rgb, 0.0),
-            }
-        }));
-        let n = (LIGHT_DIR[0] * LIGHT_DIR[0]
-            + LIGHT_DIR[1] * LIGHT_DIR[1]
-            + LIGHT_DIR[2] * LIGHT_DIR[2])
-            .sqrt();
-        let l = [LIGHT_DIR[0] / n, LIGHT_DIR[1] / n, LIGHT_DIR[2] / n];
-        let field = layout.field.as_ref();
-        let globals = SceneGlobals {
-            field: field.map_or([0.0; 4], |f| {
-                [
-                    f.half_length_mm as f32,
-                    f.half_width_mm as f32,
-                    f.line_width_mm as f32,
-                    f.centre_circle_radius_mm as f32,
-                ]
-            }),
-            flags: [
-                field.is_some() as u32,
-                any_region as u32,
-                boxes.len() as u32,
-                cylinders.len() as u32,
-            ],
-            counts: [
-                floor_rects.len() as u32,
-                boards.len() as u32,
-                quads.len() as u32,
-                0,
-            ],
-            floor_rgb: rgb4(layout.floor_rgb, 0.0),
-            outside_rgb: rgb4(layout.outside_rgb, 0.0),
-            line_rgb: rgb4(layout.line_rgb, 0.0),
-            sky_rgb: rgb4(SKY_RGB, 0.0),
-            light: [l[0], l[1], l[2], AMBIENT],
-            light2: [DIFFUSE, 1.0 / (AMBIENT + DIFFUSE * l[2]), 0.0, 0.0],
-        };
+        let (floor_rects, any_region) = floor_rects(layout);
+        let counts = [
+            boxes.len(),
+            cylinders.len(),
+            floor_rects.len(),
+            boards.len(),
+            quads.len(),
+        ];
+        let globals = SceneGlobals::of(layout, any_region, counts.map(|n| n as u32));
         Self {
             globals,
             boxes,
@@ -305,7 +325,7 @@ impl Scene {
             boards,
             stripe_edges,
             floor_rects,
-            objects: objects.concat(),
+            objects: objects_by_rank(&solids),
         }
     }
 

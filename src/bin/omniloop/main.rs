@@ -114,29 +114,7 @@ enum Command {
         print_default: bool,
     },
     /// Render one frame of a sensor to a PNG.
-    Render {
-        /// Scenario file.
-        scenario: PathBuf,
-        /// Robot pose `x_mm,y_mm,theta_deg` (default: the scenario's start).
-        #[arg(long, allow_hyphen_values = true)]
-        pose: Option<String>,
-        /// Output PNG.
-        #[arg(long)]
-        out: PathBuf,
-        /// Sensor name (default: the robot's first sensor).
-        #[arg(long)]
-        sensor: Option<String>,
-        /// Renderer: auto, gpu or cpu.
-        #[arg(long, default_value = "auto")]
-        renderer: RendererChoice,
-        /// Leave out the sensor noise.
-        #[arg(long)]
-        no_noise: bool,
-        /// Write the frame's truth beside it: OUT's stem with `_depth.png` (16-bit, mm),
-        /// `_labels.png` (indexed) and `_legend.json`.
-        #[arg(long)]
-        truth: bool,
-    },
+    Render(RenderArgs),
     /// Replay an experiment of the papers (`--list` shows them).
     Replay {
         /// The experiment (without one, the list).
@@ -206,32 +184,7 @@ enum Command {
     },
     /// Write frames of a camera with their truth (depth, labels, poses) and the camera model,
     /// for training and evaluating perception (docs/truth.md).
-    Dataset {
-        /// Scenario file.
-        scenario: PathBuf,
-        /// Frames to write.
-        #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
-        samples: u64,
-        /// Where the poses come from: random (over the floor, clear of everything) or
-        /// along-run (the scenario's own run).
-        #[arg(long, default_value = "random")]
-        poses: PoseMode,
-        /// Camera (default: the one vision uses, else the robot's first).
-        #[arg(long)]
-        sensor: Option<String>,
-        /// Output folder (default: runs/<scenario name>/dataset).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Seed overriding the scenario's.
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Renderer: auto, gpu or cpu.
-        #[arg(long, default_value = "cpu")]
-        renderer: RendererChoice,
-        /// No progress bar.
-        #[arg(long, short)]
-        quiet: bool,
-    },
+    Dataset(DatasetArgs),
     /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate;
     /// with --format, fit a standard camera model to its rays and write that tool's file.
     Calibrate {
@@ -251,6 +204,61 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+}
+
+/// `omniloop render`'s arguments.
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scenario file.
+    scenario: PathBuf,
+    /// Robot pose `x_mm,y_mm,theta_deg` (default: the scenario's start).
+    #[arg(long, allow_hyphen_values = true)]
+    pose: Option<String>,
+    /// Output PNG.
+    #[arg(long)]
+    out: PathBuf,
+    /// Sensor name (default: the robot's first sensor).
+    #[arg(long)]
+    sensor: Option<String>,
+    /// Renderer: auto, gpu or cpu.
+    #[arg(long, default_value = "auto")]
+    renderer: RendererChoice,
+    /// Leave out the sensor noise.
+    #[arg(long)]
+    no_noise: bool,
+    /// Write the frame's truth beside it: OUT's stem with `_depth.png` (16-bit, mm),
+    /// `_labels.png` (indexed) and `_legend.json`.
+    #[arg(long)]
+    truth: bool,
+}
+
+/// `omniloop dataset`'s arguments.
+#[derive(clap::Args)]
+struct DatasetArgs {
+    /// Scenario file.
+    scenario: PathBuf,
+    /// Frames to write.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u64).range(1..))]
+    samples: u64,
+    /// Where the poses come from: random (over the floor, clear of everything) or
+    /// along-run (the scenario's own run).
+    #[arg(long, default_value = "random")]
+    poses: PoseMode,
+    /// Camera (default: the one vision uses, else the robot's first).
+    #[arg(long)]
+    sensor: Option<String>,
+    /// Output folder (default: runs/<scenario name>/dataset).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Seed overriding the scenario's.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Renderer: auto, gpu or cpu.
+    #[arg(long, default_value = "cpu")]
+    renderer: RendererChoice,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 mod sweep;
@@ -558,49 +566,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             println!("{}; results in {}", outcome_line(m), dir.display());
             Ok(())
         }
-        Command::Render {
-            scenario,
-            pose,
-            out,
-            sensor,
-            renderer,
-            no_noise,
-            truth,
-        } => {
-            let s = load(&scenario)?;
-            let pose = pose.as_deref().map(parse_pose).transpose()?;
-            let mut r = Renderer::new(renderer, |msg| eprintln!("{msg}"))?;
-            let (img, truth) = if truth {
-                let (img, t) =
-                    render_snapshot_truth(&s, &mut r, sensor.as_deref(), pose, !no_noise)?;
-                (img, Some(t))
-            } else {
-                (
-                    render_snapshot(&s, &mut r, sensor.as_deref(), pose, !no_noise)?,
-                    None,
-                )
-            };
-            if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
-                std::fs::create_dir_all(parent)
-                    .with_context(|| format!("creating {}", parent.display()))?;
-            }
-            img.save(&out)
-                .with_context(|| format!("writing {}", out.display()))?;
-            if let Some(t) = &truth {
-                for file in write_snapshot_truth(&out, t)? {
-                    println!("truth -> {}", file.display());
-                }
-            }
-            println!(
-                "{}: {}x{} rendered by {} -> {}",
-                s.name,
-                img.width(),
-                img.height(),
-                r.name(),
-                out.display()
-            );
-            Ok(())
-        }
+        Command::Render(args) => render(args),
         Command::Replay {
             experiment,
             list,
@@ -683,51 +649,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 reachable_margin_mm,
             },
         }),
-        Command::Dataset {
-            scenario,
-            samples,
-            poses,
-            sensor,
-            out,
-            seed,
-            renderer,
-            quiet,
-        } => {
-            let mut s = load(&scenario)?;
-            if let Some(seed) = seed {
-                s.seed = seed;
-            }
-            let dir = out.unwrap_or_else(|| default_out_dir(&s).join("dataset"));
-            let options = DatasetOptions {
-                samples: samples as usize,
-                poses,
-                sensor,
-                renderer,
-            };
-            let bar = styled_bar(
-                samples,
-                quiet,
-                "{prefix} [{bar:40}] {pos}/{len} samples {per_sec} eta {eta}",
-            );
-            bar.set_prefix(s.name.clone());
-            let started = std::time::Instant::now();
-            let info = write_dataset(&s, &options, &dir, |k, _| bar.set_position(k as u64))
-                .with_context(|| format!("writing the dataset of {}", scenario.display()))?;
-            bar.finish_and_clear();
-            println!(
-                "{}: {} samples of camera {:?} ({}x{}, poses {}) in {:.1} s, {:.1} MB -> {}",
-                info.scenario,
-                info.samples,
-                info.sensor,
-                info.size_px[0],
-                info.size_px[1],
-                info.poses.name(),
-                started.elapsed().as_secs_f64(),
-                folder_bytes(&dir) as f64 / 1e6,
-                dir.display()
-            );
-            Ok(())
-        }
+        Command::Dataset(args) => dataset(args),
         Command::Calibrate {
             scenario,
             sensor,
@@ -863,4 +785,97 @@ fn folder_bytes(dir: &Path) -> u64 {
             _ => e.metadata().map_or(0, |m| m.len()),
         })
         .sum()
+}
+
+/// `omniloop render`: one frame of a sensor, with its truth when asked.
+fn render(args: RenderArgs) -> anyhow::Result<()> {
+    let RenderArgs {
+        scenario,
+        pose,
+        out,
+        sensor,
+        renderer,
+        no_noise,
+        truth,
+    } = args;
+    let s = load(&scenario)?;
+    let pose = pose.as_deref().map(parse_pose).transpose()?;
+    let mut r = Renderer::new(renderer, |msg| eprintln!("{msg}"))?;
+    let (img, truth) = if truth {
+        let (img, t) = render_snapshot_truth(&s, &mut r, sensor.as_deref(), pose, !no_noise)?;
+        (img, Some(t))
+    } else {
+        (
+            render_snapshot(&s, &mut r, sensor.as_deref(), pose, !no_noise)?,
+            None,
+        )
+    };
+    if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("creating {}", parent.display()))?;
+    }
+    img.save(&out)
+        .with_context(|| format!("writing {}", out.display()))?;
+    if let Some(t) = &truth {
+        for file in write_snapshot_truth(&out, t)? {
+            println!("truth -> {}", file.display());
+        }
+    }
+    println!(
+        "{}: {}x{} rendered by {} -> {}",
+        s.name,
+        img.width(),
+        img.height(),
+        r.name(),
+        out.display()
+    );
+    Ok(())
+}
+
+/// `omniloop dataset`: frames of a camera with their truth.
+fn dataset(args: DatasetArgs) -> anyhow::Result<()> {
+    let DatasetArgs {
+        scenario,
+        samples,
+        poses,
+        sensor,
+        out,
+        seed,
+        renderer,
+        quiet,
+    } = args;
+    let mut s = load(&scenario)?;
+    if let Some(seed) = seed {
+        s.seed = seed;
+    }
+    let dir = out.unwrap_or_else(|| default_out_dir(&s).join("dataset"));
+    let options = DatasetOptions {
+        samples: samples as usize,
+        poses,
+        sensor,
+        renderer,
+    };
+    let bar = styled_bar(
+        samples,
+        quiet,
+        "{prefix} [{bar:40}] {pos}/{len} samples {per_sec} eta {eta}",
+    );
+    bar.set_prefix(s.name.clone());
+    let started = std::time::Instant::now();
+    let info = write_dataset(&s, &options, &dir, |k, _| bar.set_position(k as u64))
+        .with_context(|| format!("writing the dataset of {}", scenario.display()))?;
+    bar.finish_and_clear();
+    println!(
+        "{}: {} samples of camera {:?} ({}x{}, poses {}) in {:.1} s, {:.1} MB -> {}",
+        info.scenario,
+        info.samples,
+        info.sensor,
+        info.size_px[0],
+        info.size_px[1],
+        info.poses.name(),
+        started.elapsed().as_secs_f64(),
+        folder_bytes(&dir) as f64 / 1e6,
+        dir.display()
+    );
+    Ok(())
 }

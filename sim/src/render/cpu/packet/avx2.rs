@@ -312,13 +312,18 @@ fn trace_packet<const TRUTH: bool>(frame: &FrameRays, p: &Packet) -> (I, V, I) {
     if !TRUTH {
         return (colour, splat(0.0), splat_u(0));
     }
-    let met = select_u(
-        near.hit,
-        near.rank,
-        _mm256_or_si256(splat_u(CODE_FLOOR), paint),
-    );
+    let (t, code) = truth(&near, nothing, paint);
+    (colour, t, code)
+}
+
+/// Each lane's distance to what it meets and what that is ([`crate::render::trace::Code`]):
+/// the primitive hit, else the floor's paint, else (`nothing`) the sky.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn truth(near: &Nearest, nothing: V, paint: I) -> (V, I) {
+    let floor = _mm256_or_si256(splat_u(CODE_FLOOR), paint);
+    let met = select_u(near.hit, near.rank, floor);
     (
-        colour,
         select(nothing, splat(f32::INFINITY), near.t_max),
         select_u(nothing, splat_u(CODE_SKY), met),
     )
