@@ -16,11 +16,15 @@ The loop itself, from Python::
 - ``run(scenario, seed=None, renderer="cpu", out=None)``: the built-in robot, as
   ``omniloop run`` runs it; ``.summary`` and ``.trajectory``.
 - ``Simulation(scenario, seed=None, renderer="cpu", robot="python")``: ``reset``, ``step``,
-  ``truth``, ``summary``, ``write``, ``topview``; ``robot="builtin"`` steps the built-in stack.
+  ``truth``, ``summary``, ``write``, ``topview``; ``robot="builtin"`` steps the built-in stack;
+  ``truth=True`` traces the truth beside each frame (depth, floor distance, labels:
+  ``truth_frames()``).
 - ``VectorSimulation(scenario, num_envs, ...)``: N runs stepped together in parallel.
 - ``sweep(scenario, sets={...}, seeds=..., executor="local"|"ray")``: a grid of runs, on
   this machine or a Ray cluster (``pip install omniloop[ray]``), with ``omniloop sweep``'s
   report; ``resume=True`` goes on from what finished.
+- ``write_dataset(scenario, out, samples=100, ...)``: frames of a camera with their truth, as
+  ``omniloop dataset`` writes them; ``omniloop.dataset.load(path)`` reads one back.
 - ``omniloop.gym``: the Gymnasium environments (``pip install omniloop[gym]``).
 
 Units are millimetres, seconds and radians. The robot never sees the truth: an
@@ -39,6 +43,7 @@ from ._omniloop import (
     default_scenario,
     run,
 )
+from .dataset import write_dataset
 from .sweeps import SweepResult, sweep, without_timing
 
 __all__ = [
@@ -55,4 +60,5 @@ __all__ = [
     "sweep",
     "SweepResult",
     "without_timing",
+    "write_dataset",
 ]

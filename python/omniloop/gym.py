@@ -25,6 +25,11 @@ Importing this module registers ``omniloop/Scenario-v0``::
   ``truncated`` when ``run.duration_s`` is up.
 - ``info``: the truth (``t_s``, ``x_mm``, ``y_mm``, ``theta_rad``, ``contacts``,
   ``reached_goal``, ...): the simulator's side, for scoring; never in the observation.
+- ``truth_frames=True``: ``info["truth_frames"]`` also holds the truth beside each frame the
+  robot's software got, after ``reset`` and every step (``Simulation.truth_frames()``: per
+  camera name ``"depth_mm"`` and ``"floor_mm"`` as ``float32`` ``H x W``, ``"labels"`` as
+  ``uint16`` ``H x W``, and ``"legend"``), for perception's losses and scores; never in the
+  observation. The vector environment gives it as an object array of these dicts, one a run.
 - ``render_mode="rgb_array"``: ``render()`` returns a top view of the moment.
 
 Seeds: ``reset(seed=s)`` runs with seed ``s``; ``reset()`` without one runs the scenario's
@@ -166,6 +171,7 @@ class OmniloopEnv(gymnasium.Env):
         contact_penalty: float = 1.0,
         max_omega_rad_s: Optional[float] = None,
         render_width_px: int = 640,
+        truth_frames: bool = False,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
@@ -176,9 +182,16 @@ class OmniloopEnv(gymnasium.Env):
         self.render_mode = render_mode
         self.render_width_px = render_width_px
         self.metadata = {**self.metadata, "render_fps": round(1.0 / self.scenario.control_period_s)}
-        self.sim = Simulation(self.scenario, renderer=renderer)
+        self.truth_frames = bool(truth_frames)
+        self.sim = Simulation(self.scenario, renderer=renderer, truth=self.truth_frames)
         self._episode_seed: Optional[int] = None
         self._truth = self.sim.truth()
+
+    def _info(self, truth: dict[str, Any]) -> dict[str, Any]:
+        info = dict(truth)
+        if self.truth_frames:
+            info["truth_frames"] = self.sim.truth_frames()
+        return info
 
     def reset(
         self, *, seed: Optional[int] = None, options: Optional[dict[str, Any]] = None
@@ -188,7 +201,7 @@ class OmniloopEnv(gymnasium.Env):
         self._episode_seed = episode
         obs = self.sim.reset(seed=episode)
         self._truth = self.sim.truth()
-        return self._task.observation(obs), dict(self._truth)
+        return self._task.observation(obs), self._info(self._truth)
 
     def step(
         self, action: Any
@@ -201,7 +214,7 @@ class OmniloopEnv(gymnasium.Env):
         self._truth = truth
         terminated = bool(truth["reached_goal"])
         truncated = bool(obs.done and not terminated)
-        return self._task.observation(obs), float(reward), terminated, truncated, dict(truth)
+        return self._task.observation(obs), float(reward), terminated, truncated, self._info(truth)
 
     def render(self) -> Optional[np.ndarray]:
         if self.render_mode == "rgb_array":
@@ -223,6 +236,7 @@ class OmniloopVectorEnv(VectorEnv):
         renderer: str = "cpu",
         contact_penalty: float = 1.0,
         max_omega_rad_s: Optional[float] = None,
+        truth_frames: bool = False,
     ) -> None:
         self.scenario = _one_robot(_scenario(scenario))
         self._task = _Task(self.scenario.robot, contact_penalty, max_omega_rad_s)
@@ -232,7 +246,10 @@ class OmniloopVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.render_mode = None
-        self.vec = VectorSimulation(self.scenario, self.num_envs, renderer=renderer)
+        self.truth_frames = bool(truth_frames)
+        self.vec = VectorSimulation(
+            self.scenario, self.num_envs, renderer=renderer, truth=self.truth_frames
+        )
         self._seeds: Optional[list[int]] = None
         self._truths = self.vec.truth()
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
@@ -301,6 +318,11 @@ class OmniloopVectorEnv(VectorEnv):
                 continue
             infos[key] = np.array(values)
             infos["_" + key] = np.ones(self.num_envs, dtype=bool)
+        if self.truth_frames:
+            frames = np.empty(self.num_envs, dtype=object)
+            frames[:] = self.vec.truth_frames()
+            infos["truth_frames"] = frames
+            infos["_truth_frames"] = np.ones(self.num_envs, dtype=bool)
         return infos
 
 

@@ -1,6 +1,7 @@
 //! The `omniloop` Python package's native module (`omniloop._omniloop`): scenarios, whole runs,
 //! a simulation stepped from Python with Python as the robot's software, and N of them stepped
-//! together. The pure-Python part (`omniloop/`) adds the Gymnasium environments.
+//! together, the truth beside each frame and truth datasets. The pure-Python part (`omniloop/`)
+//! adds the Gymnasium environments and the datasets' loader.
 
 mod camera;
 mod convert;
@@ -8,6 +9,7 @@ mod freespace;
 mod scenario;
 mod simulation;
 mod sweep;
+mod truth;
 mod vector;
 
 use convert::{ScenarioError, json_to_py, run_error, trajectory_columns};
@@ -130,6 +132,9 @@ fn _omniloop(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<freespace::PyFreeSpaceDetector>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(default_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(truth::write_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(truth::read_png_levels, m)?)?;
+    m.add_function(wrap_pyfunction!(truth::read_png_rgb, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep_plan, m)?)?;
     m.add_class::<sweep::SweepPlan>()?;
     m.add_function(wrap_pyfunction!(sweep::run_planned_job, m)?)?;

@@ -9,6 +9,7 @@
 use crate::convert::{finite_numbers, json_to_py, rgb_array, rgb_image_array, run_error};
 use crate::freespace::PyFreeSpaceDetector;
 use crate::scenario::PyScenario;
+use crate::truth::truth_frame_dict;
 use nalgebra::{Isometry2, Vector2};
 use omniloop::control::DeadReckoning;
 use omniloop::robot::perception::FreeSpaceStage;
@@ -143,6 +144,15 @@ struct Member {
     sensors: Vec<String>,
 }
 
+/// What a run traces beyond what the robots' software reads.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Extras {
+    /// Vision's camera is rendered and calibrated whatever the software reads.
+    pub frames: bool,
+    /// Each frame's truth is traced beside it (the simulator's side only).
+    pub truth: bool,
+}
+
 /// One run being stepped, with what the robots' side keeps between steps.
 pub struct State {
     session: Session,
@@ -153,15 +163,15 @@ pub struct State {
 
 impl State {
     /// Builds the run of `scenario` with `seed`, each robot driven by its entry of `drivers`
-    /// (in the scenario's order of robots), and senses its first frames; with `takes_frames`,
-    /// vision's camera is rendered and calibrated whatever the software reads.
+    /// (in the scenario's order of robots), and senses its first frames; `extras` says what
+    /// else it traces (vision's camera whatever the software reads, the truth beside frames).
     pub fn new(
         scenario: &Scenario,
         seed: u64,
         renderer: RendererChoice,
         drivers: &[Driver],
         shared_gpu: Option<BatchHandle>,
-        takes_frames: bool,
+        extras: Extras,
     ) -> Result<Self, RunError> {
         let mut scenario = scenario.clone();
         scenario.seed = seed;
@@ -172,7 +182,8 @@ impl State {
         let options = RunOptions {
             renderer,
             shared_gpu,
-            takes_frames,
+            takes_frames: extras.frames,
+            truth: extras.truth,
             ..RunOptions::default()
         };
         let names = scenario.robot_names();
@@ -621,6 +632,21 @@ fn team_dict<'py>(
     }
 }
 
+/// The truth beside each frame robot `k`'s software got in the last cycle, by camera name
+/// (empty unless the run traces the truth).
+pub fn truth_frames<'py>(py: Python<'py>, state: &State, k: usize) -> PyResult<Bound<'py, PyDict>> {
+    let agent = &state.session().simulation().robots()[k];
+    let out = PyDict::new(py);
+    for (name, t) in agent.truth_frames() {
+        out.set_item(name, truth_frame_dict(py, t)?)?;
+    }
+    Ok(out)
+}
+
+/// The message of `truth_frames()` on a run made without the truth.
+pub const NO_TRUTH: &str = "truth_frames(): the truth beside the frames is traced only when \
+                            asked for: make the simulation with truth=True";
+
 /// The truth as a dict.
 pub fn truth_dict<'py>(py: Python<'py>, t: &Truth) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -644,8 +670,8 @@ pub struct PySimulation {
     renderer: RendererChoice,
     /// Who drives each robot, in the robots' order.
     drivers: Vec<Driver>,
-    /// Vision's camera is rendered and calibrated whatever the software reads.
-    frames: bool,
+    /// What the run traces beyond what the software reads (vision's camera, the truth).
+    extras: Extras,
     state: Mutex<State>,
 }
 
@@ -767,9 +793,12 @@ impl PySimulation {
     /// `"builtin"` (the scenario's own robot software decides); for a team, one of these for
     /// every robot or a dict naming each robot's (`{"blue1": "python", "blue2": "builtin"}`);
     /// `frames=True` renders (and calibrates) vision's camera even where the built-in software
-    /// reads no frame, to watch it or run a detector on it.
+    /// reads no frame, to watch it or run a detector on it; `truth=True` traces the truth
+    /// beside each frame (`truth_frames()`), the simulator's side only.
     #[new]
-    #[pyo3(signature = (scenario, seed = None, renderer = "cpu", robot = None, frames = false))]
+    #[pyo3(signature = (
+        scenario, seed = None, renderer = "cpu", robot = None, frames = false, truth = false
+    ))]
     fn new(
         py: Python<'_>,
         scenario: PyRef<'_, PyScenario>,
@@ -777,6 +806,7 @@ impl PySimulation {
         renderer: &str,
         robot: Option<&Bound<'_, PyAny>>,
         frames: bool,
+        truth: bool,
     ) -> PyResult<Self> {
         let renderer = renderer_choice(renderer)?;
         let drivers = match robot {
@@ -787,14 +817,15 @@ impl PySimulation {
         let s = &scenario.scenario;
         let drivers = drivers.resolve(&s.name, &s.robot_names())?;
         let seed = seed.unwrap_or(s.seed);
+        let extras = Extras { frames, truth };
         let state = py
-            .detach(|| State::new(s, seed, renderer, &drivers, None, frames))
+            .detach(|| State::new(s, seed, renderer, &drivers, None, extras))
             .map_err(run_error)?;
         Ok(Self {
             scenario,
             renderer,
             drivers,
-            frames,
+            extras,
             state: Mutex::new(state),
         })
     }
@@ -812,7 +843,7 @@ impl PySimulation {
                     self.renderer,
                     &self.drivers,
                     None,
-                    self.frames,
+                    self.extras,
                 )
             })
             .map_err(run_error)?;
@@ -870,6 +901,27 @@ impl PySimulation {
             let t = state.truth_of(k).unwrap_or_else(|| state.truth());
             Ok(truth_dict(py, &t)?.into_any())
         })
+    }
+
+    /// The truth beside each frame `robot`'s software got in the last cycle (default: the
+    /// first robot), by camera name (the simulator's side, never part of an observation):
+    /// `depth_mm` (`float32` `H x W`: how far the light travelled to the camera, mirror
+    /// included; inf for the sky, NaN where the pixel sees no mirror), `floor_mm` (`float32`:
+    /// the floor point's distance from the robot's centre where the pixel shows the floor, NaN
+    /// elsewhere), `labels` (`uint16`: what the pixel shows) and `legend` (the labels' entries
+    /// as `legend.json` holds them). Raises `ValueError` unless made with `truth=True`.
+    #[pyo3(signature = (robot = None))]
+    fn truth_frames<'py>(
+        &self,
+        py: Python<'py>,
+        robot: Option<&str>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        if !self.extras.truth {
+            return Err(PyValueError::new_err(NO_TRUTH));
+        }
+        let state = self.lock();
+        let k = state.robot_index(robot)?;
+        truth_frames(py, &state, k)
     }
 
     /// The last cycle's `estimates.jsonl` record (truth beside belief) as a dict; `None`

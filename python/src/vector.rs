@@ -5,7 +5,8 @@
 use crate::convert::run_error;
 use crate::scenario::PyScenario;
 use crate::simulation::{
-    Command, Driver, Observation, State, observation, renderer_choice, truth_dict,
+    Command, Driver, Extras, NO_TRUTH, Observation, State, observation, renderer_choice,
+    truth_dict, truth_frames,
 };
 use omniloop_sim::RendererChoice;
 use omniloop_sim::render::{BatchHandle, BatchServer};
@@ -21,6 +22,8 @@ pub struct PyVectorSimulation {
     scenario: PyScenario,
     renderer: RendererChoice,
     driver: Driver,
+    /// The truth is traced beside each frame.
+    truth: bool,
     states: Mutex<Vec<State>>,
     /// The GPU the runs' frames are traced on in batches (kept alive while they run).
     _gpu: Mutex<Option<BatchServer>>,
@@ -39,7 +42,10 @@ impl PyVectorSimulation {
             self.renderer,
             &[self.driver],
             self.gpu.clone(),
-            false,
+            Extras {
+                frames: false,
+                truth: self.truth,
+            },
         )
     }
 }
@@ -47,9 +53,12 @@ impl PyVectorSimulation {
 #[pymethods]
 impl PyVectorSimulation {
     /// `num_envs` runs of `scenario`, run `i` with seed `seed + i` (default: the scenario's
-    /// seed), on `renderer`, with `robot` `"python"` or `"builtin"` (see `Simulation`).
+    /// seed), on `renderer`, with `robot` `"python"` or `"builtin"`; `truth=True` traces the
+    /// truth beside each frame (see `Simulation`).
     #[new]
-    #[pyo3(signature = (scenario, num_envs, seed = None, renderer = "cpu", robot = "python"))]
+    #[pyo3(signature = (
+        scenario, num_envs, seed = None, renderer = "cpu", robot = "python", truth = false
+    ))]
     fn new(
         py: Python<'_>,
         scenario: PyRef<'_, PyScenario>,
@@ -57,6 +66,7 @@ impl PyVectorSimulation {
         seed: Option<u64>,
         renderer: &str,
         robot: &str,
+        truth: bool,
     ) -> PyResult<Self> {
         if !(1..=4096).contains(&num_envs) {
             return Err(PyValueError::new_err(format!(
@@ -81,6 +91,7 @@ impl PyVectorSimulation {
             scenario,
             renderer: choice,
             driver,
+            truth,
             states: Mutex::new(Vec::new()),
             _gpu: Mutex::new(server),
             gpu,
@@ -161,6 +172,16 @@ impl PyVectorSimulation {
             .map(|s| truth_dict(py, &s.truth()))
             .collect::<PyResult<Vec<Bound<'py, PyDict>>>>()?;
         PyList::new(py, dicts)
+    }
+
+    /// Every run's truth beside the frames its software got in the last cycle (see
+    /// `Simulation.truth_frames`); raises `ValueError` unless made with `truth=True`.
+    fn truth_frames<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        if !self.truth {
+            return Err(PyValueError::new_err(NO_TRUTH));
+        }
+        let states = self.lock();
+        states.iter().map(|s| truth_frames(py, s, 0)).collect()
     }
 
     /// Each run's seed.
