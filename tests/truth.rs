@@ -8,6 +8,9 @@ use common::scenario;
 use omniloop::run::truth_files;
 use omniloop_sim::labels::{self, Class, ObjectId};
 use omniloop_sim::optics::Optics;
+use omniloop_sim::render::cpu::trace_reference;
+use omniloop_sim::render::trace::CODE_NOTHING;
+use omniloop_sim::render::{CpuRenderer, SensorRays};
 use omniloop_sim::{Renderer, Scene, World};
 
 /// The world of a scenario with its robots where they start, and the first robot's pose.
@@ -287,6 +290,30 @@ fn a_dataset_holds_frames_depth_labels_poses_and_the_camera_model() {
         assert_eq!(
             std::fs::read(dir.join(f)).unwrap(),
             std::fs::read(again.join(f)).unwrap()
+        );
+    }
+}
+
+/// The first frame traced with its truth on fresh rays gives what tracing every primitive gives,
+/// the pixels that see no mirror included (known once the rays' packets are made).
+#[test]
+fn the_first_cpu_frame_with_truth_marks_the_pixels_that_see_no_mirror() {
+    let s = scenario("render_spherical.toml");
+    let sensor = s.robot.sensors[0].build();
+    let (world, pose) = world_of(&s);
+    let scene = Scene::of_world(&world);
+    let mut rays = SensorRays::new(&sensor);
+    let n = (sensor.width_px * sensor.height_px) as usize;
+    let (mut pixels, mut t, mut codes) = (vec![0; n], vec![0.0; n], vec![0; n]);
+    CpuRenderer::new().render_truth(&scene, &mut rays, &pose, &mut pixels, (&mut t, &mut codes));
+    let traced = trace_reference(&scene, &rays, &pose);
+    let blind = traced.iter().filter(|r| r.code == CODE_NOTHING).count();
+    assert!(blind > 1000, "{blind} pixels see no mirror");
+    for (k, r) in traced.iter().enumerate() {
+        assert_eq!(
+            (codes[k], t[k].to_bits()),
+            (r.code, r.t.to_bits()),
+            "pixel {k}"
         );
     }
 }
