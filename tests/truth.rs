@@ -8,7 +8,11 @@ use common::scenario;
 use omniloop::run::truth_files;
 use omniloop_sim::labels::{self, Class, ObjectId};
 use omniloop_sim::optics::Optics;
-use omniloop_sim::{Renderer, Scene, World};
+use omniloop_sim::render::cpu::trace_reference;
+use omniloop_sim::render::trace::CODE_NOTHING;
+use omniloop_sim::render::truth::{self, TruthFrame, TruthRays};
+use omniloop_sim::render::{BatchServer, CpuRenderer, SensorRays};
+use omniloop_sim::{FrameRequest, Renderer, Scene, SensorNoise, World};
 
 /// The world of a scenario with its robots where they start, and the first robot's pose.
 fn world_of(s: &omniloop::Scenario) -> (World, nalgebra::Isometry2<f64>) {
@@ -288,5 +292,214 @@ fn a_dataset_holds_frames_depth_labels_poses_and_the_camera_model() {
             std::fs::read(dir.join(f)).unwrap(),
             std::fs::read(again.join(f)).unwrap()
         );
+    }
+}
+
+/// The first frame traced with its truth on fresh rays gives what tracing every primitive gives,
+/// the pixels that see no mirror included (known once the rays' packets are made).
+#[test]
+fn the_first_cpu_frame_with_truth_marks_the_pixels_that_see_no_mirror() {
+    let s = scenario("render_spherical.toml");
+    let sensor = s.robot.sensors[0].build();
+    let (world, pose) = world_of(&s);
+    let scene = Scene::of_world(&world);
+    let mut rays = SensorRays::new(&sensor);
+    let n = (sensor.width_px * sensor.height_px) as usize;
+    let (mut pixels, mut t, mut codes) = (vec![0; n], vec![0.0; n], vec![0; n]);
+    CpuRenderer::new().render_truth(&scene, &mut rays, &pose, &mut pixels, (&mut t, &mut codes));
+    let traced = trace_reference(&scene, &rays, &pose);
+    let blind = traced.iter().filter(|r| r.code == CODE_NOTHING).count();
+    assert!(blind > 1000, "{blind} pixels see no mirror");
+    for (k, r) in traced.iter().enumerate() {
+        assert_eq!(
+            (codes[k], t[k].to_bits()),
+            (r.code, r.t.to_bits()),
+            "pixel {k}"
+        );
+    }
+}
+
+/// The render examples at their start, and the corner of `corner55_velocity_aware` near its
+/// tip (its quad prisms in view), as `tests/renderer.rs` compares their images.
+fn compared_frames() -> Vec<(omniloop::Scenario, Option<nalgebra::Isometry2<f64>>)> {
+    let examples = ["hyperbolic", "conical", "spherical", "pinhole"];
+    let mut v: Vec<_> = (examples.iter())
+        .map(|k| (scenario(&format!("render_{k}.toml")), None))
+        .collect();
+    let tip = nalgebra::Isometry2::new(nalgebra::Vector2::new(-650.0, 150.0), 40f64.to_radians());
+    v.push((scenario("corner55_velocity_aware.toml"), Some(tip)));
+    v
+}
+
+/// Beyond this depth (mm) a scene shows only floor near the horizon: every object and the floor
+/// region of these scenes lie within it.
+const NEAR_MM: f32 = 10_000.0;
+
+/// How a GPU truth differs from the CPU's.
+#[derive(Debug, Default)]
+struct TruthDifference {
+    /// The share of pixels labelled otherwise.
+    relabelled: f64,
+    /// On the pixels labelled alike within [`NEAR_MM`]: the share whose depths differ by more
+    /// than 0.5 mm, and the largest difference (mm).
+    near_over: f64,
+    near_worst: f32,
+    /// On those beyond: the largest difference over the depth squared (1/mm).
+    far_worst: f64,
+}
+
+fn truth_difference(gpu: &TruthFrame, cpu: &TruthFrame) -> TruthDifference {
+    let n = cpu.labels.len();
+    let mut d = TruthDifference::default();
+    let (mut relabelled, mut near, mut over) = (0usize, 0usize, 0usize);
+    for k in 0..n {
+        if gpu.labels[k] != cpu.labels[k] {
+            relabelled += 1;
+            continue;
+        }
+        let (a, b) = (gpu.depth_mm[k], cpu.depth_mm[k]);
+        if !b.is_finite() {
+            // The sky (infinite) or no mirror (NaN) on both.
+            assert!(
+                a == b || (a.is_nan() && b.is_nan()),
+                "pixel {k}: {a} vs {b}"
+            );
+            continue;
+        }
+        let diff = (a - b).abs();
+        if b < NEAR_MM {
+            near += 1;
+            over += usize::from(diff > 0.5);
+            d.near_worst = d.near_worst.max(diff);
+        } else {
+            d.far_worst = d.far_worst.max(diff as f64 / (b as f64).powi(2));
+        }
+    }
+    d.relabelled = relabelled as f64 / n as f64;
+    d.near_over = over as f64 / near.max(1) as f64;
+    d
+}
+
+/// The GPU's truth is the CPU's up to the rounding of the mirror half (f32 in the shader, f64
+/// then f32 on the CPU), and asking for it changes no pixel.
+#[test]
+fn gpu_and_cpu_truth_agree() {
+    let Some(mut gpu) = common::gpu_or_skip() else {
+        return;
+    };
+    let mut cpu = Renderer::cpu();
+    let mut frames = 0;
+    for (s, pose) in compared_frames() {
+        let mut bodies = s.robot_bodies();
+        if let Some(p) = pose {
+            bodies[0].start = p;
+        }
+        let world = World::new(&s.world, &bodies, 0.002).unwrap();
+        let scene = Scene::of_world(&world);
+        let pose = world.robot_state(0).pose;
+        for spec in &s.robot.sensors {
+            let sensor = spec.build();
+            let a = gpu.render_truth(&scene, &sensor, &pose).unwrap();
+            let b = cpu.render_truth(&scene, &sensor, &pose).unwrap();
+            assert_eq!(a.legend, b.legend);
+            let d = truth_difference(&a, &b);
+            let frame = format!("{}/{}", s.name, spec.name);
+            eprintln!(
+                "{frame}: {:.4}% of pixels labelled otherwise; of those alike within {} m, \
+                 {:.4}% with depths more than 0.5 mm apart, at most {:.3} mm; beyond, at most \
+                 {:.2e} depth^2/mm ({})",
+                100.0 * d.relabelled,
+                NEAR_MM / 1000.0,
+                100.0 * d.near_over,
+                d.near_worst,
+                d.far_worst,
+                gpu.name()
+            );
+            // The GPU traces the mirror half in f32, the CPU in f64: a ray's direction differs
+            // by a few f32 roundings, a small fraction of a pixel, so a label can differ only
+            // on a ray that grazes an edge (none on lavapipe; a hardware GPU rounds sqrt and
+            // division differently).
+            assert!(d.relabelled < 0.0005, "{frame}: {d:?}");
+            // Depth: within 0.5 mm nearly everywhere near the robot (lavapipe: at least
+            // 99.98%, at most 0.57 mm, on the spherical mirror's floor 4.2 m off).
+            assert!(d.near_over < 0.001 && d.near_worst < 1.0, "{frame}: {d:?}");
+            // The floor near the horizon amplifies the rounding: it is met at t = h / |d_z|,
+            // so a change delta in d_z moves it by t^2 delta / h: 5e-9 / mm is delta up to 1e-6
+            // (eight f32 roundings of a unit vector's component) from the hyperbolic mirror's
+            // 205 mm (lavapipe: 2.2e-9 / mm, 1.2 m apart at 1.28 km).
+            assert!(d.far_worst < 5e-9, "{frame}: {d:?}");
+            // The truth changes no pixel: the same image, noise drawn in the shader included,
+            // and the same truth as the frame traced for its truth alone.
+            let poses = [pose];
+            let noise = || SensorNoise::new(0x5eed);
+            let plain = gpu.render_exposed(&scene, &sensor, &poses, Some(&mut noise()));
+            let (img, truth) = gpu
+                .render_exposed_truth(&scene, &sensor, &poses, Some(&mut noise()))
+                .unwrap();
+            assert!(
+                img == plain.unwrap(),
+                "{frame}: the truth changed the image"
+            );
+            assert_eq!(truth.labels, a.labels);
+            frames += 1;
+        }
+    }
+    assert!(frames >= 6, "{frames} frames");
+}
+
+/// Frames traced in one GPU batch, every other one with its truth, get the pixels and truth
+/// they get traced alone; a renderer on the shared batch server gets the same truth too.
+#[test]
+fn a_gpu_batch_carries_the_truth_of_the_frames_that_ask() {
+    let Some(gpu) = common::gpu_or_skip() else {
+        return;
+    };
+    let mut gpu = gpu.into_gpu().unwrap();
+    let mut frames = Vec::new();
+    for (s, pose) in compared_frames() {
+        let mut bodies = s.robot_bodies();
+        if let Some(p) = pose {
+            bodies[0].start = p;
+        }
+        let world = World::new(&s.world, &bodies, 0.002).unwrap();
+        let pose = world.robot_state(0).pose;
+        for spec in &s.robot.sensors {
+            frames.push((Scene::of_world(&world), spec.build(), pose));
+        }
+    }
+    let requests: Vec<FrameRequest> = (frames.iter())
+        .map(|(scene, sensor, pose)| FrameRequest {
+            scene,
+            sensor,
+            pose,
+            noise: None,
+        })
+        .collect();
+    let asks: Vec<bool> = (0..requests.len()).map(|i| i % 2 == 0).collect();
+    let batch = gpu.render_batch_truth(&requests, &asks).unwrap();
+    let mut alone = Vec::new();
+    for (r, (pixels, truth)) in requests.iter().zip(&batch) {
+        let n = pixels.len();
+        let (mut p, mut t, mut codes) = (vec![0; n], vec![0.0; n], vec![0; n]);
+        gpu.render_truth(*r, &mut p, &mut t, &mut codes).unwrap();
+        assert_eq!(pixels, &p);
+        if let Some(truth) = truth {
+            assert_eq!(truth.codes, codes);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&truth.t), bits(&t));
+        }
+        alone.push((t, codes));
+    }
+    assert_eq!(
+        batch.iter().map(|(_, t)| t.is_some()).collect::<Vec<_>>(),
+        asks
+    );
+    let server = BatchServer::start(gpu, std::time::Duration::from_millis(1));
+    let mut shared = Renderer::shared(&server.handle());
+    for ((scene, sensor, pose), (t, codes)) in frames.iter().zip(&alone) {
+        let a = shared.render_truth(scene, sensor, pose).unwrap();
+        let b = truth::truth_frame(scene, sensor, &TruthRays::new(sensor), pose, t, codes);
+        assert_eq!(a.labels, b.labels);
+        assert!((a.depth_mm.iter().zip(&b.depth_mm)).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
 }

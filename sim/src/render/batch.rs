@@ -1,11 +1,12 @@
 //! One GPU shared by many runs: each run's renderer sends its frames to a [`BatchServer`], which
 //! waits until every run that has joined has a frame waiting (or `wait` has passed since the
 //! first), traces them all in one dispatch with one readback ([`GpuRenderer::render_batch`]) and
-//! hands each run its image. Runs that render in the same cycle so share the GPU's fixed cost
-//! per dispatch; a frame's image is the one it would get alone.
+//! hands each run its image (and its truth, when the frame asked:
+//! [`GpuRenderer::render_batch_truth`]). Runs that render in the same cycle so share the GPU's
+//! fixed cost per dispatch; a frame's image is the one it would get alone.
 
 use super::error::RenderError;
-use super::gpu::{FrameRequest, GpuRenderer};
+use super::gpu::{FrameRequest, GpuRenderer, PixelTruth, TracedFrame};
 use super::noise::FrameNoise;
 use super::scene::Scene;
 use crate::sensor::Sensor;
@@ -19,7 +20,9 @@ struct Pending {
     sensor: Sensor,
     pose: Isometry2<f64>,
     noise: Option<FrameNoise>,
-    reply: Sender<Result<Vec<u32>, String>>,
+    /// Whether the frame asks for its truth.
+    truth: bool,
+    reply: Sender<Result<TracedFrame, String>>,
 }
 
 enum Message {
@@ -107,12 +110,36 @@ impl BatchClient {
         pose: &Isometry2<f64>,
         noise: Option<FrameNoise>,
     ) -> Result<Vec<u32>, RenderError> {
+        let request = FrameRequest {
+            scene,
+            sensor,
+            pose,
+            noise,
+        };
+        Ok(self.send(request, false)?.0)
+    }
+
+    /// The image of one frame, traced in the next batch, with its truth
+    /// ([`GpuRenderer::render_truth`]).
+    pub fn render_truth(
+        &self,
+        request: FrameRequest<'_>,
+    ) -> Result<(Vec<u32>, PixelTruth), RenderError> {
+        match self.send(request, true)? {
+            (pixels, Some(truth)) => Ok((pixels, truth)),
+            (_, None) => Err(RenderError::Device("the batch returned no truth".into())),
+        }
+    }
+
+    /// Sends one frame to the next batch and waits for it.
+    fn send(&self, r: FrameRequest<'_>, truth: bool) -> Result<TracedFrame, RenderError> {
         let (reply, rx) = channel();
         let frame = Pending {
-            scene: scene.clone(),
-            sensor: sensor.clone(),
-            pose: *pose,
-            noise,
+            scene: r.scene.clone(),
+            sensor: r.sensor.clone(),
+            pose: *r.pose,
+            noise: r.noise,
+            truth,
             reply,
         };
         let gone = || RenderError::Device("the batch renderer stopped".into());
@@ -186,10 +213,11 @@ fn flush(gpu: &mut GpuRenderer, pending: &mut Vec<Pending>) {
             noise: p.noise,
         })
         .collect();
-    match gpu.render_batch(&requests) {
-        Ok(images) => {
-            for (p, img) in frames.iter().zip(images) {
-                let _ = p.reply.send(Ok(img));
+    let truth: Vec<bool> = frames.iter().map(|p| p.truth).collect();
+    match gpu.render_batch_truth(&requests, &truth) {
+        Ok(traced) => {
+            for (p, frame) in frames.iter().zip(traced) {
+                let _ = p.reply.send(Ok(frame));
             }
         }
         Err(e) => {

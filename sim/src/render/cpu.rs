@@ -746,10 +746,11 @@ impl CpuRenderer {
         (t, code): (&mut [f32], &mut [u32]),
     ) {
         assert!(t.len() == pixels.len() && code.len() == pixels.len());
+        self.trace(scene, rays, pose, &mut *pixels, Some((&mut *t, &mut *code)));
+        // After tracing: the rays' blind pixels are known once their packets are made.
         for &k in &rays.blind {
             (t[k as usize], code[k as usize]) = (f32::NAN, trace::CODE_NOTHING);
         }
-        self.trace(scene, rays, pose, pixels, Some((t, code)));
     }
 
     fn trace(

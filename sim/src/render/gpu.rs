@@ -4,6 +4,10 @@
 //! are read back together as packed RGBA8. A single frame is a batch of one, so a frame traced
 //! alone and in a batch is the same computation.
 //!
+//! A frame may ask for its truth as well ([`PixelTruth`]): per pixel, the distance along its
+//! scene ray and what the ray meets, written to a buffer of its own for just the frames that
+//! ask, and read back beside the pixels. A batch where none asks writes and reads none.
+//!
 //! One [`GpuRenderer`] owns its device, pipeline and buffers; buffers grow when a batch needs more
 //! room and are reused otherwise.
 
@@ -12,6 +16,7 @@ use super::noise::{FrameNoise, gauss_table};
 use super::scene::{
     BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals,
 };
+use super::trace::Code;
 use crate::optics::Optics;
 use crate::optics::calibrated::{CalibratedCamera, MAX_POLYNOMIAL};
 use crate::sensor::Sensor;
@@ -44,7 +49,9 @@ fn copy_frames(all: &[u32], spans: &[(usize, usize)]) -> Vec<Vec<u32>> {
     })
 }
 
-/// The sensor and pose of one frame, as the shader reads them.
+/// The sensor and pose of one frame, as the shader reads them; `size` is the image's width and
+/// height, the optics' kind and where the frame's truth starts (0: no truth, else one more than
+/// its first pixel in the truth buffer).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 struct SensorParams {
@@ -247,6 +254,30 @@ pub struct FrameRequest<'a> {
     pub noise: Option<FrameNoise>,
 }
 
+/// Per pixel of a frame, the distance along its scene ray to what the ray meets (mm; infinity
+/// for the sky, NaN where the pixel sees no mirror) and what that is (a [`Code`]), in the
+/// convention of the CPU's [`trace_ray`](super::trace::trace_ray).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PixelTruth {
+    /// The distance along each pixel's (unit) scene ray, mm.
+    pub t: Vec<f32>,
+    /// What each pixel's ray meets.
+    pub codes: Vec<Code>,
+}
+
+impl PixelTruth {
+    /// The truth of the shader's pairs (t's bits, code).
+    fn of(pairs: &[[u32; 2]]) -> Self {
+        Self {
+            t: pairs.iter().map(|p| f32::from_bits(p[0])).collect(),
+            codes: pairs.iter().map(|p| p[1]).collect(),
+        }
+    }
+}
+
+/// A frame traced: its packed RGBA8 pixels and, when it asked, its truth.
+pub type TracedFrame = (Vec<u32>, Option<PixelTruth>);
+
 /// The concatenated primitives and headers of a batch.
 #[derive(Default)]
 struct Batch {
@@ -258,19 +289,28 @@ struct Batch {
     rects: Vec<FloorRectPrim>,
     quads: Vec<QuadPrim>,
     pixels: usize,
+    /// The pixels of the frames that ask for their truth.
+    truth_pixels: usize,
 }
 
 impl Batch {
-    fn of(requests: &[FrameRequest<'_>]) -> Result<Self, RenderError> {
+    /// The batch of `requests`, frame `i` with its truth when `truth[i]` (none past its end).
+    fn of(requests: &[FrameRequest<'_>], truth: &[bool]) -> Result<Self, RenderError> {
         let mut b = Self::default();
         let at =
             |n: usize| u32::try_from(n).map_err(|_| RenderError::Device("batch too large".into()));
-        for r in requests {
+        for (i, r) in requests.iter().enumerate() {
             let sc = r.scene;
             let (key, sigma) = r.noise.map_or((0, 0.0), |n| (n.key, n.sigma));
+            let n = (r.sensor.width_px * r.sensor.height_px) as usize;
+            let mut sensor = SensorParams::new(r.sensor, r.pose, sigma);
+            if truth.get(i).copied().unwrap_or(false) {
+                sensor.size[3] = at(b.truth_pixels + 1)?;
+                b.truth_pixels += n;
+            }
             b.frames.push(FrameParams {
                 globals: sc.globals,
-                sensor: SensorParams::new(r.sensor, r.pose, sigma),
+                sensor,
                 offsets: [
                     at(b.boxes.len())?,
                     at(b.cylinders.len())?,
@@ -285,9 +325,10 @@ impl Batch {
             b.stripes.extend_from_slice(&sc.stripe_edges);
             b.rects.extend_from_slice(&sc.floor_rects);
             b.quads.extend_from_slice(&sc.quads);
-            b.pixels += (r.sensor.width_px * r.sensor.height_px) as usize;
+            b.pixels += n;
         }
         at(b.pixels)?;
+        at(b.truth_pixels)?;
         Ok(b)
     }
 }
@@ -338,6 +379,67 @@ impl Storage {
     }
 }
 
+/// A buffer the shader writes and its twin the host maps to read it back, grown together to
+/// fit.
+struct Output {
+    buffer: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    capacity: u64,
+    label: &'static str,
+}
+
+impl Output {
+    fn new(device: &wgpu::Device, label: &'static str, capacity: u64) -> Self {
+        let capacity = capacity.max(16);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: capacity,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: capacity,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            buffer,
+            readback,
+            capacity,
+            label,
+        }
+    }
+
+    /// Makes room for `bytes`, replacing both buffers when too small; returns whether it did.
+    fn fit(&mut self, device: &wgpu::Device, bytes: u64) -> bool {
+        if bytes <= self.capacity {
+            return false;
+        }
+        *self = Self::new(device, self.label, bytes.next_power_of_two());
+        true
+    }
+
+    /// Copies the first `bytes` the shader wrote to the readback buffer (none: nothing).
+    fn copy(&self, encoder: &mut wgpu::CommandEncoder, bytes: u64) {
+        if bytes > 0 {
+            encoder.copy_buffer_to_buffer(&self.buffer, 0, &self.readback, 0, Some(bytes));
+        }
+    }
+}
+
+/// Asks for the first `bytes` of `buffer` mapped for reading; the receiver says when they are.
+fn map_read(
+    buffer: &wgpu::Buffer,
+    bytes: u64,
+) -> std::sync::mpsc::Receiver<Result<(), wgpu::BufferAsyncError>> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    buffer.map_async(wgpu::MapMode::Read, 0..bytes, move |r| {
+        let _ = tx.send(r);
+    });
+    rx
+}
+
 /// Renders frames with a wgpu compute shader.
 pub struct GpuRenderer {
     device: wgpu::Device,
@@ -354,9 +456,11 @@ pub struct GpuRenderer {
     quads: Storage,
     /// The noise's Gaussian table, written once.
     gauss: wgpu::Buffer,
-    pixels: wgpu::Buffer,
-    readback: wgpu::Buffer,
-    pixel_capacity: u64,
+    /// The frames' packed RGBA8 pixels.
+    pixels: Output,
+    /// The truth of the frames that ask for it: per pixel t's bits and the code (16 bytes
+    /// until a frame asks).
+    truth: Output,
     bind_group: Option<wgpu::BindGroup>,
 }
 
@@ -439,7 +543,8 @@ impl GpuRenderer {
             mapped_at_creation: false,
         });
         queue.write_buffer(&gauss, 0, table);
-        let (pixels, readback) = Self::pixel_buffers(&device, 256 * 256 * 4);
+        let pixels = Output::new(&device, "pixels", 256 * 256 * 4);
+        let truth = Output::new(&device, "truth", 0);
         Ok(Self {
             device,
             queue,
@@ -455,8 +560,7 @@ impl GpuRenderer {
             quads,
             gauss,
             pixels,
-            readback,
-            pixel_capacity: 256 * 256 * 4,
+            truth,
             bind_group: None,
         })
     }
@@ -481,6 +585,7 @@ impl GpuRenderer {
                 entry(7, B::Storage { read_only: false }),
                 entry(8, ro),
                 entry(9, ro),
+                entry(10, B::Storage { read_only: false }),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -497,22 +602,6 @@ impl GpuRenderer {
             cache: None,
         });
         (pipeline, layout)
-    }
-
-    fn pixel_buffers(device: &wgpu::Device, bytes: u64) -> (wgpu::Buffer, wgpu::Buffer) {
-        let pixels = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("pixels"),
-            size: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        (pixels, readback)
     }
 
     /// Name and backend of the adapter.
@@ -538,7 +627,28 @@ impl GpuRenderer {
             pose,
             noise,
         };
-        self.trace(&[request], |all| out.copy_from_slice(all))
+        self.trace(&[request], &[], |all, _| out.copy_from_slice(all))
+    }
+
+    /// Renders one frame as [`GpuRenderer::render`] does (the same pixels) with each pixel's
+    /// truth: the distance along its scene ray to what it meets into `t` (mm; infinity for the
+    /// sky, NaN where the pixel sees no mirror) and what that is into `codes` ([`Code`]), as
+    /// the CPU's [`trace_ray`](super::trace::trace_ray) gives them.
+    pub fn render_truth(
+        &mut self,
+        request: FrameRequest<'_>,
+        out: &mut [u32],
+        t: &mut [f32],
+        codes: &mut [Code],
+    ) -> Result<(), RenderError> {
+        let n = (request.sensor.width_px * request.sensor.height_px) as usize;
+        assert!(out.len() == n && t.len() == n && codes.len() == n);
+        self.trace(&[request], &[true], |all, truth| {
+            out.copy_from_slice(all);
+            for ((tk, ck), p) in t.iter_mut().zip(codes.iter_mut()).zip(truth) {
+                (*tk, *ck) = (f32::from_bits(p[0]), p[1]);
+            }
+        })
     }
 
     /// Renders every frame of `requests` in one dispatch with one readback: each image packed
@@ -547,9 +657,21 @@ impl GpuRenderer {
         &mut self,
         requests: &[FrameRequest<'_>],
     ) -> Result<Vec<Vec<u32>>, RenderError> {
+        let frames = self.render_batch_truth(requests, &[])?;
+        Ok(frames.into_iter().map(|(pixels, _)| pixels).collect())
+    }
+
+    /// [`GpuRenderer::render_batch`] with the truth of frame `i` when `truth[i]` (none past
+    /// its end): the frames' pixels are the same, and those that ask get their truth too.
+    pub fn render_batch_truth(
+        &mut self,
+        requests: &[FrameRequest<'_>],
+        truth: &[bool],
+    ) -> Result<Vec<TracedFrame>, RenderError> {
         if requests.is_empty() {
             return Ok(Vec::new());
         }
+        let asks = |i: usize| truth.get(i).copied().unwrap_or(false);
         // Each frame's place in the readback.
         let spans: Vec<(usize, usize)> = requests
             .iter()
@@ -560,20 +682,34 @@ impl GpuRenderer {
             })
             .collect();
         let mut out = Vec::new();
-        self.trace(requests, |all| out = copy_frames(all, &spans))?;
+        self.trace(requests, truth, |all, pairs| {
+            let mut at = 0;
+            out = (copy_frames(all, &spans).into_iter().enumerate())
+                .map(|(i, pixels)| {
+                    let truth = asks(i).then(|| {
+                        at += pixels.len();
+                        PixelTruth::of(&pairs[at - pixels.len()..at])
+                    });
+                    (pixels, truth)
+                })
+                .collect();
+        })?;
         Ok(out)
     }
 
-    /// Traces `requests` (not empty) in one dispatch and hands `take` their pixels, frame after
-    /// frame, straight from the mapped readback buffer.
+    /// Traces `requests` (not empty) in one dispatch, frame `i` with its truth when `truth[i]`,
+    /// and hands `take` their pixels, frame after frame, and the truth of those that asked
+    /// (t's bits, code), straight from the mapped readback buffers.
     fn trace(
         &mut self,
         requests: &[FrameRequest<'_>],
-        take: impl FnOnce(&[u32]),
+        truth: &[bool],
+        take: impl FnOnce(&[u32], &[[u32; 2]]),
     ) -> Result<(), RenderError> {
-        let batch = Batch::of(requests)?;
+        let batch = Batch::of(requests, truth)?;
         let bytes = (batch.pixels * 4) as u64;
-        let mut rebind = self.upload(&batch, bytes);
+        let truth_bytes = (batch.truth_pixels * 8) as u64;
+        let mut rebind = self.upload(&batch, bytes, truth_bytes);
         rebind |= self.bind_group.is_none();
         if rebind {
             self.rebind();
@@ -602,20 +738,17 @@ impl GpuRenderer {
             pass.set_bind_group(0, self.bind_group.as_ref(), &[]);
             pass.dispatch_workgroups(max_w.div_ceil(8), max_h.div_ceil(8), requests.len() as u32);
         }
-        encoder.copy_buffer_to_buffer(&self.pixels, 0, &self.readback, 0, Some(bytes));
+        self.pixels.copy(&mut encoder, bytes);
+        self.truth.copy(&mut encoder, truth_bytes);
         self.queue.submit([encoder.finish()]);
-        self.read_back(bytes, take)
+        self.read_back(bytes, truth_bytes, take)
     }
 
-    /// Writes the batch's buffers, growing those too small; returns whether any was replaced.
-    fn upload(&mut self, b: &Batch, pixel_bytes: u64) -> bool {
-        let mut rebind = false;
-        if pixel_bytes > self.pixel_capacity {
-            let cap = pixel_bytes.next_power_of_two();
-            (self.pixels, self.readback) = Self::pixel_buffers(&self.device, cap);
-            self.pixel_capacity = cap;
-            rebind = true;
-        }
+    /// Writes the batch's buffers, growing those too small (the outputs to `pixel_bytes` and
+    /// `truth_bytes`); returns whether any was replaced.
+    fn upload(&mut self, b: &Batch, pixel_bytes: u64, truth_bytes: u64) -> bool {
+        let mut rebind = self.pixels.fit(&self.device, pixel_bytes);
+        rebind |= self.truth.fit(&self.device, truth_bytes);
         let (d, q) = (&self.device, &self.queue);
         rebind |= self.frames.write(d, q, bytemuck::cast_slice(&b.frames));
         rebind |= self.boxes.write(d, q, bytemuck::cast_slice(&b.boxes));
@@ -638,9 +771,10 @@ impl GpuRenderer {
             (4, &self.boards.buffer),
             (5, &self.stripes.buffer),
             (6, &self.rects.buffer),
-            (7, &self.pixels),
+            (7, &self.pixels.buffer),
             (8, &self.quads.buffer),
             (9, &self.gauss),
+            (10, &self.truth.buffer),
         ];
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
@@ -656,26 +790,41 @@ impl GpuRenderer {
         }));
     }
 
-    /// Maps the first `bytes` of the readback buffer and hands them to `take`.
-    fn read_back(&mut self, bytes: u64, take: impl FnOnce(&[u32])) -> Result<(), RenderError> {
-        let slice = self.readback.slice(0..bytes);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
+    /// Maps the first `bytes` of the pixels' readback buffer and the first `truth_bytes` of
+    /// the truth's (none: not mapped) and hands them to `take`.
+    fn read_back(
+        &mut self,
+        bytes: u64,
+        truth_bytes: u64,
+        take: impl FnOnce(&[u32], &[[u32; 2]]),
+    ) -> Result<(), RenderError> {
+        let device_error = |e: &dyn std::fmt::Display| RenderError::Device(e.to_string());
+        let pixels = map_read(&self.pixels.readback, bytes);
+        let truth = (truth_bytes > 0).then(|| map_read(&self.truth.readback, truth_bytes));
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Device(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| RenderError::Device(e.to_string()))?
-            .map_err(|e| RenderError::Device(e.to_string()))?;
-        {
-            let view = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Device(e.to_string()))?;
-            take(bytemuck::cast_slice::<u8, u32>(&view));
+            .map_err(|e| device_error(&e))?;
+        for rx in std::iter::once(pixels).chain(truth) {
+            rx.recv()
+                .map_err(|e| device_error(&e))?
+                .map_err(|e| device_error(&e))?;
         }
-        self.readback.unmap();
+        {
+            let view =
+                (self.pixels.readback.get_mapped_range(0..bytes)).map_err(|e| device_error(&e))?;
+            let truth_view = (truth_bytes > 0)
+                .then(|| self.truth.readback.get_mapped_range(0..truth_bytes))
+                .transpose()
+                .map_err(|e| device_error(&e))?;
+            let pairs = truth_view
+                .as_deref()
+                .map_or(&[][..], |v| bytemuck::cast_slice::<u8, [u32; 2]>(v));
+            take(bytemuck::cast_slice::<u8, u32>(&view), pairs);
+        }
+        self.pixels.readback.unmap();
+        if truth_bytes > 0 {
+            self.truth.readback.unmap();
+        }
         Ok(())
     }
 }

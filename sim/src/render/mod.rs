@@ -15,7 +15,7 @@ pub use batch::{BatchClient, BatchHandle, BatchServer};
 pub use cpu::{CpuRenderer, SensorRays};
 pub use effects::CameraEffects;
 pub use error::RenderError;
-pub use gpu::{FrameRequest, GpuRenderer};
+pub use gpu::{FrameRequest, GpuRenderer, PixelTruth, TracedFrame};
 pub use noise::{FrameNoise, SensorNoise};
 pub use scene::Scene;
 pub use truth::{TruthFrame, TruthRays};
@@ -202,8 +202,22 @@ impl Renderer {
             self.truth.t.resize(n, 0.0);
             self.truth.codes.resize(n, 0);
         }
+        let request = FrameRequest {
+            scene,
+            sensor,
+            pose,
+            noise,
+        };
         match &mut self.backend {
+            Backend::Gpu(g) if truth => {
+                let (t, codes) = (&mut self.truth.t, &mut self.truth.codes);
+                g.render_truth(request, &mut self.pixels, t, codes)?;
+            }
             Backend::Gpu(g) => g.render(scene, sensor, pose, noise, &mut self.pixels)?,
+            Backend::Shared(client) if truth => {
+                let (pixels, t) = client.render_truth(request)?;
+                (self.pixels, self.truth.t, self.truth.codes) = (pixels, t.t, t.codes);
+            }
             Backend::Shared(client) => self.pixels = client.render(scene, sensor, pose, noise)?,
             Backend::Cpu(c) => {
                 // One cache entry a sensor name, traced again when the sensor changed (a camera

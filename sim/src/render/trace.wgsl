@@ -1,6 +1,8 @@
 // omniloop catadioptric tracer: one invocation per pixel of each frame of a batch (z: frame).
 // camera ray -> mirror (hyperbolic, conical, spherical) or pinhole -> scene (floor, boxes,
-// quadrilateral prisms, cylinders, striped boards) -> Lambert shading -> packed RGBA8.
+// quadrilateral prisms, cylinders, striped boards) -> Lambert shading -> packed RGBA8; a frame
+// that asks for its truth also gets, per pixel, the distance along the scene ray to what it
+// meets and what that is (trace.rs: Code).
 // The scene half matches sim/src/render/trace.rs operation for operation.
 
 struct Globals {
@@ -16,7 +18,7 @@ struct Globals {
 };
 
 struct SensorParams {
-    size: vec4<u32>,        // width, height, kind, unused
+    size: vec4<u32>,        // width, height, kind, truth (0: none, else 1 + its first pixel)
     intr: vec4<f32>,        // cx, cy, focal, noise sigma (0: none)
     p0: vec4<f32>,
     p1: vec4<f32>,
@@ -54,6 +56,9 @@ struct Frame {
 @group(0) @binding(8) var<storage, read> quads: array<QuadPrim>;
 // Standard normal quantiles (sim/src/render/noise.rs: gauss_table).
 @group(0) @binding(9) var<storage, read> gauss: array<f32>;
+// Per pixel of the frames that ask for their truth: the distance t along the scene ray (f32
+// bits) and what the ray meets (a code, as trace.rs's Code), the frames one after the other.
+@group(0) @binding(10) var<storage, read_write> truth: array<vec2<u32>>;
 
 // The invocation's frame (global_invocation_id.z), read once in main.
 var<private> g: Globals;
@@ -64,6 +69,15 @@ var<private> off2: vec4<u32>;
 const T_EPS: f32 = 1e-3;
 const BIG: f32 = 3.0e38;
 const BLACK: u32 = 0xff000000u;
+// The codes of what a pixel shows (trace.rs: Code): a primitive's rank from 1 (boxes, quads,
+// cylinders), the floor bit with the paint's index, the sky, or no mirror at all.
+const CODE_FLOOR: u32 = 0x80000000u;
+const CODE_SKY: u32 = 0xffffffffu;
+const CODE_NOTHING: u32 = 0xfffffffeu;
+// The bits of t for the sky (+infinity) and for a pixel that sees no mirror (NaN, Rust's
+// f32::NAN).
+const T_SKY: u32 = 0x7f800000u;
+const T_NOTHING: u32 = 0x7fc00000u;
 
 struct Ray { o: vec3<f32>, d: vec3<f32>, ok: bool };
 struct Hit { t: f32, n: vec3<f32>, rgb: vec3<f32>, ok: bool };
@@ -307,10 +321,14 @@ fn scene_ray(x: f32, y: f32) -> Ray {
     return Ray(vec3<f32>(p.x, p.y, p.z + sensor.p0.z), reflect_n(d, n), true);
 }
 
-fn floor_color(x: f32, y: f32) -> vec3<f32> {
+// What covers the floor at (x, y), as trace.rs's paint_index: mark i (the last that covers the
+// point) is i, then outside every region n, a line n + 1 and the bare floor n + 2, with n the
+// floor rects' count.
+fn floor_paint(x: f32, y: f32) -> u32 {
+    let n = g.counts.x;
     var inside = g.flags.y == 0u;
     var mark = -1;
-    for (var i = 0u; i < g.counts.x; i = i + 1u) {
+    for (var i = 0u; i < n; i = i + 1u) {
         let r = floor_rects[off2.x + i];
         let dx = x - r.geom.x;
         let dy = y - r.geom.y;
@@ -325,8 +343,8 @@ fn floor_color(x: f32, y: f32) -> vec3<f32> {
             mark = i32(i);
         }
     }
-    if (mark >= 0) { return floor_rects[off2.x + u32(mark)].color.xyz; }
-    if (!inside) { return g.outside_rgb.xyz; }
+    if (mark >= 0) { return u32(mark); }
+    if (!inside) { return n; }
     if (g.flags.x != 0u) {
         let ax = abs(x);
         let ay = abs(y);
@@ -337,9 +355,18 @@ fn floor_color(x: f32, y: f32) -> vec3<f32> {
             let boundary = ax >= a1 - w || ay >= b - w;
             let centre = ax <= 0.5 * w;
             let circle = abs(sqrt(x * x + y * y) - g.field.w) <= 0.5 * w;
-            if (boundary || centre || circle) { return g.line_rgb.xyz; }
+            if (boundary || centre || circle) { return n + 1u; }
         }
     }
+    return n + 2u;
+}
+
+// The colour of floor paint `k` (floor_paint's index).
+fn paint_color(k: u32) -> vec3<f32> {
+    let n = g.counts.x;
+    if (k < n) { return floor_rects[off2.x + k].color.xyz; }
+    if (k == n) { return g.outside_rgb.xyz; }
+    if (k == n + 1u) { return g.line_rgb.xyz; }
     return g.floor_rgb.xyz;
 }
 
@@ -511,6 +538,51 @@ fn with_noise(p: u32, i: u32) -> u32 {
     return r | (gr << 8u) | (b << 16u) | (p & 0xff000000u);
 }
 
+// What a world ray meets first: the hit (not ok: the sky) and its code (trace.rs: trace_ray).
+struct Seen { hit: Hit, code: u32 };
+
+// The world ray o + t d traced against the floor and every primitive, in trace.rs's order.
+fn trace_scene(o: vec3<f32>, d: vec3<f32>) -> Seen {
+    var best = no_hit();
+    var code = CODE_SKY;
+    var t_max = BIG;
+    if (d.z < 0.0) {
+        let t = -o.z / d.z;
+        if (t > T_EPS) {
+            let paint = floor_paint(o.x + t * d.x, o.y + t * d.y);
+            best = Hit(t, vec3<f32>(0.0, 0.0, 1.0), paint_color(paint), true);
+            code = CODE_FLOOR | paint;
+            t_max = t;
+        }
+    }
+    // Ranks from 1: boxes, then quads, then cylinders.
+    var rank = 1u;
+    for (var i = 0u; i < g.flags.z; i = i + 1u) {
+        let hb = hit_box(boxes[off.x + i], o, d, t_max);
+        if (hb.ok) { best = hb; t_max = hb.t; code = rank + i; }
+    }
+    rank = rank + g.flags.z;
+    for (var i = 0u; i < g.counts.z; i = i + 1u) {
+        let hq = hit_quad(quads[off2.y + i], o, d, t_max);
+        if (hq.ok) { best = hq; t_max = hq.t; code = rank + i; }
+    }
+    rank = rank + g.counts.z;
+    for (var i = 0u; i < g.flags.w; i = i + 1u) {
+        let hc = hit_cylinder(cylinders[off.y + i], o, d, t_max);
+        if (hc.ok) { best = hc; t_max = hc.t; code = rank + i; }
+    }
+    return Seen(best, code);
+}
+
+// Pixel `local` of the frame: its colour and, when the frame asks for its truth, its t (bits)
+// and code.
+fn put(index: u32, local: u32, colour: u32, t_bits: u32, code: u32) {
+    pixels[index] = with_noise(colour, local);
+    if (sensor.size.w != 0u) {
+        truth[sensor.size.w - 1u + local] = vec2<u32>(t_bits, code);
+    }
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let fr = frames[id.z];
@@ -527,7 +599,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let y = sensor.intr.y - (f32(id.y) + 0.5);
     let ray = scene_ray(x, y);
     if (!ray.ok) {
-        pixels[index] = with_noise(BLACK, local);
+        put(index, local, BLACK, T_NOTHING, CODE_NOTHING);
         return;
     }
     // Robot frame -> world.
@@ -536,32 +608,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let ro = vec3<f32>(ray.o.x + sensor.mount.x, ray.o.y + sensor.mount.y, ray.o.z);
     let o = vec3<f32>(sensor.pose.x + c * ro.x - s * ro.y, sensor.pose.y + s * ro.x + c * ro.y, ro.z);
     let d = vec3<f32>(c * ray.d.x - s * ray.d.y, s * ray.d.x + c * ray.d.y, ray.d.z);
-
-    var best = no_hit();
-    var t_max = BIG;
-    if (d.z < 0.0) {
-        let t = -o.z / d.z;
-        if (t > T_EPS) {
-            best = Hit(t, vec3<f32>(0.0, 0.0, 1.0), floor_color(o.x + t * d.x, o.y + t * d.y), true);
-            t_max = t;
-        }
-    }
-    for (var i = 0u; i < g.flags.z; i = i + 1u) {
-        let hb = hit_box(boxes[off.x + i], o, d, t_max);
-        if (hb.ok) { best = hb; t_max = hb.t; }
-    }
-    for (var i = 0u; i < g.counts.z; i = i + 1u) {
-        let hq = hit_quad(quads[off2.y + i], o, d, t_max);
-        if (hq.ok) { best = hq; t_max = hq.t; }
-    }
-    for (var i = 0u; i < g.flags.w; i = i + 1u) {
-        let hc = hit_cylinder(cylinders[off.y + i], o, d, t_max);
-        if (hc.ok) { best = hc; t_max = hc.t; }
-    }
-    if (!best.ok) {
-        pixels[index] = with_noise(pack(g.sky_rgb.xyz), local);
+    let seen = trace_scene(o, d);
+    if (!seen.hit.ok) {
+        put(index, local, pack(g.sky_rgb.xyz), T_SKY, CODE_SKY);
         return;
     }
-    let k = (g.light.w + g.light2.x * max(dot(best.n, g.light.xyz), 0.0)) * g.light2.y;
-    pixels[index] = with_noise(pack(best.rgb * k), local);
+    let k = (g.light.w + g.light2.x * max(dot(seen.hit.n, g.light.xyz), 0.0)) * g.light2.y;
+    put(index, local, pack(seen.hit.rgb * k), bitcast<u32>(seen.hit.t), seen.code);
 }
