@@ -46,37 +46,37 @@ impl TruthFrame {
     }
 }
 
-/// A pixel's mirror half: the camera ray's length (mm), the scene ray's origin and direction.
-type MirrorPath = (f64, [f64; 3], [f64; 3]);
-
-/// The mirror half of each pixel's path for the truth, in the robot frame: the camera ray's
-/// length to the mirror and the scene ray (`f64`, the same for every pose).
+/// The mirror half of each pixel's path for the truth, in the robot frame (the same for every
+/// pose), traced in `f64` and kept in `f32`: the camera ray's length to the mirror, and the
+/// scene ray's origin and direction across the floor (x, y).
 #[derive(Debug, Clone)]
 pub struct TruthRays {
-    /// Per pixel: the camera ray's length (mm), the scene ray's origin and direction; `None`
-    /// where the pixel sees no mirror.
-    rays: Vec<Option<MirrorPath>>,
+    /// Per pixel, the camera ray's length (mm); NaN where the pixel sees no mirror.
+    path_mm: Vec<f32>,
+    /// Per pixel, the scene ray's origin x, y (mm) and direction x, y, each in an array of its
+    /// own.
+    rays: [Vec<f32>; 4],
 }
 
 impl TruthRays {
     /// Traces the mirror half of every pixel of `sensor`.
     pub fn new(sensor: &Sensor) -> Self {
         let (w, h) = (sensor.width_px, sensor.height_px);
-        let rays = (0..h)
-            .flat_map(|v| (0..w).map(move |u| (u, v)))
-            .map(|(u, v)| {
-                sensor.pixel_ray(u, v).map(|r| {
-                    let o = [r.origin.x, r.origin.y, r.origin.z];
-                    (r.path_mm, o, [r.dir.x, r.dir.y, r.dir.z])
-                })
-            })
-            .collect();
-        Self { rays }
+        let (mut path_mm, mut rays) = (Vec::new(), <[Vec<f32>; 4]>::default());
+        for (u, v) in (0..h).flat_map(|v| (0..w).map(move |u| (u, v))) {
+            let ray = sensor.pixel_ray(u, v);
+            path_mm.push(ray.map_or(f32::NAN, |r| r.path_mm as f32));
+            let parts = ray.map_or([0.0; 4], |r| [r.origin.x, r.origin.y, r.dir.x, r.dir.y]);
+            for (a, c) in rays.iter_mut().zip(parts) {
+                a.push(c as f32);
+            }
+        }
+        Self { path_mm, rays }
     }
 
     /// How many pixels.
     pub fn len(&self) -> usize {
-        self.rays.len()
+        self.path_mm.len()
     }
 
     /// Whether there are none.
@@ -152,26 +152,24 @@ pub fn truth_frame(
 ) -> TruthFrame {
     let legend = scene.legend();
     let labeller = Labeller::new(scene, &legend, own_body(scene, pose));
-    let n = rays.len();
-    let (mut depth_mm, mut floor_mm, mut labels) =
-        (vec![f32::NAN; n], vec![f32::NAN; n], vec![0; n]);
-    for k in 0..n.min(t.len()).min(codes.len()) {
-        let label = labeller.label(codes[k]);
-        labels[k] = label;
-        let Some((path, o, d)) = rays.rays[k] else {
-            labels[k] = labels::NOTHING;
-            continue;
-        };
-        depth_mm[k] = match codes[k] {
-            CODE_SKY => f32::INFINITY,
-            CODE_NOTHING => f32::NAN,
-            _ => (path + t[k] as f64) as f32,
-        };
-        if legend.object(label).is_some_and(|o| o.class.is_floor()) {
-            let tk = t[k] as f64;
-            floor_mm[k] = (o[0] + tk * d[0]).hypot(o[1] + tk * d[1]) as f32;
-        }
-    }
+    let n = rays.len().min(t.len()).min(codes.len());
+    let labels: Vec<u16> = (codes[..n].iter())
+        .zip(&rays.path_mm)
+        .map(|(&code, path)| {
+            if path.is_nan() {
+                labels::NOTHING
+            } else {
+                labeller.label(code)
+            }
+        })
+        .collect();
+    // The sky's distance is infinite, a pixel that sees no mirror has none (its path is NaN):
+    // the sum holds both.
+    let depth_mm: Vec<f32> = (rays.path_mm[..n].iter())
+        .zip(&t[..n])
+        .map(|(path, t)| path + t)
+        .collect();
+    let floor_mm = floor_distances(&rays.rays, &t[..n], &codes[..n]);
     TruthFrame {
         width: sensor.width_px,
         height: sensor.height_px,
@@ -180,4 +178,23 @@ pub fn truth_frame(
         labels,
         legend,
     }
+}
+
+/// Where a pixel shows the floor (`codes`), the floor point's distance from the robot's centre:
+/// `|o + t d|` across the floor, from the scene rays `[o_x, o_y, d_x, d_y]` in the robot frame;
+/// NaN elsewhere.
+fn floor_distances(rays: &[Vec<f32>; 4], t: &[f32], codes: &[Code]) -> Vec<f32> {
+    let n = t.len().min(codes.len());
+    let [ox, oy, dx, dy] = rays.each_ref().map(|a| &a[..n]);
+    let mut out = vec![f32::NAN; n];
+    for k in 0..n {
+        let (x, y) = (ox[k] + t[k] * dx[k], oy[k] + t[k] * dy[k]);
+        let floor = codes[k] & CODE_FLOOR != 0 && codes[k] < CODE_NOTHING;
+        out[k] = if floor {
+            (x * x + y * y).sqrt()
+        } else {
+            f32::NAN
+        };
+    }
+    out
 }

@@ -92,7 +92,8 @@ impl<T: Copy> Scatter<T> {
     /// # Safety
     /// No other thread reads or writes these pixels meanwhile, and the slice this was made
     /// from outlives the call.
-    unsafe fn write(&self, p: &Packet, values: &[T; LANES]) {
+    #[inline(always)]
+    pub(super) unsafe fn write(&self, p: &Packet, values: &[T; LANES]) {
         for (&k, &c) in p.pixel.iter().zip(values) {
             let k = k as usize;
             assert!(k < self.len, "a packet's pixel lies outside the frame");
@@ -115,6 +116,7 @@ impl Outputs {
     ///
     /// # Safety
     /// As [`Scatter::write`]: this packet alone writes its pixels.
+    #[inline(always)]
     unsafe fn write(&self, p: &Packet, colours: &U, t: &F, code: &U) {
         // SAFETY: the caller's contract.
         unsafe {

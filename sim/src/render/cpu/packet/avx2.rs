@@ -18,20 +18,18 @@ type I = __m256i;
 /// Traces `packets` as [`super::trace_chunk`] does.
 #[target_feature(enable = "avx2")]
 pub(super) fn trace_chunk(frame: &FrameRays, packets: &[Packet], out: &Outputs) {
-    if out.truth.is_some() {
-        trace_packets::<true>(frame, packets, out);
-    } else {
-        trace_packets::<false>(frame, packets, out);
-    }
-}
-
-/// [`trace_chunk`] with the truth computed (`TRUTH`) or not.
-#[target_feature(enable = "avx2")]
-fn trace_packets<const TRUTH: bool>(frame: &FrameRays, packets: &[Packet], out: &Outputs) {
+    let with_truth = out.truth.is_some();
     for p in packets {
-        let (colours, t, code) = trace_packet::<TRUTH>(frame, p);
+        let (colours, truth) = trace_packet(frame, p, with_truth);
         // SAFETY: as in `super::trace_chunk`: this chunk alone writes these pixels.
-        unsafe { out.write(p, &lanes_u(colours), &lanes_f(t), &lanes_u(code)) };
+        unsafe { out.colour.write(p, &lanes_u(colours)) };
+        if let (Some((ts, codes)), Some((t, code))) = (&out.truth, truth) {
+            // SAFETY: as above.
+            unsafe {
+                ts.write(p, &lanes_f(t));
+                codes.write(p, &lanes_u(code));
+            }
+        }
     }
 }
 
@@ -238,11 +236,11 @@ impl Nearest {
     }
 }
 
-/// The colour of each lane and, with `TRUTH`, its distance along the ray and what it meets
-/// (else zeros).
+/// The colour of each lane and, `with_truth`, its distance along the ray to what it meets and
+/// what that is.
 #[inline]
 #[target_feature(enable = "avx2")]
-fn trace_packet<const TRUTH: bool>(frame: &FrameRays, p: &Packet) -> (I, V, I) {
+fn trace_packet(frame: &FrameRays, p: &Packet, with_truth: bool) -> (I, Option<(V, I)>) {
     let [px, py, c, s] = frame.pose;
     let (px, py, c, s) = (splat(px), splat(py), splat(c), splat(s));
     let sectors = frame.sectors;
@@ -261,11 +259,8 @@ fn trace_packet<const TRUTH: bool>(frame: &FrameRays, p: &Packet) -> (I, V, I) {
     let zero = splat(0.0);
     let sky = and(ge(dz, zero), gt(oz, splat(sectors.top_mm)));
     if _mm256_movemask_ps(sky) == 0xff {
-        return (
-            splat_u(sectors.sky),
-            splat(f32::INFINITY),
-            splat_u(CODE_SKY),
-        );
+        let truth = (splat(f32::INFINITY), splat_u(CODE_SKY));
+        return (splat_u(sectors.sky), with_truth.then_some(truth));
     }
     let floor_t = load(&p.floor_t);
     let floor = gt(floor_t, zero);
@@ -309,11 +304,7 @@ fn trace_packet<const TRUTH: bool>(frame: &FrameRays, p: &Packet) -> (I, V, I) {
     let nothing = or(sky, not(or(near.hit, floor)));
     let seen = select_u(near.hit, near.colour, floor_colour);
     let colour = select_u(nothing, splat_u(sectors.sky), seen);
-    if !TRUTH {
-        return (colour, splat(0.0), splat_u(0));
-    }
-    let (t, code) = truth(&near, nothing, paint);
-    (colour, t, code)
+    (colour, with_truth.then(|| truth(&near, nothing, paint)))
 }
 
 /// Each lane's distance to what it meets and what that is ([`crate::render::trace::Code`]):
