@@ -98,45 +98,55 @@ pub fn own_body(scene: &Scene, pose: &Isometry2<f64>) -> Option<usize> {
 /// The label of each [`Code`] a frame of `scene` can hold, for a robot whose body is cylinder
 /// `body`.
 struct Labeller {
-    /// By rank less one.
-    ranks: Vec<u16>,
-    /// By floor paint index.
-    paints: Vec<u16>,
+    /// The label of each code's place in the table ([`Labeller::place`]): nothing for rank 0
+    /// (none), the ranks' from 1, the floor paints', then the sky's and nothing's.
+    table: Vec<u16>,
+    /// The number of ranks (primitives).
+    ranks: u32,
 }
 
 impl Labeller {
     fn new(scene: &Scene, legend: &Legend, body: Option<usize>) -> Self {
         let first_cylinder = scene.boxes.len() + scene.quads.len();
-        let ranks = (scene.objects.iter().enumerate())
-            .map(|(k, &o)| match body {
-                Some(b) if k == first_cylinder + b => labels::OWN_BODY,
-                _ => legend.label(o),
-            })
-            .collect();
-        let paints = (0..scene.floor_rects.len() as u32 + 3)
-            .map(|k| match trace::paint_of_index(scene, k) {
+        let ranks = (scene.objects.iter().enumerate()).map(|(k, &o)| match body {
+            Some(b) if k == first_cylinder + b => labels::OWN_BODY,
+            _ => legend.label(o),
+        });
+        let paints = (0..scene.floor_rects.len() as u32 + 3).map(|k| {
+            match trace::paint_of_index(scene, k) {
                 FloorPaint::Mark(_) => labels::FLOOR_MARK,
                 FloorPaint::Outside => labels::FLOOR_OUTSIDE,
                 FloorPaint::Line => labels::FLOOR_LINE,
                 FloorPaint::Floor => labels::FLOOR_REGION,
-            })
+            }
+        });
+        let table = [labels::NOTHING]
+            .into_iter()
+            .chain(ranks)
+            .chain(paints)
+            .chain([labels::SKY, labels::NOTHING])
             .collect();
-        Self { ranks, paints }
+        Self {
+            table,
+            ranks: scene.objects.len() as u32,
+        }
+    }
+
+    /// A code's place in the table, by selects rather than branches (a frame's codes change
+    /// class often along the rows): a rank is its own place, a floor paint `p` follows the
+    /// ranks, the sky and nothing close the table.
+    #[inline]
+    fn place(&self, code: Code) -> usize {
+        let last = self.table.len() as u32 - 1;
+        let paint = self.ranks + 1 + (code & !CODE_FLOOR);
+        let place = if code & CODE_FLOOR == 0 { code } else { paint };
+        let place = if code == CODE_SKY { last - 1 } else { place };
+        let place = if code == CODE_NOTHING { last } else { place };
+        place.min(last) as usize
     }
 
     fn label(&self, code: Code) -> u16 {
-        match code {
-            CODE_NOTHING => labels::NOTHING,
-            CODE_SKY => labels::SKY,
-            c if c & CODE_FLOOR != 0 => {
-                let k = (c & !CODE_FLOOR) as usize;
-                self.paints.get(k).copied().unwrap_or(labels::FLOOR_REGION)
-            }
-            rank => (rank as usize)
-                .checked_sub(1)
-                .and_then(|k| self.ranks.get(k).copied())
-                .unwrap_or(labels::NOTHING),
-        }
+        self.table[self.place(code)]
     }
 }
 
@@ -156,11 +166,8 @@ pub fn truth_frame(
     let labels: Vec<u16> = (codes[..n].iter())
         .zip(&rays.path_mm)
         .map(|(&code, path)| {
-            if path.is_nan() {
-                labels::NOTHING
-            } else {
-                labeller.label(code)
-            }
+            let code = if path.is_nan() { CODE_NOTHING } else { code };
+            labeller.label(code)
         })
         .collect();
     // The sky's distance is infinite, a pixel that sees no mirror has none (its path is NaN):
@@ -189,7 +196,7 @@ fn floor_distances(rays: &[Vec<f32>; 4], t: &[f32], codes: &[Code]) -> Vec<f32> 
     let mut out = vec![f32::NAN; n];
     for k in 0..n {
         let (x, y) = (ox[k] + t[k] * dx[k], oy[k] + t[k] * dy[k]);
-        let floor = codes[k] & CODE_FLOOR != 0 && codes[k] < CODE_NOTHING;
+        let floor = (codes[k] & CODE_FLOOR != 0) & (codes[k] < CODE_NOTHING);
         out[k] = if floor {
             (x * x + y * y).sqrt()
         } else {
