@@ -12,6 +12,7 @@ use super::trace::{self, CODE_FLOOR, CODE_NOTHING, CODE_SKY, Code, FloorPaint};
 use crate::labels::{self, Legend};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
+use rayon::prelude::*;
 
 /// The truth of one frame, row-major like the image.
 #[derive(Debug, Clone, PartialEq)]
@@ -163,8 +164,10 @@ pub fn truth_frame(
     let legend = scene.legend();
     let labeller = Labeller::new(scene, &legend, own_body(scene, pose));
     let n = rays.len().min(t.len()).min(codes.len());
-    let labels: Vec<u16> = (codes[..n].iter())
-        .zip(&rays.path_mm)
+    // In parallel over the cores, in runs of rows.
+    let labels: Vec<u16> = (codes[..n].par_iter())
+        .with_min_len(PIXELS_A_TASK)
+        .zip(&rays.path_mm[..n])
         .map(|(&code, path)| {
             let code = if path.is_nan() { CODE_NOTHING } else { code };
             labeller.label(code)
@@ -172,7 +175,8 @@ pub fn truth_frame(
         .collect();
     // The sky's distance is infinite, a pixel that sees no mirror has none (its path is NaN):
     // the sum holds both.
-    let depth_mm: Vec<f32> = (rays.path_mm[..n].iter())
+    let depth_mm: Vec<f32> = (rays.path_mm[..n].par_iter())
+        .with_min_len(PIXELS_A_TASK)
         .zip(&t[..n])
         .map(|(path, t)| path + t)
         .collect();
@@ -194,14 +198,21 @@ fn floor_distances(rays: &[Vec<f32>; 4], t: &[f32], codes: &[Code]) -> Vec<f32> 
     let n = t.len().min(codes.len());
     let [ox, oy, dx, dy] = rays.each_ref().map(|a| &a[..n]);
     let mut out = vec![f32::NAN; n];
-    for k in 0..n {
-        let (x, y) = (ox[k] + t[k] * dx[k], oy[k] + t[k] * dy[k]);
-        let floor = (codes[k] & CODE_FLOOR != 0) & (codes[k] < CODE_NOTHING);
-        out[k] = if floor {
-            (x * x + y * y).sqrt()
-        } else {
-            f32::NAN
-        };
-    }
+    (out.par_chunks_mut(PIXELS_A_TASK).enumerate()).for_each(|(c, chunk)| {
+        let first = c * PIXELS_A_TASK;
+        for (i, out) in chunk.iter_mut().enumerate() {
+            let k = first + i;
+            let (x, y) = (ox[k] + t[k] * dx[k], oy[k] + t[k] * dy[k]);
+            let floor = (codes[k] & CODE_FLOOR != 0) & (codes[k] < CODE_NOTHING);
+            *out = if floor {
+                (x * x + y * y).sqrt()
+            } else {
+                f32::NAN
+            };
+        }
+    });
     out
 }
+
+/// Pixels a task of the truth's conversion takes at least.
+const PIXELS_A_TASK: usize = 8192;
