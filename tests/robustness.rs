@@ -101,3 +101,41 @@ fn knobs_that_cannot_reach_an_estimator() {
         assert!(md.contains("| n/a |"), "{md}");
     }
 }
+
+/// The floor region's estimator shares the free-space estimator's runs (E1, with the truth
+/// beside every frame): each noise level is one run, both scored; the stage's floor region
+/// strays from the truth's as the noise grows, within the target.
+#[test]
+fn the_floor_region_is_scored_pixel_by_pixel_in_the_free_space_runs() {
+    let selection = Selection {
+        estimators: vec![
+            estimator("free_space").unwrap(),
+            estimator("floor_region").unwrap(),
+        ],
+        knobs: vec![knob("noise").unwrap()],
+        max_levels: None,
+    };
+    let grid = run_grid(&selection, &cpu(None), |_, _| {}).unwrap();
+    assert_eq!(grid.runs, 5, "the two estimators share their runs");
+    let floor: Vec<_> = (grid.cells.iter())
+        .filter(|c| c.estimator.name == "floor_region")
+        .map(|c| match &c.outcome {
+            Outcome::Scored(s) => s.clone(),
+            o => panic!("noise {}: {o:?}", c.level),
+        })
+        .collect();
+    assert_eq!(floor.len(), 5);
+    println!(
+        "1 - median IoU at noise 2, 4, 8, 12, 16: {:?} %",
+        floor.iter().map(|s| s.error).collect::<Vec<_>>()
+    );
+    let errors: Vec<f64> = floor.iter().map(|s| s.error).collect();
+    assert!(
+        errors.windows(2).all(|w| w[1] >= w[0]) && errors[4] > errors[0],
+        "the floor region does not stray more with more noise: {errors:?}"
+    );
+    for s in &floor {
+        assert!((0.0..10.0).contains(&s.error), "{}", s.error);
+        assert!(s.meets(), "{:?}", s.missed);
+    }
+}
