@@ -181,3 +181,10 @@ pub fn finite_numbers(what: &str, v: &Bound<'_, PyAny>, expected: &str) -> PyRes
     }
     Ok(values)
 }
+
+/// The renderer named in Python.
+pub fn renderer_choice(name: &str) -> PyResult<omniloop_sim::RendererChoice> {
+    name.parse().map_err(|e: String| {
+        pyo3::exceptions::PyValueError::new_err(format!("renderer={name:?}: {e}"))
+    })
+}

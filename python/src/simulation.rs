@@ -118,11 +118,7 @@ impl Drivers {
     }
 }
 
-/// The renderer named in Python.
-pub fn renderer_choice(name: &str) -> PyResult<RendererChoice> {
-    name.parse()
-        .map_err(|e: String| PyValueError::new_err(format!("renderer={name:?}: {e}")))
-}
+pub use crate::convert::renderer_choice;
 
 /// What Python hands one step: checked before the step runs.
 #[derive(Debug, Clone, Default)]

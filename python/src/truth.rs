@@ -4,9 +4,8 @@
 //!
 //! All of it is the simulator's side: none of it reaches the robot's software.
 
-use crate::convert::{ScenarioError, json_to_py, rgb_image_array, run_error};
+use crate::convert::{ScenarioError, json_to_py, renderer_choice, rgb_image_array, run_error};
 use crate::scenario::PyScenario;
-use crate::simulation::renderer_choice;
 use numpy::ndarray::Array2;
 use numpy::{PyArray2, PyArray3};
 use omniloop::dataset::{DatasetError, DatasetOptions, PoseMode};
