@@ -13,6 +13,7 @@ use omniloop_sim::render::trace::CODE_NOTHING;
 use omniloop_sim::render::truth::{self, TruthFrame, TruthRays};
 use omniloop_sim::render::{BatchServer, CpuRenderer, SensorRays};
 use omniloop_sim::{FrameRequest, Renderer, Scene, SensorNoise, World};
+use std::ffi::OsStr;
 
 /// The world of a scenario with its robots where they start, and the first robot's pose.
 fn world_of(s: &omniloop::Scenario) -> (World, nalgebra::Isometry2<f64>) {
@@ -168,19 +169,10 @@ fn another_robot_is_robot_k_and_the_observer_its_own_body() {
 fn render_truth_writes_a_depth_png_in_mm_a_label_png_and_its_legend() {
     let dir = common::tmp("render_truth");
     let out = dir.join("h.png");
-    let status = common::bin()
-        .args([
-            "render",
-            "scenarios/render_hyperbolic.toml",
-            "--renderer",
-            "cpu",
-        ])
-        .args(["--no-noise", "--truth", "--out"])
-        .arg(&out)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let scenario_file = common::scenario_path("render_hyperbolic.toml");
+    let flags = ["--renderer", "cpu", "--no-noise", "--truth", "--out"].map(OsStr::new);
+    let first = [OsStr::new("render"), scenario_file.as_os_str()];
+    common::omniloop([&first[..], &flags, &[out.as_os_str()]].concat());
     // The files hold what the renderer gives.
     let s = scenario("render_hyperbolic.toml");
     let sensor = s.robot.sensors[0].build();
@@ -204,19 +196,10 @@ fn render_truth_writes_a_depth_png_in_mm_a_label_png_and_its_legend() {
 #[test]
 fn a_run_with_truth_scores_the_floor_region_every_cycle_and_its_median() {
     let dir = common::tmp("run_truth");
-    let status = common::bin()
-        .args([
-            "run",
-            "scenarios/corner55_velocity_aware.toml",
-            "--renderer",
-            "cpu",
-        ])
-        .args(["--truth", "-q", "--out"])
-        .arg(&dir)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    let scenario_file = common::scenario_path("corner55_velocity_aware.toml");
+    let flags = ["--renderer", "cpu", "--truth", "-q", "--out"].map(OsStr::new);
+    let first = [OsStr::new("run"), scenario_file.as_os_str()];
+    common::omniloop([&first[..], &flags, &[dir.as_os_str()]].concat());
     let text = std::fs::read_to_string(dir.join("estimates.jsonl")).unwrap();
     let mut ious = Vec::new();
     for line in text.lines() {
