@@ -10,7 +10,7 @@ mod common;
 
 use nalgebra::{Isometry2, Vector2};
 use omniloop::load_scenario;
-use omniloop_robot::perception::{Belief, OmnistereoStage, Percepts, Stage};
+use omniloop_robot::perception::{Belief, OmnistereoStage, Perceived, Stage};
 use omniloop_robot::{Frame, Observation};
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::omnistereo::{AngularProfile, MirrorRim, OmnistereoConfig, detect_marks};
@@ -76,7 +76,7 @@ fn main() {
             frames: &f,
             actuators: &[],
         };
-        let mut out = Percepts::default();
+        let mut out = Perceived::default();
         stage.run(&obs, &belief, &mut out).expect("stage");
         out
     };

@@ -72,7 +72,8 @@ impl RobotSoftware for GapFollower {
         let pose = self.start * self.odometry.pose();
         let command = BodyCommand::translate(self.decide(&fs, &pose));
         let mut beliefs = Estimates::at(obs.t_s);
-        (beliefs.pose, beliefs.freespace) = (Some(pose), Some(fs));
+        beliefs.pose = Some(pose);
+        beliefs.percepts.put(fs);
         Ok(Outputs::drive(command, beliefs))
     }
 

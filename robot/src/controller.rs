@@ -5,21 +5,20 @@
 use crate::RobotError;
 use crate::boundary::BodyCommand;
 use crate::config::{ControlSpec, RobotConfig};
-use crate::estimates::GroundReading;
 use crate::navigation::{MapSnapshot, NavigationReport};
 use crate::near_field::NearSpace;
+use crate::percept::{Percept, Percepts};
 use crate::tables::ConfigProblem;
 use crate::traffic::TrafficPoints;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::Surroundings;
 use omniloop_vision::FreeSpace;
-use omniloop_vision::forward::FlowBalance;
 
 /// What a controller decides on.
 #[derive(Debug, Clone, Copy)]
 pub struct Situation<'a> {
-    /// Free space around the robot, when perceived this cycle.
-    pub freespace: Option<&'a FreeSpace>,
+    /// What the perception stages found this cycle, by type: [`Situation::percept`].
+    pub percepts: &'a Percepts,
     /// The target relative to the robot (body frame, by the estimate), with a mission.
     pub target_body_mm: Option<Vector2<f64>>,
     /// The target itself (world frame), with a mission and a pose estimate.
@@ -30,14 +29,16 @@ pub struct Situation<'a> {
     pub pose: Option<Isometry2<f64>>,
     /// The dead-reckoned pose in the odometry frame.
     pub odometry_pose: Isometry2<f64>,
-    /// A point perception asks the robot to drive to (odometry frame).
-    pub observation_point: Option<Point2<f64>>,
-    /// A forward camera's ground segmentation, when perceived this cycle.
-    pub ground: Option<&'a GroundReading>,
-    /// A forward camera's flow balance, when perceived this cycle.
-    pub flow: Option<FlowBalance>,
     /// Time of the cycle, s.
     pub t_s: f64,
+}
+
+impl Situation<'_> {
+    /// What the stages found of type `T` this cycle (free space, a ground reading, ...), if a
+    /// stage the controller reads gave it.
+    pub fn percept<T: Percept>(&self) -> Option<&T> {
+        self.percepts.get::<T>()
+    }
 }
 
 /// Chooses the command each cycle.
@@ -126,7 +127,7 @@ pub fn with_surroundings(
     traffic: Option<&TrafficPoints>,
     f: impl FnOnce(&Surroundings<'_>, Vector2<f64>) -> Vector2<f64>,
 ) -> BodyCommand {
-    let (Some(fs), Some(target)) = (s.freespace, s.target_body_mm) else {
+    let (Some(fs), Some(target)) = (s.percept::<FreeSpace>(), s.target_body_mm) else {
         return BodyCommand::STOP;
     };
     let coords =

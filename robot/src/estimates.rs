@@ -1,8 +1,8 @@
 //! What the robot believes: the typed record it returns each cycle, written beside the truth.
 
+use crate::percept::{Percept, Percepts};
 use nalgebra::{Isometry2, Point2, Vector2};
-use omniloop_vision::forward::{FlowBalance, OdometryStep};
-use omniloop_vision::{FreeSpace, LocalizationQuality};
+use omniloop_vision::LocalizationQuality;
 
 /// A measurement a perception stage gives the estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,53 +70,6 @@ pub struct NotFound {
     pub reason: String,
 }
 
-/// A landmark of the map the robot identified and measured this cycle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LandmarkSighting {
-    /// Its index in the map.
-    pub landmark: usize,
-    /// Range from the camera axis to its near face, mm.
-    pub range_mm: f64,
-    /// Bearing (robot frame), rad.
-    pub bearing_rad: f64,
-}
-
-/// The robot's motion since the previous frame as its vision read it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MotionReading {
-    /// The rotation the visual compass read, counter-clockwise positive, rad.
-    pub rotation_rad: f64,
-    /// The translation, in the previous frame's axes, mm; `None` when no feature was seen in
-    /// both frames.
-    pub translation_mm: Option<Vector2<f64>>,
-    /// Features seen in both frames.
-    pub features: usize,
-    /// Of which the clustering kept.
-    pub inliers: usize,
-}
-
-/// What the ground segmentation of a forward camera showed this cycle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GroundReading {
-    /// The fewest ground pixels from the bottom over the columns of the robot's path.
-    pub ahead_px: u32,
-    /// Ground pixels needed ahead to go straight.
-    pub needed_px: u32,
-    /// Mean run of ground over the left half, px.
-    pub left_px: f64,
-    /// Mean run of ground over the right half, px.
-    pub right_px: f64,
-    /// Whether the level at the bottom centre jumped (an obstacle right in front).
-    pub jumped: bool,
-}
-
-impl GroundReading {
-    /// Whether more ground pixels than needed lie ahead.
-    pub fn clear_ahead(&self) -> bool {
-        self.ahead_px > self.needed_px
-    }
-}
-
 /// What the robot believes after one cycle.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Estimates {
@@ -126,24 +79,15 @@ pub struct Estimates {
     pub pose: Option<Isometry2<f64>>,
     /// The measured body velocity, mm/s.
     pub velocity_body_mm_s: Vector2<f64>,
-    /// Free space around the robot, when the stage runs.
-    pub freespace: Option<FreeSpace>,
     /// The fixes of this cycle and what the estimator did with each.
     pub fixes: Vec<Fix>,
     /// Stages that gave no fix this cycle, and why ("not localized: ...").
     pub not_found: Vec<NotFound>,
     /// Index of the target (waypoints, then the goal) the robot is heading for, with a goal.
     pub target: Option<usize>,
-    /// Landmarks of the map identified and ranged this cycle.
-    pub landmarks: Vec<LandmarkSighting>,
-    /// The motion since the previous frame, as vision read it.
-    pub motion: Option<MotionReading>,
-    /// A forward camera's ground segmentation.
-    pub ground: Option<GroundReading>,
-    /// A forward camera's flow balance.
-    pub flow: Option<FlowBalance>,
-    /// A forward camera's visual odometry since the previous frame.
-    pub visual_odometry: Option<OdometryStep>,
+    /// What the perception stages found this cycle, by type (free space, the landmarks
+    /// ranged, a ground reading, ...): [`Estimates::percept`].
+    pub percepts: Percepts,
     /// The move a scripted drive is at (the number of moves once done).
     pub step: Option<usize>,
     /// What the planner did, when the controller plans.
@@ -157,6 +101,11 @@ impl Estimates {
             t_s,
             ..Self::default()
         }
+    }
+
+    /// What the stages found of type `T` this cycle (e.g. `FreeSpace`), if any.
+    pub fn percept<T: Percept>(&self) -> Option<&T> {
+        self.percepts.get::<T>()
     }
 
     /// The first full-pose fix of the cycle from stage `source`, with what became of it.

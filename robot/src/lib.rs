@@ -25,6 +25,7 @@ pub mod estimator;
 pub mod mission;
 pub mod navigation;
 pub mod near_field;
+pub mod percept;
 pub mod perception;
 pub mod remote;
 pub mod robot;
@@ -41,17 +42,17 @@ pub use config::{
 };
 pub use controller::{Controller, ControllerEntry};
 pub use controllers::CONTROLLERS;
-pub use estimates::{
-    Estimates, Fix, FixOutcome, GroundReading, LandmarkSighting, Measurement, MotionReading,
-    NotFound,
-};
+pub use estimates::{Estimates, Fix, FixOutcome, Measurement, NotFound};
 pub use estimator::PoseEstimator;
 pub use mission::Mission;
 pub use navigation::{
     CellState, GridGeometry, MapSnapshot, NavigationReport, PlannerConfig, Unreachable,
 };
+pub use percept::{Percept, Percepts};
 pub use perception::forward::ForwardVisionConfig;
-pub use perception::{STAGES, StageEntry};
+pub use perception::{
+    GroundReading, LandmarkSighting, Landmarks, MotionReading, ObservationPoint, STAGES, StageEntry,
+};
 pub use remote::{Mailbox, Remote, RemoteHandle};
 pub use robot::{Robot, stages_of};
 pub use tables::{ConfigProblem, Tables};

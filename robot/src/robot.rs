@@ -9,7 +9,7 @@ use crate::estimates::{Estimates, Fix, NotFound};
 use crate::estimator::PoseEstimator;
 use crate::mission::Mission;
 use crate::navigation::Unreachable;
-use crate::perception::{self, Belief, Percepts, Stage, StageEntry};
+use crate::perception::{self, Belief, Perceived, Stage, StageEntry};
 use nalgebra::Isometry2;
 
 /// The perception stages a configuration runs, in order: those its controller reads and those
@@ -72,8 +72,12 @@ impl Robot {
 
     /// Runs every perception stage on this cycle's observation; a stage whose camera's frame
     /// was lost finds nothing (a `not_found` entry), unless it carries on without frames.
-    fn perceive(&mut self, obs: &Observation<'_>, belief: &Belief) -> Result<Percepts, RobotError> {
-        let mut percepts = Percepts::default();
+    fn perceive(
+        &mut self,
+        obs: &Observation<'_>,
+        belief: &Belief,
+    ) -> Result<Perceived, RobotError> {
+        let mut percepts = Perceived::default();
         for stage in &mut self.stages {
             // A frame lost on its way: the stage finds nothing this cycle, unless it carries
             // on without one.
@@ -184,15 +188,12 @@ impl RobotSoftware for Robot {
         };
         let velocity_body_mm_s = self.estimator.velocity_body_mm_s();
         let command = self.controller.decide(&Situation {
-            freespace: percepts.freespace.as_ref(),
+            percepts: &percepts.percepts,
             target_body_mm,
             target_mm,
             velocity_body_mm_s,
             pose,
             odometry_pose: self.estimator.odometry_pose(),
-            observation_point: percepts.observation_point,
-            ground: percepts.ground.as_ref(),
-            flow: percepts.flow,
             t_s: obs.t_s,
         });
         self.estimator.end_cycle();
@@ -210,15 +211,10 @@ impl RobotSoftware for Robot {
                 t_s: obs.t_s,
                 pose,
                 velocity_body_mm_s,
-                freespace: percepts.freespace,
                 fixes,
                 not_found,
                 target: self.mission.as_ref().map(Mission::index),
-                landmarks: percepts.landmarks,
-                motion: percepts.motion,
-                ground: percepts.ground,
-                flow: percepts.flow,
-                visual_odometry: percepts.visual_odometry,
+                percepts: percepts.percepts,
                 step: self.controller.step(),
                 navigation,
             },

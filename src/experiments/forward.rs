@@ -15,6 +15,7 @@ use nalgebra::{Isometry2, Vector2};
 use omniloop_control::wrap_pi;
 use omniloop_robot::controllers::script::{Move, ScriptConfig};
 use omniloop_robot::{Estimates, ForwardVisionConfig};
+use omniloop_vision::forward::OdometryStep;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -124,13 +125,13 @@ impl Forward {
 pub fn odometry_path(
     start: Isometry2<f64>,
     estimates: &[Estimates],
-    pick: impl Fn(&omniloop_vision::forward::OdometryStep) -> Option<Vector2<f64>>,
+    pick: impl Fn(&OdometryStep) -> Option<Vector2<f64>>,
 ) -> Vec<Isometry2<f64>> {
     let mut pose = start;
     estimates
         .iter()
         .map(|e| {
-            if let Some(step) = &e.visual_odometry {
+            if let Some(step) = e.percept::<OdometryStep>() {
                 let t = pick(step).unwrap_or_else(Vector2::zeros);
                 pose *= Isometry2::new(t, step.rotation_rad);
             }
@@ -139,11 +140,11 @@ pub fn odometry_path(
         .collect()
 }
 
-fn lk(step: &omniloop_vision::forward::OdometryStep) -> Option<Vector2<f64>> {
+fn lk(step: &OdometryStep) -> Option<Vector2<f64>> {
     step.lk.as_ref().ok().map(|m| m.translation_mm)
 }
 
-fn ncc(step: &omniloop_vision::forward::OdometryStep) -> Option<Vector2<f64>> {
+fn ncc(step: &OdometryStep) -> Option<Vector2<f64>> {
     step.ncc.as_ref().ok().map(|m| m.translation_mm)
 }
 
@@ -162,10 +163,10 @@ impl Forward {
             };
             let before = first.saturating_sub(1);
             let (a, b) = (&rows[before], &rows[last]);
-            let gaps = |f: &dyn Fn(&omniloop_vision::forward::OdometryStep) -> bool| {
+            let gaps = |f: &dyn Fn(&OdometryStep) -> bool| {
                 cycles
                     .iter()
-                    .filter(|&&i| e[i].visual_odometry.as_ref().is_some_and(f))
+                    .filter(|&&i| e[i].percept::<OdometryStep>().is_some_and(f))
                     .count()
             };
             let dist = |p: &[Isometry2<f64>]| {
@@ -189,7 +190,7 @@ impl Forward {
                     scanline_deg: Some(
                         cycles
                             .iter()
-                            .filter_map(|&i| e[i].visual_odometry.as_ref())
+                            .filter_map(|&i| e[i].percept::<OdometryStep>())
                             .map(|s| s.rotation_rad)
                             .sum::<f64>()
                             .to_degrees(),

@@ -15,7 +15,7 @@ use crate::scenario::Checker;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::wrap_pi;
-use omniloop_robot::Measurement;
+use omniloop_robot::{Landmarks, Measurement, MotionReading};
 use omniloop_sim::SimError;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -144,7 +144,7 @@ impl Omnistereo {
         for k in 0..s.frames {
             let e = &out.estimates[k];
             let axis = self.axis(out, k);
-            for l in &e.landmarks {
+            for l in e.percept::<Landmarks>().map_or(&[][..], |l| &l.0) {
                 let Some(&(c, radius)) = self.pillars.get(l.landmark) else {
                     continue;
                 };
@@ -164,7 +164,7 @@ impl Omnistereo {
                 let err = (pose.translation.vector - Vector2::new(r.x_mm, r.y_mm)).norm();
                 s.trilateration_mm.push((k, err));
             }
-            if let (Some(m), true) = (&e.motion, k > 0) {
+            if let (Some(m), true) = (e.percept::<MotionReading>(), k > 0) {
                 let before = self.axis(out, k - 1);
                 let turn = wrap_pi(axis.rotation.angle() - before.rotation.angle());
                 s.compass_deg

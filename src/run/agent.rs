@@ -21,8 +21,8 @@ use omniloop_robot::{
 };
 use omniloop_sim::render::BatchHandle;
 use omniloop_sim::{Reachability, RendererChoice, RobotState, Scene, SimError, World};
-use omniloop_vision::RadialCalibration;
 use omniloop_vision::resection::ColumnCalibration;
+use omniloop_vision::{FreeSpace, RadialCalibration};
 use std::collections::VecDeque;
 use std::path::Path;
 
@@ -292,14 +292,18 @@ impl Agent {
         if let Some(c) = &mut self.cameras {
             c.command(&out.actuators)?;
         }
-        let floor = out.estimates.freespace.as_mut().and_then(|fs| {
-            let mount = self.vision_mount_mm();
-            let free_true = (self.truth).freespace(world, self.body, &state.pose, mount, fs);
-            // The judged pixels are scored now and not kept in the record.
-            let pixels = fs.pixels.take()?;
-            let truth = self.vision_truth()?;
-            Some(FloorRegionScore::of(&pixels, truth, free_true))
-        });
+        let floor = out
+            .estimates
+            .percepts
+            .get_mut::<FreeSpace>()
+            .and_then(|fs| {
+                let mount = self.vision_mount_mm();
+                let free_true = (self.truth).freespace(world, self.body, &state.pose, mount, fs);
+                // The judged pixels are scored now and not kept in the record.
+                let pixels = fs.pixels.take()?;
+                let truth = self.vision_truth()?;
+                Some(FloorRegionScore::of(&pixels, truth, free_true))
+            });
         if let Some(score) = &floor {
             self.truth.floor_region(score);
         }

@@ -4,7 +4,7 @@ use super::outcome::GoalFigures;
 use super::score::FloorRegionScore;
 use nalgebra::{Isometry2, Point2};
 use omniloop_robot::{Estimates, Fix, FixOutcome, Measurement, NavigationReport};
-use omniloop_vision::{LocalizationMode, LocalizationQuality};
+use omniloop_vision::{FreeSpace, LocalizationMode, LocalizationQuality};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 
@@ -387,10 +387,10 @@ struct EstimateLine<'a> {
     fixes: Vec<FixRecord<'a>>,
     not_found: Vec<(&'a str, &'a str)>,
     free_mm: Option<&'a [f64]>,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    landmarks: Vec<LandmarkRecord>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    motion: Option<MotionRecord>,
+    /// What the stages found, each entry as its stage records it (the landmarks ranged, the
+    /// motion read, ...).
+    #[serde(flatten)]
+    percepts: serde_json::Map<String, serde_json::Value>,
     #[serde(skip_serializing_if = "Option::is_none")]
     plan: Option<PlanRecord>,
     /// With the truth traced: the free-space stage's floor region scored pixel by pixel.
@@ -442,23 +442,6 @@ fn round_mm(v: f64) -> f64 {
     (v * 10.0).round() / 10.0
 }
 
-/// A landmark ranged in one cycle.
-#[derive(Debug, Serialize)]
-struct LandmarkRecord {
-    landmark: usize,
-    range_mm: f64,
-    bearing_rad: f64,
-}
-
-/// The motion since the previous frame as vision read it.
-#[derive(Debug, Serialize)]
-struct MotionRecord {
-    rotation_rad: f64,
-    translation_mm: Option<[f64; 2]>,
-    features: usize,
-    inliers: usize,
-}
-
 /// Writes one JSON line a control cycle ([`estimates_line`]), with the cycle's floor-region
 /// score where `floor_scores` has one.
 pub fn write_estimates_jsonl(
@@ -506,22 +489,12 @@ impl<'a> EstimateLine<'a> {
                 .iter()
                 .map(|n| (n.source, n.reason.as_str()))
                 .collect(),
-            free_mm: e.freespace.as_ref().map(|f| f.free_mm.as_slice()),
-            landmarks: e
-                .landmarks
-                .iter()
-                .map(|l| LandmarkRecord {
-                    landmark: l.landmark,
-                    range_mm: l.range_mm,
-                    bearing_rad: l.bearing_rad,
-                })
+            free_mm: e.percept::<FreeSpace>().map(|f| f.free_mm.as_slice()),
+            percepts: e
+                .percepts
+                .records()
+                .map(|(key, value)| (key.to_string(), value))
                 .collect(),
-            motion: e.motion.map(|m| MotionRecord {
-                rotation_rad: m.rotation_rad,
-                translation_mm: m.translation_mm.map(|t| [t.x, t.y]),
-                features: m.features,
-                inliers: m.inliers,
-            }),
             plan: e.navigation.as_ref().map(PlanRecord::of),
             floor_region: floor,
         }

@@ -10,6 +10,7 @@ use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_robot::Frame;
 use omniloop_sim::World;
 use omniloop_sim::render::TruthFrame;
+use omniloop_vision::FreeSpace;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -345,7 +346,7 @@ impl Cycle {
                     .map(|(s, t)| (s.to_string(), (*t).clone()))
                     .collect(),
                 estimate: r.estimates.pose,
-                freespace: r.estimates.freespace.clone(),
+                freespace: r.estimates.percept::<FreeSpace>().cloned(),
                 path: r.estimates.navigation.as_ref().map(|n| n.path_mm.clone()),
                 record: crate::run::record::estimates_line(r.row, r.estimates, r.floor),
             })

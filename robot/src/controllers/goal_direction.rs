@@ -20,7 +20,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         check: check_avoidance,
     }],
     needs_goal: true,
-    stages: &["freespace"],
+    stages: &[crate::perception::freespace::NAME],
     check_use: no_problems,
     build: |c| {
         let b = &c.body;

@@ -3,6 +3,7 @@
 
 use crate::boundary::BodyCommand;
 use crate::controller::{Controller, ControllerEntry, Situation, no_problems};
+use crate::perception::ObservationPoint;
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -33,7 +34,7 @@ pub struct Observe {
 
 impl Controller for Observe {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        let Some(target) = s.observation_point else {
+        let Some(&ObservationPoint(target)) = s.percept::<ObservationPoint>() else {
             return BodyCommand::STOP;
         };
         let to = s.odometry_pose.inverse_transform_point(&target).coords;

@@ -6,6 +6,7 @@ use crate::boundary::BodyCommand;
 use crate::controller::{ControlTable, Controller, ControllerEntry, Situation, parses, settings};
 use crate::perception::forward::{ForwardVisionConfig, needs_forward_camera};
 use crate::perception::stage::vision_settings;
+use omniloop_vision::forward::FlowBalance;
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -17,7 +18,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         check: |spec| parses::<ForwardDriveConfig>(spec, "forward"),
     }],
     needs_goal: false,
-    stages: &["flow"],
+    stages: &[crate::perception::forward::FLOW_NAME],
     check_use: needs_forward_camera,
     build: |c| {
         Ok(Box::new(FlowAvoidance {
@@ -56,7 +57,7 @@ impl Controller for FlowAvoidance {
             self.settle -= 1;
             return BodyCommand::forward(self.drive.speed_mm_s);
         }
-        match s.flow {
+        match s.percept::<FlowBalance>() {
             Some(f) if f.larger_px() > self.threshold_px => {
                 let side = if f.left_px > f.right_px { -1.0 } else { 1.0 };
                 self.turn = Some((side, s.t_s + self.drive.flow_turn_s));

@@ -3,6 +3,7 @@
 
 use crate::boundary::BodyCommand;
 use crate::controller::{ControlTable, Controller, ControllerEntry, Situation, parses, settings};
+use crate::perception::GroundReading;
 use crate::perception::forward::needs_forward_camera;
 use serde::{Deserialize, Serialize};
 
@@ -16,7 +17,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         check: |spec| parses::<ForwardDriveConfig>(spec, "forward"),
     }],
     needs_goal: false,
-    stages: &["ground"],
+    stages: &[crate::perception::forward::GROUND_NAME],
     check_use: needs_forward_camera,
     build: |c| {
         Ok(Box::new(Segmentation {
@@ -65,7 +66,7 @@ pub struct Segmentation {
 
 impl Controller for Segmentation {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        let Some(g) = s.ground else {
+        let Some(g) = s.percept::<GroundReading>() else {
             return BodyCommand::STOP;
         };
         let enough = match self.turning {

@@ -17,6 +17,7 @@ use nalgebra::Isometry2;
 use omniloop_control::{
     AccelLimitedDrive, AvoidanceConfig, GoalKind, SpeedChoice, TrafficConfig, VelocityAware,
 };
+use omniloop_vision::FreeSpace;
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -34,7 +35,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         },
     ],
     needs_goal: true,
-    stages: &["freespace"],
+    stages: &[crate::perception::freespace::NAME],
     check_use: no_problems,
     build: |c| {
         let b = &c.body;
@@ -102,16 +103,19 @@ fn push_blind_out(space: &mut NearSpace, nav: &Navigator, pose: &Isometry2<f64>,
 
 impl Controller for VelocityAwareStack {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        let mut clear = match (&mut self.near, s.freespace) {
+        let mut clear = match (&mut self.near, s.percept::<FreeSpace>()) {
             (Some(near), Some(fs)) => Some(near.update(fs, &s.odometry_pose, s.t_s)),
             _ => None,
         };
-        if let (Some(space), Some(nav), Some(pose), Some(fs)) =
-            (&mut clear, &self.navigator, &s.pose, s.freespace)
-        {
+        if let (Some(space), Some(nav), Some(pose), Some(fs)) = (
+            &mut clear,
+            &self.navigator,
+            &s.pose,
+            s.percept::<FreeSpace>(),
+        ) {
             push_blind_out(space, nav, pose, fs.inner_mm);
         }
-        let traffic = match (&mut self.traffic, s.freespace) {
+        let traffic = match (&mut self.traffic, s.percept::<FreeSpace>()) {
             (Some(sense), Some(fs)) => {
                 Some(sense.update(fs, s.pose.as_ref(), &s.odometry_pose, s.t_s))
             }
@@ -119,7 +123,13 @@ impl Controller for VelocityAwareStack {
         };
         let (target_body_mm, kind) = match (&mut self.navigator, &s.pose, s.target_mm) {
             (Some(nav), Some(pose), Some(target)) => {
-                let to = nav.steer(s.freespace, pose, s.velocity_body_mm_s, target, s.t_s);
+                let to = nav.steer(
+                    s.percept::<FreeSpace>(),
+                    pose,
+                    s.velocity_body_mm_s,
+                    target,
+                    s.t_s,
+                );
                 let kind = if nav.on_final_leg() {
                     GoalKind::InSight
                 } else {

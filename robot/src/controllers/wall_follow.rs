@@ -39,7 +39,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
         check: check_wall_follow,
     }],
     needs_goal: false,
-    stages: &["freespace"],
+    stages: &[crate::perception::freespace::NAME],
     check_use: no_problems,
     build: |c| {
         Ok(Box::new(WallFollow {
@@ -158,7 +158,7 @@ impl WallFollow {
 
 impl Controller for WallFollow {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
-        let Some(fs) = s.freespace else {
+        let Some(fs) = s.percept::<FreeSpace>() else {
             return BodyCommand::STOP;
         };
         let c = &self.config;
@@ -188,6 +188,7 @@ impl Controller for WallFollow {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::percept::Percepts;
     use std::f64::consts::TAU;
 
     /// 64 directions, each surely free to `clear(direction)` mm from the axis, with an
@@ -224,16 +225,17 @@ mod tests {
             config: WallFollowConfig::default(),
             radius_mm: 90.0,
         };
+        let mut percepts = Percepts::default();
+        if let Some(fs) = fs {
+            percepts.put(fs.clone());
+        }
         w.decide(&Situation {
-            freespace: fs,
+            percepts: &percepts,
             target_body_mm: None,
             target_mm: None,
             velocity_body_mm_s: nalgebra::Vector2::zeros(),
             pose: None,
             odometry_pose: nalgebra::Isometry2::identity(),
-            observation_point: None,
-            ground: None,
-            flow: None,
             t_s: 0.0,
         })
     }

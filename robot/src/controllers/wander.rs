@@ -209,6 +209,7 @@ impl Controller for Wander {
 mod tests {
     use super::*;
     use crate::config::{BodySpec, MapSegment};
+    use crate::percept::Percepts;
 
     fn config() -> RobotConfig {
         let seg = |a: [f64; 2], b: [f64; 2]| MapSegment {
@@ -237,16 +238,14 @@ mod tests {
     }
 
     fn situation(pose: Isometry2<f64>) -> Situation<'static> {
+        static NOTHING: Percepts = Percepts::new();
         Situation {
-            freespace: None,
+            percepts: &NOTHING,
             target_body_mm: None,
             target_mm: None,
             velocity_body_mm_s: Vector2::zeros(),
             pose: Some(pose),
             odometry_pose: Isometry2::identity(),
-            observation_point: None,
-            ground: None,
-            flow: None,
             t_s: 0.0,
         }
     }

@@ -5,8 +5,8 @@
 //! prediction (the start pose moved by odometry) only choosing between the twins.
 
 use super::stage::{
-    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, calibration, image, vision_camera,
-    vision_settings,
+    Belief, CameraNeed, Perceived, Sighting, Stage, StageEntry, WorldNeed, calibration, image,
+    vision_camera, vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
@@ -14,16 +14,23 @@ use crate::estimates::{Measurement, NotFound};
 use crate::tables::Problems;
 use omniloop_vision::{FloorLocalizer, Localization, LocalizationConfig, RadialCalibration};
 
+/// The stage's name, in the estimates record and the registry.
+pub const NAME: &str = "floor_localization";
+
+/// The `control.pose_source` under which its fixes correct the estimate.
+pub const POSE_SOURCE: &str = "localization";
+
 /// The registry's entry.
 pub const ENTRY: StageEntry = StageEntry {
-    name: "floor_localization",
+    name: NAME,
     summary: "self-localization from the shape of the floor region (Sect. 4 of the corner paper)",
-    pose_source: Some("localization"),
+    pose_source: Some(POSE_SOURCE),
     table: None,
     vision_table: Some(TABLE),
     check_vision: |v| v.tables.check("vision", TABLE, check),
-    asked: |c| c.control.pose_source == "localization",
+    asked: |c| c.control.pose_source == POSE_SOURCE,
     camera: CameraNeed::MirrorFloor,
+    world: &[WorldNeed::Field],
     check: |_| Vec::new(),
     build: |c| {
         let camera = vision_camera(c, "self-localization")?;
@@ -99,7 +106,7 @@ impl FloorLocalizationStage {
 
 impl Stage for FloorLocalizationStage {
     fn name(&self) -> &'static str {
-        "floor_localization"
+        NAME
     }
 
     fn cameras(&self) -> Vec<&str> {
@@ -110,7 +117,7 @@ impl Stage for FloorLocalizationStage {
         &mut self,
         obs: &Observation<'_>,
         belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let img = image(obs, &self.camera, self.name())?;
         let result = match (belief.fixed, &belief.pose) {

@@ -1,17 +1,47 @@
 //! A forward camera's stages (Ahmed, Saatchi and Caparrelli): ground segmentation and
 //! Horn-Schunck flow for avoidance, scan-line and feature visual odometry.
 
-use super::stage::{Belief, CameraNeed, Percepts, Stage, StageEntry, image, vision_settings};
+use super::stage::{Belief, CameraNeed, Perceived, Stage, StageEntry, image, vision_settings};
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::{RobotConfig, VisionSpec};
-use crate::estimates::GroundReading;
+use crate::percept::Percept;
 use crate::tables::ConfigProblem;
 use omniloop_vision::forward::{
     FlowBalance, FlowConfig, ForwardCamera, ForwardOdometry, Grey, GroundConfig, GroundSegmenter,
-    OdometryConfig, grey, horn_schunck, reduce,
+    OdometryConfig, OdometryStep, grey, horn_schunck, reduce,
 };
 use serde::{Deserialize, Serialize};
+
+/// What the ground segmentation of a forward camera showed this cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GroundReading {
+    /// The fewest ground pixels from the bottom over the columns of the robot's path.
+    pub ahead_px: u32,
+    /// Ground pixels needed ahead to go straight.
+    pub needed_px: u32,
+    /// Mean run of ground over the left half, px.
+    pub left_px: f64,
+    /// Mean run of ground over the right half, px.
+    pub right_px: f64,
+    /// Whether the level at the bottom centre jumped (an obstacle right in front).
+    pub jumped: bool,
+}
+
+impl GroundReading {
+    /// Whether more ground pixels than needed lie ahead.
+    pub fn clear_ahead(&self) -> bool {
+        self.ahead_px > self.needed_px
+    }
+}
+
+impl Percept for GroundReading {}
+
+/// A forward camera's flow balance (Sect. 2.1.2), as the optical-flow controller reads it.
+impl Percept for FlowBalance {}
+
+/// A forward camera's visual odometry since the previous frame (Sect. 2.2).
+impl Percept for OdometryStep {}
 
 /// The forward camera the stages read, or the error saying vision's camera is not one.
 fn camera(c: &RobotConfig) -> Result<ForwardCamera, RobotError> {
@@ -64,9 +94,18 @@ fn check_vision(v: &VisionSpec) -> Vec<ConfigProblem> {
         .check::<ForwardVisionConfig>("vision", TABLE, |_, _| {})
 }
 
+/// The ground segmentation's name in the registry.
+pub const GROUND_NAME: &str = "ground";
+
+/// The flow balance's name in the registry.
+pub const FLOW_NAME: &str = "flow";
+
+/// The visual odometry's name in the registry and the estimates record.
+pub const VISUAL_ODOMETRY_NAME: &str = "visual_odometry";
+
 /// The registry's entry of the ground segmentation.
 pub const GROUND: StageEntry = StageEntry {
-    name: "ground",
+    name: GROUND_NAME,
     summary: "a forward camera's ground segmentation (Ahmed et al., Sect. 2.1.1)",
     pose_source: None,
     table: None,
@@ -74,6 +113,7 @@ pub const GROUND: StageEntry = StageEntry {
     check_vision,
     asked: |_| false,
     camera: CameraNeed::Forward,
+    world: &[],
     check: |_| Vec::new(),
     build: |c| {
         let camera = camera(c)?;
@@ -87,7 +127,7 @@ pub const GROUND: StageEntry = StageEntry {
 
 /// The registry's entry of the Horn-Schunck flow.
 pub const FLOW: StageEntry = StageEntry {
-    name: "flow",
+    name: FLOW_NAME,
     summary: "a forward camera's Horn-Schunck flow balance (Ahmed et al., Sect. 2.1.2)",
     pose_source: None,
     table: None,
@@ -95,6 +135,7 @@ pub const FLOW: StageEntry = StageEntry {
     check_vision,
     asked: |_| false,
     camera: CameraNeed::Forward,
+    world: &[],
     check: |_| Vec::new(),
     build: |c| {
         Ok(Box::new(FlowStage {
@@ -107,7 +148,7 @@ pub const FLOW: StageEntry = StageEntry {
 
 /// The registry's entry of the visual odometry (`vision.forward.visual_odometry = true`).
 pub const VISUAL_ODOMETRY: StageEntry = StageEntry {
-    name: "visual_odometry",
+    name: VISUAL_ODOMETRY_NAME,
     summary: "a forward camera's visual odometry: scan-line rotation, LK and NCC translation \
               (Ahmed et al., Sect. 2.2)",
     pose_source: None,
@@ -116,6 +157,7 @@ pub const VISUAL_ODOMETRY: StageEntry = StageEntry {
     check_vision,
     asked: |c| settings(c).is_ok_and(|f| f.visual_odometry),
     camera: CameraNeed::Forward,
+    world: &[],
     check: needs_forward_camera,
     build: |c| {
         Ok(Box::new(VisualOdometryStage::new(
@@ -133,7 +175,7 @@ pub struct GroundStage {
 
 impl Stage for GroundStage {
     fn name(&self) -> &'static str {
-        "ground"
+        GROUND_NAME
     }
 
     fn cameras(&self) -> Vec<&str> {
@@ -144,11 +186,11 @@ impl Stage for GroundStage {
         &mut self,
         obs: &Observation<'_>,
         _belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let img = grey(image(obs, &self.camera, self.name())?);
         let v = self.segmenter.update(&img);
-        out.ground = Some(GroundReading {
+        out.percepts.put(GroundReading {
             ahead_px: v.ahead_px,
             needed_px: v.needed_px,
             left_px: v.left_px,
@@ -183,13 +225,14 @@ impl Stage for FlowStage {
         &mut self,
         obs: &Observation<'_>,
         _belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let c = &self.config;
         let img = reduce(&grey(image(obs, &self.camera, self.name())?), c.downsample);
         if let Some(prev) = &self.previous {
             let field = horn_schunck(prev, &img, c.alpha, c.iterations);
-            out.flow = Some(FlowBalance::of(&field, c.skip_top, c.downsample.max(1)));
+            out.percepts
+                .put(FlowBalance::of(&field, c.skip_top, c.downsample.max(1)));
         }
         self.previous = Some(img);
         Ok(())
@@ -213,7 +256,7 @@ impl VisualOdometryStage {
 
 impl Stage for VisualOdometryStage {
     fn name(&self) -> &'static str {
-        "visual_odometry"
+        VISUAL_ODOMETRY_NAME
     }
 
     fn cameras(&self) -> Vec<&str> {
@@ -228,10 +271,12 @@ impl Stage for VisualOdometryStage {
         &mut self,
         obs: &Observation<'_>,
         _belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let img = grey(image(obs, &self.camera, self.name())?);
-        out.visual_odometry = self.odometry.step(&img);
+        if let Some(step) = self.odometry.step(&img) {
+            out.percepts.put(step);
+        }
         Ok(())
     }
 }

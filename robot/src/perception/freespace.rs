@@ -2,12 +2,13 @@
 //! floor-colour mask, eqs. (5)-(7).
 
 use super::stage::{
-    Belief, CameraNeed, Percepts, Stage, StageEntry, calibration, vision_camera, vision_settings,
+    Belief, CameraNeed, Perceived, Stage, StageEntry, calibration, vision_camera, vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::RobotConfig;
 use crate::estimates::NotFound;
+use crate::percept::Percept;
 use crate::tables::{ConfigProblem, Problems};
 use image::RgbaImage;
 use nalgebra::Isometry2;
@@ -17,9 +18,17 @@ use omniloop_vision::image_centre::dark_disc_centre;
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, RadialCalibration};
 use std::collections::VecDeque;
 
+/// Free space around the robot (eqs. (5)-(7)). The estimates record writes it itself, as
+/// `free_mm` beside the true free distances (`null` in a cycle without it), so it gives no
+/// entry of its own.
+impl Percept for FreeSpace {}
+
+/// The stage's name, in the estimates record and the registry.
+pub const NAME: &str = "freespace";
+
 /// The registry's entry.
 pub const ENTRY: StageEntry = StageEntry {
-    name: "freespace",
+    name: NAME,
     summary: "free space in the floor region by the polar template, eqs. (5)-(7) (Sect. 3.1 of \
               the corner paper)",
     pose_source: None,
@@ -28,6 +37,7 @@ pub const ENTRY: StageEntry = StageEntry {
     check_vision: |v| v.tables.check("vision", TABLE, check_values),
     asked: |_| false,
     camera: CameraNeed::MirrorFloor,
+    world: &[],
     check,
     build: |c| {
         let camera = vision_camera(c, "free space")?;
@@ -212,7 +222,7 @@ const DARK_LEVEL: u8 = 64;
 
 impl Stage for FreeSpaceStage {
     fn name(&self) -> &'static str {
-        "freespace"
+        NAME
     }
 
     fn cameras(&self) -> Vec<&str> {
@@ -232,7 +242,7 @@ impl Stage for FreeSpaceStage {
         &mut self,
         obs: &Observation<'_>,
         belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let now = belief.odometry_pose;
         self.history.push_back((obs.t_s, now));
@@ -251,7 +261,7 @@ impl Stage for FreeSpaceStage {
                 // Taken now: as it is.
                 let fs = self.detect_frame(frame.image)?;
                 self.last = Some((fs.clone(), now, frame.t_s));
-                out.freespace = Some(fs);
+                out.percepts.put(fs);
                 return Ok(());
             }
             Some(frame) => {
@@ -263,12 +273,11 @@ impl Stage for FreeSpaceStage {
                 reason: format!("no frame of camera {:?} this cycle", self.camera),
             }),
         }
-        out.freespace = match &self.last {
-            Some((fs, taken, t)) if obs.t_s - t <= MAX_AGE_S => {
-                Some(fs.moved(&(taken.inverse() * now)))
-            }
-            _ => None,
-        };
+        if let Some((fs, taken, t)) = &self.last
+            && obs.t_s - t <= MAX_AGE_S
+        {
+            out.percepts.put(fs.moved(&(taken.inverse() * now)));
+        }
         Ok(())
     }
 }

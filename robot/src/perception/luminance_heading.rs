@@ -11,7 +11,7 @@
 //! and are passed over as it leaves.
 
 use super::stage::{
-    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, calibration, image, vision_camera,
+    Belief, CameraNeed, Perceived, Sighting, Stage, StageEntry, calibration, image, vision_camera,
     vision_settings,
 };
 use crate::RobotError;
@@ -21,12 +21,18 @@ use nalgebra::Point2;
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::luminance_heading::{LuminanceCircle, LuminanceConfig};
 
+/// The stage's name, in the estimates record and the registry.
+pub const NAME: &str = "luminance_heading";
+
+/// The `control.pose_source` under which its fixes correct the estimate.
+pub const POSE_SOURCE: &str = "checkpoints";
+
 /// The registry's entry.
 pub const ENTRY: StageEntry = StageEntry {
-    name: "luminance_heading",
+    name: NAME,
     summary: "heading at the goal's checkpoints from the luminance circle (Kim, Kim and Kwon, \
               Sect. 3)",
-    pose_source: Some("checkpoints"),
+    pose_source: Some(POSE_SOURCE),
     table: None,
     vision_table: Some("luminance_heading"),
     check_vision: |v| {
@@ -35,6 +41,7 @@ pub const ENTRY: StageEntry = StageEntry {
     },
     asked: |c| !c.checkpoints().is_empty(),
     camera: CameraNeed::Mirror,
+    world: &[],
     check: |_| Vec::new(),
     build: |c| {
         let camera = vision_camera(c, "the luminance heading")?;
@@ -102,7 +109,7 @@ impl LuminanceHeadingStage {
 
 impl Stage for LuminanceHeadingStage {
     fn name(&self) -> &'static str {
-        "luminance_heading"
+        NAME
     }
 
     fn cameras(&self) -> Vec<&str> {
@@ -113,7 +120,7 @@ impl Stage for LuminanceHeadingStage {
         &mut self,
         obs: &Observation<'_>,
         belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let Some(pose) = belief.pose else {
             return Ok(());

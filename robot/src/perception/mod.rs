@@ -14,12 +14,16 @@ pub mod resection;
 pub mod stage;
 
 pub use floor_localization::FloorLocalizationStage;
+pub use forward::GroundReading;
 pub use forward::{FlowStage, GroundStage, VisualOdometryStage};
 pub use freespace::FreeSpaceStage;
 pub use luminance_heading::LuminanceHeadingStage;
 pub use omnistereo::OmnistereoStage;
+pub use omnistereo::{LandmarkSighting, Landmarks, MotionReading};
 pub use resection::ResectionStage;
-pub use stage::{Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry};
+pub use stage::{
+    Belief, CameraNeed, ObservationPoint, Perceived, Sighting, Stage, StageEntry, WorldNeed,
+};
 
 use crate::RobotError;
 use crate::config::{ODOMETRY, RobotConfig};

@@ -12,12 +12,13 @@
 //! millimetres is no better than the wheels over 50 ms.
 
 use super::stage::{
-    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, image, vision_settings,
+    Belief, CameraNeed, Perceived, Sighting, Stage, StageEntry, WorldNeed, image, vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::{MapLandmark, StereoRig};
-use crate::estimates::{LandmarkSighting, Measurement, MotionReading, NotFound};
+use crate::estimates::{Measurement, NotFound};
+use crate::percept::Percept;
 use crate::tables::ConfigProblem;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Vector2};
@@ -28,12 +29,18 @@ use omniloop_vision::omnistereo::{
     trilaterate_with_error,
 };
 
+/// The stage's name, in the estimates record and the registry.
+pub const NAME: &str = "omnistereo";
+
+/// The `control.pose_source` under which its fixes correct the estimate.
+pub const POSE_SOURCE: &str = "omnistereo";
+
 /// The registry's entry.
 pub const ENTRY: StageEntry = StageEntry {
-    name: "omnistereo",
+    name: NAME,
     summary: "conical omnistereo: ranges by eq. (1), trilateration, visual compass, interframe \
               motion (Spacek and Burbridge, Sect. 2)",
-    pose_source: Some("omnistereo"),
+    pose_source: Some(POSE_SOURCE),
     table: None,
     vision_table: Some("omnistereo"),
     check_vision: |v| {
@@ -44,8 +51,9 @@ pub const ENTRY: StageEntry = StageEntry {
                 }
             })
     },
-    asked: |c| c.control.pose_source == "omnistereo",
+    asked: |c| c.control.pose_source == POSE_SOURCE,
     camera: CameraNeed::None,
+    world: &[WorldNeed::StereoRig],
     check: |c| {
         let mut p = Vec::new();
         if c.map.landmarks.is_empty() {
@@ -67,6 +75,62 @@ pub const ENTRY: StageEntry = StageEntry {
         )?))
     },
 };
+
+/// A landmark of the map the robot identified and measured this cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LandmarkSighting {
+    /// Its index in the map.
+    pub landmark: usize,
+    /// Range from the camera axis to its near face, mm.
+    pub range_mm: f64,
+    /// Bearing (robot frame), rad.
+    pub bearing_rad: f64,
+}
+
+/// The robot's motion since the previous frame as its vision read it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionReading {
+    /// The rotation the visual compass read, counter-clockwise positive, rad.
+    pub rotation_rad: f64,
+    /// The translation, in the previous frame's axes, mm; `None` when no feature was seen in
+    /// both frames.
+    pub translation_mm: Option<Vector2<f64>>,
+    /// Features seen in both frames.
+    pub features: usize,
+    /// Of which the clustering kept.
+    pub inliers: usize,
+}
+
+/// The landmarks of the map identified and ranged in one cycle.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Landmarks(pub Vec<LandmarkSighting>);
+
+impl Percept for Landmarks {
+    /// `landmarks`: each one's index, range and bearing (none: not recorded).
+    fn record(&self) -> Option<(&'static str, serde_json::Value)> {
+        let each = |l: &LandmarkSighting| {
+            serde_json::json!({
+                "landmark": l.landmark,
+                "range_mm": l.range_mm,
+                "bearing_rad": l.bearing_rad,
+            })
+        };
+        (!self.0.is_empty()).then(|| ("landmarks", self.0.iter().map(each).collect()))
+    }
+}
+
+impl Percept for MotionReading {
+    /// `motion`: the compass's turn, the translation, and the features behind it.
+    fn record(&self) -> Option<(&'static str, serde_json::Value)> {
+        let value = serde_json::json!({
+            "rotation_rad": self.rotation_rad,
+            "translation_mm": self.translation_mm.map(|t| [t.x, t.y]),
+            "features": self.features,
+            "inliers": self.inliers,
+        });
+        Some(("motion", value))
+    }
+}
 
 /// What the stage measured of its own cameras.
 #[derive(Debug, Clone, Copy)]
@@ -140,7 +204,7 @@ impl OmnistereoStage {
         )
     }
 
-    fn trilateration(&self, ranged: &[RangedMark], out: &mut Percepts) {
+    fn trilateration(&self, ranged: &[RangedMark], out: &mut Perceived) {
         let seen: Vec<LandmarkRange> = ranged
             .iter()
             .map(|m| {
@@ -204,7 +268,7 @@ impl OmnistereoStage {
 
 impl Stage for OmnistereoStage {
     fn name(&self) -> &'static str {
-        "omnistereo"
+        NAME
     }
 
     fn cameras(&self) -> Vec<&str> {
@@ -215,7 +279,7 @@ impl Stage for OmnistereoStage {
         &mut self,
         obs: &Observation<'_>,
         _belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let lower = image(obs, &self.config.lower_sensor, self.name())?;
         let upper = image(obs, &self.config.upper_sensor, self.name())?;
@@ -236,20 +300,24 @@ impl Stage for OmnistereoStage {
         let lo = detect_marks(lower, &cal.lower, &self.palette, marks);
         let up = detect_marks(upper, &cal.upper, &self.palette, marks);
         let (ranged, _unranged) = range_marks(&cal.geometry, &lo, &up, self.config.radius_sigma_px);
-        out.landmarks = ranged
-            .iter()
-            .map(|m| LandmarkSighting {
-                landmark: m.label,
-                range_mm: m.range_mm,
-                bearing_rad: m.bearing_rad,
-            })
-            .collect();
+        out.percepts.put(Landmarks(
+            ranged
+                .iter()
+                .map(|m| LandmarkSighting {
+                    landmark: m.label,
+                    range_mm: m.range_mm,
+                    bearing_rad: m.bearing_rad,
+                })
+                .collect(),
+        ));
         self.trilateration(&ranged, out);
         let profile = AngularProfile::capture(
             &[(lower, &cal.lower), (upper, &cal.upper)],
             &self.config.compass,
         );
-        out.motion = self.motion(&profile, &ranged);
+        if let Some(motion) = self.motion(&profile, &ranged) {
+            out.percepts.put(motion);
+        }
         self.previous = Some(Previous {
             profile,
             marks: ranged,

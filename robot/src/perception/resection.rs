@@ -21,8 +21,8 @@
 //!   on rings of the image instead of rows, and nothing pans.
 
 use super::stage::{
-    Belief, CameraNeed, Percepts, Sighting, Stage, StageEntry, image, vision_camera,
-    vision_settings,
+    Belief, CameraNeed, ObservationPoint, Perceived, Sighting, Stage, StageEntry, WorldNeed, image,
+    vision_camera, vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::{ActuatorCommand, ActuatorState, Observation};
@@ -38,12 +38,18 @@ use omniloop_vision::resection::{
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 
+/// The stage's name, in the estimates record and the registry.
+pub const NAME: &str = "resection";
+
+/// The `control.pose_source` under which its fixes correct the estimate.
+pub const POSE_SOURCE: &str = "resection";
+
 /// The registry's entry.
 pub const ENTRY: StageEntry = StageEntry {
-    name: "resection",
+    name: NAME,
     summary: "three-mark resection: a panning search for the striped marks, then one fix \
               (Ishikawa, Kikuchi and Kato)",
-    pose_source: Some("resection"),
+    pose_source: Some(POSE_SOURCE),
     table: Some("resection"),
     vision_table: Some("resection"),
     check_vision: |v| {
@@ -54,8 +60,9 @@ pub const ENTRY: StageEntry = StageEntry {
                 }
             })
     },
-    asked: |c| c.control.pose_source == "resection",
+    asked: |c| c.control.pose_source == POSE_SOURCE,
     camera: CameraNeed::MirrorOrPinhole,
+    world: &[WorldNeed::ResectionCamera],
     check,
     build: |c| Ok(Box::new(build(c)?)),
 };
@@ -130,9 +137,6 @@ impl Default for SearchConfig {
         }
     }
 }
-
-/// The stage's name in the estimates record.
-pub const NAME: &str = "resection";
 
 /// The words of the stage's last "not found" when it stops searching.
 pub const GAVE_UP: &str = "gave up";
@@ -344,7 +348,7 @@ impl ResectionStage {
     }
 
     /// The search is over with these bearings: a fix, or a move to another point.
-    fn conclude(&mut self, bearings: &[Option<f64>], belief: &Belief, out: &mut Percepts) {
+    fn conclude(&mut self, bearings: &[Option<f64>], belief: &Belief, out: &mut Perceived) {
         let missing: Vec<&str> = self
             .marks
             .iter()
@@ -460,7 +464,7 @@ impl Stage for ResectionStage {
         &mut self,
         obs: &Observation<'_>,
         belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError> {
         if matches!(self.view, View::Pan(_)) {
             let pan = self.pan_rad(obs)?;
@@ -510,7 +514,7 @@ impl Stage for ResectionStage {
                     self.state = State::Start;
                     return Ok(());
                 }
-                out.observation_point = Some(target);
+                out.percepts.put(ObservationPoint(target));
                 self.state = State::Move(target);
             }
         }

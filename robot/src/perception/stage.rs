@@ -5,37 +5,32 @@
 use crate::RobotError;
 use crate::boundary::{ActuatorCommand, Observation};
 use crate::config::{RobotConfig, VisionSpec};
-use crate::estimates::{GroundReading, LandmarkSighting, Measurement, MotionReading, NotFound};
+use crate::estimates::{Measurement, NotFound};
+use crate::percept::{Percept, Percepts};
 use crate::tables::ConfigProblem;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Point2};
-use omniloop_vision::forward::{FlowBalance, OdometryStep};
-use omniloop_vision::{FreeSpace, LocalizationQuality, RadialCalibration};
+use omniloop_vision::{LocalizationQuality, RadialCalibration};
 
-/// What the stages of one cycle found.
+/// What the stages of one cycle found: their outputs by type, fixes for the estimator, the
+/// stages that found nothing and commands to the actuators.
 #[derive(Debug, Clone, Default)]
-pub struct Percepts {
-    /// Free space around the robot.
-    pub freespace: Option<FreeSpace>,
+pub struct Perceived {
+    /// The stages' outputs, one of each type (free space, a ground reading, ...).
+    pub percepts: Percepts,
     /// Measurements for the estimator.
     pub fixes: Vec<Sighting>,
     /// Stages that found nothing, and why.
     pub not_found: Vec<NotFound>,
-    /// Landmarks of the map identified and ranged.
-    pub landmarks: Vec<LandmarkSighting>,
-    /// The motion since the previous frame, as vision read it.
-    pub motion: Option<MotionReading>,
     /// Commands to the actuators (a stage steering its camera).
     pub actuators: Vec<ActuatorCommand>,
-    /// A point to drive to (odometry frame), when a stage needs another view.
-    pub observation_point: Option<Point2<f64>>,
-    /// A forward camera's ground segmentation.
-    pub ground: Option<GroundReading>,
-    /// A forward camera's flow balance.
-    pub flow: Option<FlowBalance>,
-    /// A forward camera's visual odometry.
-    pub visual_odometry: Option<OdometryStep>,
 }
+
+/// A point a stage asks the robot to drive to (odometry frame, mm), when it needs another view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObservationPoint(pub Point2<f64>);
+
+impl Percept for ObservationPoint {}
 
 /// A measurement, the stage that made it and how good that stage judged it.
 #[derive(Debug, Clone)]
@@ -85,7 +80,7 @@ pub trait Stage: Send {
         &mut self,
         obs: &Observation<'_>,
         belief: &Belief,
-        out: &mut Percepts,
+        out: &mut Perceived,
     ) -> Result<(), RobotError>;
 }
 
@@ -102,6 +97,18 @@ pub enum CameraNeed {
     MirrorOrPinhole,
     /// A forward pinhole camera (its intrinsics, height and tilt).
     Forward,
+}
+
+/// What a stage needs of the world beyond the robot's own map, so that the scenario's check
+/// can say which field is missing before the run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WorldNeed {
+    /// A field (`[world.field]`): floor-region localization matches the floor to its lines.
+    Field,
+    /// Two cameras under coaxial cones that make a stereo rig.
+    StereoRig,
+    /// A pan camera whose column calibration the resection reads.
+    ResectionCamera,
 }
 
 /// A perception stage as the registry lists it: a new stage is its own file with one of these
@@ -124,6 +131,9 @@ pub struct StageEntry {
     pub asked: fn(&RobotConfig) -> bool,
     /// What it needs of vision's camera.
     pub camera: CameraNeed,
+    /// What it needs of the world that the robot is not told, checked where the scenario is
+    /// read.
+    pub world: &'static [WorldNeed],
     /// Checks what it needs of the robot (its camera, the map, its settings on that camera),
     /// naming each field at fault; its vision table's own values are `check_vision`'s.
     pub check: fn(&RobotConfig) -> Vec<ConfigProblem>,
