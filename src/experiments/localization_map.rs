@@ -14,6 +14,7 @@ use crate::scenario::Checker;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::wrap_pi;
+use omniloop_robot::perception::floor_localization;
 use omniloop_sim::SimError;
 use omniloop_vision::{
     FloorLocalizer, Localization, LocalizationConfig, LocalizationMethod, LocalizationQuality,
@@ -83,7 +84,7 @@ impl MapSpec {
                 );
             }
         }
-        if s.control.pose_source != "localization" {
+        if s.control.pose_source != floor_localization::POSE_SOURCE {
             c.fail(
                 at,
                 "the map localizes the robot's camera images: set control.pose_source = \

@@ -15,6 +15,7 @@ use crate::scenario::Checker;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::wrap_pi;
+use omniloop_robot::perception::omnistereo;
 use omniloop_robot::{Landmarks, Measurement, MotionReading};
 use omniloop_sim::SimError;
 use serde::{Deserialize, Serialize};
@@ -43,7 +44,7 @@ impl OmnistereoSpec {
                 format!("must be [near, far] with 0 <= near < far (got [{a}, {b}])"),
             );
         }
-        if s.control.pose_source != "omnistereo" {
+        if s.control.pose_source != omnistereo::POSE_SOURCE {
             c.fail(
                 "control.pose_source",
                 "experiment.omnistereo scores the omnistereo stage: set pose_source = \
@@ -158,7 +159,7 @@ impl Omnistereo {
                 });
             }
             if let Some(Measurement::Pose { pose, .. }) =
-                e.pose_fix("omnistereo").map(|f| &f.measurement)
+                e.pose_fix(omnistereo::NAME).map(|f| &f.measurement)
             {
                 let r = &out.trajectory[k];
                 let err = (pose.translation.vector - Vector2::new(r.x_mm, r.y_mm)).norm();

@@ -16,13 +16,14 @@ use anyhow::Context;
 use nalgebra::{Isometry2, Point2};
 use omniloop_control::wrap_pi;
 use omniloop_robot::Measurement;
+use omniloop_robot::perception::floor_localization;
 use omniloop_vision::{LocalizationConfig, LocalizationMethod};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// The stage whose fixes E2 scores.
-const STAGE: &str = "floor_localization";
+const STAGE: &str = floor_localization::NAME;
 
 /// The places (`[experiment.places]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -55,7 +56,7 @@ impl PlacesSpec {
                 &s.world,
             );
         }
-        if s.control.pose_source != "localization" {
+        if s.control.pose_source != floor_localization::POSE_SOURCE {
             c.fail(
                 "experiment.places",
                 "the robot localizes itself at each place: set control.pose_source = \

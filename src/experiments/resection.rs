@@ -16,7 +16,7 @@ use crate::scenario::{PoseSpec, Scenario};
 use nalgebra::Point2;
 use omniloop_control::wrap_pi;
 use omniloop_robot::Measurement;
-use omniloop_robot::perception::resection::{GAVE_UP, NAME};
+use omniloop_robot::perception::resection::{GAVE_UP, NAME, POSE_SOURCE};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -49,7 +49,7 @@ impl ResectionSpec {
                 &s.world,
             );
         }
-        if s.control.pose_source != "resection" {
+        if s.control.pose_source != POSE_SOURCE {
             c.fail(
                 "control.pose_source",
                 "experiment.resection scores the resection stage: set pose_source = \

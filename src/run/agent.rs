@@ -15,6 +15,7 @@ use crate::scenario::calibrate::calibrate_sensor;
 use crate::scenario::{PilotChoice, Scenario};
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
+use omniloop_robot::perception::floor_localization;
 use omniloop_robot::{
     ActuatorState, Estimates, FixOutcome, Frame, NavigationReport, Observation, OdometryReading,
     Outputs, RobotConfig, RobotError, RobotSoftware,
@@ -585,7 +586,7 @@ fn columns(scenario: &Scenario) -> Result<Vec<ColumnCalibration>, RunError> {
 /// The fixes the estimator used (set or pulled its estimate by), when the robot localizes on
 /// the floor region (its `floor_localization` stage reported a fix or why it found none).
 pub fn localization_fixes(records: &[Estimates]) -> Option<usize> {
-    const STAGE: &str = "floor_localization";
+    const STAGE: &str = floor_localization::NAME;
     let localizes = records.iter().any(|e| {
         e.fixes.iter().any(|f| f.source == STAGE) || e.not_found.iter().any(|n| n.source == STAGE)
     });
