@@ -15,6 +15,36 @@ use omniloop_robot::{RobotConfig, RobotError, RobotSoftware};
 use std::time::Instant;
 
 /// A driving run stepped from outside (see the module's documentation).
+///
+/// The built-in robot drives the corner for a few cycles; between steps the outside reads the
+/// frames its software got and the truth:
+///
+/// ```
+/// use omniloop::run::builtin_software;
+/// use omniloop::vision::FreeSpace;
+/// use omniloop::{RunOptions, Session, load_scenario};
+/// use omniloop_sim::RendererChoice;
+///
+/// # fn main() -> anyhow::Result<()> {
+/// let scenario = load_scenario("scenarios/corner55_velocity_aware.toml".as_ref())?;
+/// let options = RunOptions {
+///     renderer: RendererChoice::Cpu,
+///     ..RunOptions::default()
+/// };
+/// let mut session = Session::new(&scenario, &options, builtin_software, |_| {})?;
+/// for _ in 0..10 {
+///     let frames = session.simulation().frames();
+///     assert_eq!(frames.len(), 1, "the corner's robot has one camera");
+///     session.step()?;
+/// }
+/// let truth = session.simulation().truth();
+/// assert!(truth.pose.translation.x > -2500.0, "it drove forward from its start");
+/// let output = session.output();
+/// assert_eq!(output.summary.cycles, 10);
+/// assert!(output.estimates[9].percept::<FreeSpace>().is_some(), "it saw free space");
+/// # Ok(())
+/// # }
+/// ```
 pub struct Session {
     sim: Simulation,
     experiment: Box<dyn Experiment>,
