@@ -11,7 +11,7 @@ used as such, and free where a team's dict is read).
 import os
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, Final, Union
+from typing import Any, Final, Union, final
 
 import numpy as np
 import numpy.typing as npt
@@ -26,6 +26,30 @@ _Command: TypeAlias = Union[Sequence[float], npt.NDArray[Any]]
 _Estimate: TypeAlias = Union[Sequence[float], npt.NDArray[Any]]
 _Actuators: TypeAlias = Sequence[Union[PanTo, PanAt]]
 _Columns: TypeAlias = dict[str, npt.NDArray[np.float64]]
+
+__all__ = [
+    "FreeSpaceDetector",
+    "Observation",
+    "Odometry",
+    "RenderError",
+    "RobotSoftwareError",
+    "RunFinishedError",
+    "RunResult",
+    "Scenario",
+    "ScenarioError",
+    "Simulation",
+    "SimulationError",
+    "SweepPlan",
+    "VectorSimulation",
+    "__version__",
+    "default_scenario",
+    "read_png_levels",
+    "read_png_rgb",
+    "run",
+    "run_planned_job",
+    "sweep_plan",
+    "write_dataset",
+]
 
 __version__: Final[str]
 
@@ -51,6 +75,7 @@ class RunFinishedError(SimulationError):
     """A run that is over was stepped again (a `SimulationError`): time up or the goal reached;
     `reset()` it to run again."""
 
+@final
 class Scenario:
     """A scenario, checked as `omniloop check` checks it."""
 
@@ -120,6 +145,7 @@ class Scenario:
     def is_team(self) -> bool:
         """Whether the scenario has a team (`[[robots]]`)."""
 
+@final
 class RunResult:
     """What `omniloop.run` gives: the summary and the trajectory, and where the files went."""
 
@@ -136,6 +162,7 @@ class RunResult:
     def out(self) -> Path | None:
         """The folder the run's files were written to, if any."""
 
+@final
 class Odometry:
     """What the wheel encoders measured over the last period, with the scenario's errors."""
 
@@ -155,6 +182,7 @@ class Odometry:
     def dt_s(self) -> float:
         """The period it covers, s (0 before the first step)."""
 
+@final
 class Observation:
     """What the robot's sensors give at the start of a control cycle."""
 
@@ -192,6 +220,7 @@ class Observation:
         """With `robot="builtin"`: what the robot believed after the last cycle (its
         `estimates.jsonl` record without the truth); `None` otherwise."""
 
+@final
 class FreeSpaceDetector:
     """The free-space stage of one robot's vision camera, fed frame by frame."""
 
@@ -209,6 +238,7 @@ class FreeSpaceDetector:
     def camera(self) -> str:
         """The camera whose frames it reads."""
 
+@final
 class Simulation:
     """A scenario run stepped from Python."""
 
@@ -322,6 +352,7 @@ class Simulation:
     def sensors(self) -> list[str] | Any:
         """The cameras, in the scenario's order (a team's: a dict of these by robot name)."""
 
+@final
 class VectorSimulation:
     """N runs of one scenario, stepped together."""
 
@@ -377,6 +408,7 @@ class VectorSimulation:
     def scenario(self) -> Scenario:
         """The scenario being run."""
 
+@final
 class SweepPlan:
     """A checked sweep and its folder: what `sweep_plan` gives and the sweep's steps take."""
 

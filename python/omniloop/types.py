@@ -100,7 +100,7 @@ class SensorInfo(TypedDict):
     name: str
     width_px: int
     height_px: int
-    #: The optics' kind (``"mirror"``, ``"pinhole"``, ...).
+    #: The optics' kind (``"hyperbolic"``, ``"pinhole"``, ...).
     kind: str
     #: Whether a pan unit turns it.
     pan_unit: bool
