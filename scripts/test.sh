@@ -21,5 +21,5 @@ MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./pyth
 # The package's types: mypy --strict on the package and its examples (the settings in
 # python/pyproject.toml's [tool.mypy]), then stubtest, the native module's stub
 # (omniloop/_omniloop.pyi) against the module built above.
-(cd python && "../$venv/bin/python" -m mypy omniloop examples)
+"$venv/bin/python" -m mypy --config-file python/pyproject.toml python/omniloop python/examples
 "$venv/bin/python" -m mypy.stubtest omniloop._omniloop --allowlist python/stubtest-allowlist.txt
