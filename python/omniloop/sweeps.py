@@ -39,7 +39,7 @@ TIMING_COLUMNS = ("wall_time_s", "cycles_per_s", "renderer")
 class SweepResult:
     """The rows of a sweep (``sweep.csv``'s columns, one dict a run) and where its files are."""
 
-    rows: list = field(default_factory=list)
+    rows: list[dict[str, Any]] = field(default_factory=list)
     out: Optional[Path] = None
     #: Seconds the jobs took on the executor, wall clock.
     wall_s: float = 0.0
@@ -51,7 +51,7 @@ class SweepResult:
         """The share of runs that succeeded (no error, no contact, the goal when there is one)."""
         return sum(1 for r in self.rows if r["success"]) / max(1, len(self.rows))
 
-    def failed(self) -> list:
+    def failed(self) -> list[dict[str, Any]]:
         """The rows of runs that failed, with their ``error``."""
         return [r for r in self.rows if r["error"]]
 
@@ -164,6 +164,6 @@ def sweep(
     return SweepResult(rows=rows, out=out_dir, wall_s=wall_s, ran=ran)
 
 
-def without_timing(rows: Sequence[Mapping[str, Any]]) -> list:
+def without_timing(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """The rows without the columns that depend on the machine (to compare two sweeps)."""
     return [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows]

@@ -4,27 +4,9 @@
 use numpy::ndarray::Array3;
 use numpy::{PyArray1, PyArray3, PyReadonlyArray3, PyUntypedArrayMethods};
 use omniloop::TrajectoryRow;
-use omniloop::run::RunError;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-
-pyo3::create_exception!(
-    omniloop,
-    ScenarioError,
-    PyValueError,
-    "A scenario file or text that is not a valid scenario: the message is the command line's \
-     `FILE:LINE:COLUMN: field PATH: message`, a line a problem."
-);
-
-/// A run that could not go on: a `ValueError` for a scenario the run cannot take, a
-/// `RuntimeError` otherwise (the renderer, the robot's software, a finished run).
-pub fn run_error(e: RunError) -> PyErr {
-    match e {
-        RunError::Scenario(m) => ScenarioError::new_err(m),
-        other => PyRuntimeError::new_err(other.to_string()),
-    }
-}
 
 /// An RGBA image as an `H x W x 3` `uint8` array (the alpha channel, always opaque, dropped).
 pub fn rgb_array<'py>(py: Python<'py>, img: &image::RgbaImage) -> Bound<'py, PyArray3<u8>> {

@@ -6,9 +6,9 @@
 //! never the truth.
 
 use crate::convert::rgba_from_array;
+use crate::errors::RobotSoftwareError;
 use numpy::{PyArray1, PyReadonlyArray3};
 use omniloop::robot::perception::FreeSpaceStage;
-use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, PoisonError};
@@ -38,7 +38,8 @@ impl PyFreeSpaceDetector {
     /// obstacle cell, or to the template's edge where free throughout), `clear_mm` (surely
     /// free), `front_mm` (farthest the obstacle's face can be), NumPy arrays; `range_mm` and
     /// `inner_mm` (the template's outer and inner edges on the floor); `axis_mm` (the sensor
-    /// axis in the robot frame, the origin of the distances).
+    /// axis in the robot frame, the origin of the distances). Raises `RobotSoftwareError` when
+    /// the stage fails on the frame (one smaller than the camera's image).
     fn detect<'py>(
         &self,
         py: Python<'py>,
@@ -52,7 +53,7 @@ impl PyFreeSpaceDetector {
                     .unwrap_or_else(PoisonError::into_inner)
                     .detect_frame(&img)
             })
-            .map_err(|e| PyRuntimeError::new_err(format!("free space: {e}")))?;
+            .map_err(|e| RobotSoftwareError::new_err(format!("free space: {e}")))?;
         let d = PyDict::new(py);
         d.set_item("direction_rad", PyArray1::from_slice(py, &fs.direction_rad))?;
         d.set_item("free_mm", PyArray1::from_slice(py, &fs.free_mm))?;

@@ -5,6 +5,7 @@
 
 mod camera;
 mod convert;
+mod errors;
 mod freespace;
 mod scenario;
 mod simulation;
@@ -12,7 +13,8 @@ mod sweep;
 mod truth;
 mod vector;
 
-use convert::{ScenarioError, json_to_py, run_error, trajectory_columns};
+use convert::{json_to_py, trajectory_columns};
+use errors::run_error;
 use pyo3::exceptions::{PyOSError, PyRuntimeError};
 use pyo3::prelude::*;
 use scenario::PyScenario;
@@ -122,7 +124,7 @@ fn default_scenario() -> &'static str {
 
 #[pymodule]
 fn _omniloop(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
+    errors::add_exceptions(m)?;
     m.add_class::<PyScenario>()?;
     m.add_class::<RunResult>()?;
     m.add_class::<simulation::PySimulation>()?;

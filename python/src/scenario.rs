@@ -1,7 +1,8 @@
 //! `omniloop.Scenario`: a validated scenario, loaded from a file or text, with values set by
 //! the dotted keys of `omniloop sweep --set`.
 
-use crate::convert::{ScenarioError, toml_value};
+use crate::convert::toml_value;
+use crate::errors::ScenarioError;
 use omniloop::scenario::LoadError;
 use omniloop::{Scenario, load_scenario, parse_scenario};
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};

@@ -6,7 +6,8 @@
 //! works out from them (dead reckoning from the start it is told); the truth comes from
 //! `Simulation.truth()`, for scoring and recording.
 
-use crate::convert::{finite_numbers, json_to_py, rgb_array, rgb_image_array, run_error};
+use crate::convert::{finite_numbers, json_to_py, rgb_array, rgb_image_array};
+use crate::errors::{RunFinishedError, run_error};
 use crate::freespace::PyFreeSpaceDetector;
 use crate::scenario::PyScenario;
 use crate::truth::truth_frame_dict;
@@ -860,6 +861,8 @@ impl PySimulation {
     /// optional `(x_mm, y_mm, theta_rad)` recorded as the robot's own estimate; with
     /// `robot="builtin"` no command is given. A team takes each as a dict by robot name,
     /// holding every robot Python drives. Returns the next observation (a team's: a dict).
+    /// Raises `RunFinishedError` once the run is over, `RobotSoftwareError` when the built-in
+    /// software fails, `RenderError` when the renderer does.
     #[pyo3(signature = (command = None, actuators = None, estimate = None))]
     fn step(
         &self,
@@ -871,7 +874,7 @@ impl PySimulation {
         let cmds = {
             let state = self.lock();
             if state.done() {
-                return Err(PyRuntimeError::new_err(format!(
+                return Err(RunFinishedError::new_err(format!(
                     "the run is over after {} cycles (time up or goal reached): call reset() \
                      to run again",
                     state.session().simulation().cycle()

@@ -3,7 +3,8 @@
 //! one by one wherever a Ray task calls [`run_planned_job`], each finished job a line of the
 //! sweep's `rows.jsonl`, the report written by the same code as the command's.
 
-use crate::convert::{ScenarioError, toml_value};
+use crate::convert::toml_value;
+use crate::errors::ScenarioError;
 use crate::simulation::renderer_choice;
 use omniloop::RunOptions;
 use omniloop::sweep::plan_file::scenario_of_lines;

@@ -4,7 +4,8 @@
 //!
 //! All of it is the simulator's side: none of it reaches the robot's software.
 
-use crate::convert::{ScenarioError, json_to_py, renderer_choice, rgb_image_array, run_error};
+use crate::convert::{json_to_py, renderer_choice, rgb_image_array};
+use crate::errors::{ScenarioError, run_error};
 use crate::scenario::PyScenario;
 use numpy::ndarray::Array2;
 use numpy::{PyArray2, PyArray3};
@@ -81,7 +82,8 @@ pub fn read_png_rgb(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyArray
 }
 
 /// A dataset that could not be made, as Python's errors: `ScenarioError` for a scenario that
-/// cannot give one, `OSError` for a file, `RuntimeError` otherwise.
+/// cannot give one, `OSError` for a file, the run's (see [`run_error`]) for the run along
+/// which it is taken, `RuntimeError` otherwise.
 fn dataset_error(e: DatasetError) -> PyErr {
     match e {
         DatasetError::Scenario { .. } => ScenarioError::new_err(e.to_string()),

@@ -2,7 +2,7 @@
 //! cores (and in shared GPU batches when the renderer is a GPU, as sweeps do). The Gymnasium
 //! vector environment (`omniloop.gym.make_vec`) is built on it.
 
-use crate::convert::run_error;
+use crate::errors::{RenderError, RunFinishedError, run_error};
 use crate::scenario::PyScenario;
 use crate::simulation::{
     Command, Driver, Extras, NO_TRUTH, Observation, State, observation, renderer_choice,
@@ -10,7 +10,7 @@ use crate::simulation::{
 };
 use omniloop_sim::RendererChoice;
 use omniloop_sim::render::{BatchHandle, BatchServer};
-use pyo3::exceptions::{PyIndexError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
@@ -83,7 +83,7 @@ impl PyVectorSimulation {
         let choice = renderer_choice(renderer)?;
         let driver = Driver::parse(robot)?;
         let server = omniloop::sweep::shared_gpu(choice)
-            .map_err(|e| PyRuntimeError::new_err(format!("renderer={renderer:?}: {e}")))?;
+            .map_err(|e| RenderError::new_err(format!("renderer={renderer:?}: {e}")))?;
         let gpu = server.as_ref().map(BatchServer::handle);
         let scenario = scenario.clone();
         let base = seed.unwrap_or(scenario.scenario.seed);
@@ -139,7 +139,7 @@ impl PyVectorSimulation {
 
     /// One control cycle of every run whose `active` flag is true (default: all), in
     /// parallel: `commands` holds a command a run (a sequence or an `N x 3` / `N x 2` array;
-    /// `None` with `robot="builtin"`). A finished run that is active raises `RuntimeError`.
+    /// `None` with `robot="builtin"`). A finished run that is active raises `RunFinishedError`.
     /// Returns every run's observation.
     #[pyo3(signature = (commands = None, active = None))]
     fn step(
@@ -248,7 +248,7 @@ impl PyVectorSimulation {
                 continue;
             }
             if state.done() {
-                return Err(PyRuntimeError::new_err(format!(
+                return Err(RunFinishedError::new_err(format!(
                     "run {i} is over: reset it (or leave it inactive) before stepping again"
                 )));
             }

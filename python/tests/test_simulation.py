@@ -188,7 +188,7 @@ def gpu_or_skip(make):
 
     try:
         return make()
-    except RuntimeError as e:
+    except omniloop.RenderError as e:
         if os.environ.get("OMNILOOP_REQUIRE_GPU"):
             raise
         pytest.skip(f"no GPU adapter: {e}")

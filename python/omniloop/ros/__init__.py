@@ -17,13 +17,15 @@ needs no ROS 2; ``Bridge`` needs rclpy: importing it without rclpy raises ``Impo
 how to install it. See ``docs/ros.md``.
 """
 
+from typing import Any
+
 INSTALL_HINT = (
     "omniloop-ros needs ROS 2's rclpy and messages: pip install 'omniloop[ros]' (Python >= 3.10), "
     "or source a ROS 2 installation"
 )
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     if name in ("Bridge", "BridgeOptions"):
         try:
             from . import bridge

@@ -22,8 +22,10 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import List, Optional
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, cast
 
+import numpy as np
+import numpy.typing as npt
 import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
@@ -31,12 +33,17 @@ from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, LaserScan
 from std_srvs.srv import SetBool, Trigger
 
 import omniloop
+from omniloop._omniloop import FreeSpaceDetector
+from omniloop.types import FreeSpace, Truth
 
 from . import mapping
 from .mapping import MM, CommandError, OdometryCovariance
@@ -95,7 +102,10 @@ class RobotPort:
         self.spec = scenario.robots[name]
         self.sensors = [s["name"] for s in self.spec["sensors"]]
         self.models = {s: scenario.camera_model(s, robot=name) for s in self.sensors}
-        topic = lambda t: f"/{ns}/{t}"  # noqa: E731
+
+        def topic(t: str) -> str:
+            return f"/{ns}/{t}"
+
         self.images = {
             s: node.create_publisher(Image, topic(f"{s}/image_raw"), RELIABLE) for s in self.sensors
         }
@@ -116,16 +126,16 @@ class RobotPort:
         self.odom_msg = odometry_frames(self.frame("odom"), self.frame("base_link"))
         self.truth_msg = odometry_frames("map", self.frame("base_link"))
         self.scan_msg = LaserScan(time_increment=0.0, scan_time=scenario.control_period_s)
-        self.scan = None
-        self.detector = None
+        self.scan: Optional[Publisher[LaserScan]] = None
+        self.detector: Optional[FreeSpaceDetector] = None
         self.scan_sensor: Optional[str] = None
         self.scan_axis_mm = (0.0, 0.0)
         self.covariance = OdometryCovariance.from_spec(self.spec["odometry"])
-        self.command: tuple = self.stop()
+        self.command: Tuple[float, ...] = self.stop()
         self.command_t_s = -math.inf
         self.command_stamp = -math.inf
         self.awaiting_t_s: Optional[float] = None
-        self.cmd_vel = None
+        self.cmd_vel: Optional[Subscription[Any]] = None
         if bridge.options.robot == "python":
             kind = TwistStamped if bridge.options.twist_stamped else Twist
             self.cmd_vel = node.create_subscription(
@@ -135,7 +145,7 @@ class RobotPort:
     def frame(self, name: str) -> str:
         return self.prefix + name
 
-    def stop(self) -> tuple:
+    def stop(self) -> Tuple[float, ...]:
         return (0.0, 0.0) if self.spec["differential"] else (0.0, 0.0, 0.0)
 
     def attach(self, sim: "omniloop.Simulation") -> None:
@@ -144,18 +154,19 @@ class RobotPort:
         self.covariance.reset()
         self.command, self.command_t_s, self.command_stamp = self.stop(), -math.inf, -math.inf
         try:
-            self.detector = sim.free_space_detector(robot=self.name)
+            detector = sim.free_space_detector(robot=self.name)
         except ValueError as e:
             if self.scan is None:
                 self.bridge.node.get_logger().info(f"{self.ns}: no scan ({e})")
             self.detector = None
             return
-        self.scan_sensor = self.detector.camera
+        self.detector = detector
+        self.scan_sensor = detector.camera
         self.scan_msg.header.frame_id = self.frame(f"{self.scan_sensor}_scan")
         if self.scan is None:
             self.scan = self.bridge.node.create_publisher(LaserScan, f"/{self.ns}/scan", RELIABLE)
 
-    def on_cmd_vel(self, msg) -> None:
+    def on_cmd_vel(self, msg: Any) -> None:
         twist = msg.twist if self.bridge.options.twist_stamped else msg
         try:
             command = mapping.body_command(
@@ -178,12 +189,12 @@ class RobotPort:
             self.awaiting_t_s = None
             self.bridge.answered()
 
-    def command_now(self, t_s: float) -> tuple:
+    def command_now(self, t_s: float) -> Tuple[float, ...]:
         """The command to apply at ``t_s``: the last, unless older than the timeout."""
         timeout = self.bridge.options.cmd_vel_timeout_s
         return mapping.command_at(self.command, self.command_t_s, t_s, timeout, self.stop())
 
-    def publish(self, obs, truth: dict, t_s: float) -> None:
+    def publish(self, obs: omniloop.Observation, truth: Truth, t_s: float) -> None:
         """Publishes robot ``obs``'s frames, scan and odometry (last of its sensors), then the
         truth, stamped ``t_s``."""
         stamp = time_msg(t_s)
@@ -212,7 +223,7 @@ class RobotPort:
         pose = (truth["x_mm"], truth["y_mm"], truth["theta_rad"])
         self.truth.publish(fill_odometry(self.truth_msg, stamp, pose, body_v))
 
-    def publish_frame(self, sensor: str, img, stamp: Time) -> None:
+    def publish_frame(self, sensor: str, img: npt.NDArray[np.uint8], stamp: Time) -> None:
         msg, info = self.image_msgs[sensor], self.info_msgs[sensor]
         msg.header.stamp = info.header.stamp = stamp
         msg.height, msg.width = img.shape[0], img.shape[1]
@@ -221,7 +232,7 @@ class RobotPort:
         self.images[sensor].publish(msg)
         self.info_pubs[sensor].publish(info)
 
-    def publish_scan(self, free: dict, stamp: Time) -> None:
+    def publish_scan(self, free: FreeSpace, stamp: Time) -> None:
         scan = mapping.free_space_scan(free)
         self.scan_axis_mm = free["axis_mm"]
         msg = self.scan_msg
@@ -233,7 +244,8 @@ class RobotPort:
         msg.range_min, msg.range_max = scan.range_min, scan.range_max
         msg.ranges = array.array("f", scan.ranges)
         msg.header.stamp = stamp
-        self.scan.publish(msg)
+        if self.scan is not None:
+            self.scan.publish(msg)
 
     def publish_goal(self) -> None:
         goal = self.spec.get("goal")
@@ -253,7 +265,12 @@ def odometry_frames(frame: str, child: str) -> Odometry:
     return msg
 
 
-def fill_odometry(msg: Odometry, stamp: Time, pose: tuple, body_velocity: tuple) -> Odometry:
+def fill_odometry(
+    msg: Odometry,
+    stamp: Time,
+    pose: Tuple[float, float, float],
+    body_velocity: Tuple[float, float, float],
+) -> Odometry:
     """``msg`` stamped, in metres: ``pose`` ``(x_mm, y_mm, theta_rad)`` in its frame,
     ``body_velocity`` ``(vx_mm_s, vy_mm_s, omega_rad_s)`` in its child frame."""
     msg.header.stamp = stamp
@@ -271,7 +288,7 @@ def fill_odometry(msg: Odometry, stamp: Time, pose: tuple, body_velocity: tuple)
     return msg
 
 
-def camera_info_msg(model: dict) -> CameraInfo:
+def camera_info_msg(model: Dict[str, Any]) -> CameraInfo:
     """A camera model (``Scenario.camera_model``) as a ``CameraInfo``."""
     return CameraInfo(**dataclasses.asdict(mapping.camera_info(model)))
 
@@ -290,9 +307,9 @@ class Bridge:
         seed = scenario.seed if options.seed is None else options.seed
         self.node.declare_parameter("seed", seed)
         # The command line's values are the parameters' defaults: `--ros-args -p NAME:=V` wins.
-        stamped = self.node.declare_parameter("twist_stamped", options.twist_stamped).value
+        stamped: Any = self.node.declare_parameter("twist_stamped", options.twist_stamped).value
         options.twist_stamped = bool(stamped)
-        timeout = self.node.declare_parameter("cmd_vel_timeout", options.cmd_vel_timeout_s).value
+        timeout: Any = self.node.declare_parameter("cmd_vel_timeout", options.cmd_vel_timeout_s).value
         options.cmd_vel_timeout_s = float(timeout)
         self.node.add_on_set_parameters_callback(self.on_parameters)
         self.t_s = 0.0
@@ -316,7 +333,7 @@ class Bridge:
         self.steps_asked = 0
         self.reset_asked = False
         self.written = False
-        self.latencies_s = []
+        self.latencies_s: List[float] = []
         self.published_at = self.episode_wall = time.perf_counter()
         self.node.create_service(Trigger, "~/reset", self.on_reset)
         self.node.create_service(SetBool, "~/pause", self.on_pause)
@@ -329,7 +346,7 @@ class Bridge:
             + ", ".join(f"/{p.ns}" for p in self.ports)
         )
 
-    def on_parameters(self, params):
+    def on_parameters(self, params: List[Parameter[Any]]) -> SetParametersResult:
         """``cmd_vel_timeout`` takes effect at once, ``seed`` at the next reset;
         ``twist_stamped`` is fixed once the subscription is made."""
         for p in params:
@@ -347,17 +364,17 @@ class Bridge:
         return SetParametersResult(successful=True)
 
     # Services: each only asks; the loop acts between cycles.
-    def on_reset(self, _request, response):
+    def on_reset(self, _request: Any, response: Any) -> Any:
         self.reset_asked = True
         response.success, response.message = True, f"a new episode with seed {self.seed()}"
         return response
 
-    def on_pause(self, request, response):
+    def on_pause(self, request: Any, response: Any) -> Any:
         self.paused = bool(request.data)
         response.success, response.message = True, "paused" if self.paused else "running"
         return response
 
-    def on_step(self, _request, response):
+    def on_step(self, _request: Any, response: Any) -> Any:
         self.steps_asked += int(self.paused)
         response.success = self.paused
         response.message = "one cycle" if self.paused else "running: pause first"
@@ -366,7 +383,7 @@ class Bridge:
     def seed(self) -> int:
         return int(self.node.get_parameter("seed").value)
 
-    def publish_tf(self, port: RobotPort, obs, stamp: Time) -> None:
+    def publish_tf(self, port: RobotPort, obs: omniloop.Observation, stamp: Time) -> None:
         if self.tf is None:
             return
         x, y, theta = obs.odometry_pose
@@ -410,11 +427,11 @@ class Bridge:
         """A command answered the last frame: the time since its publication, kept."""
         self.latencies_s.append(time.perf_counter() - self.published_at)
 
-    def publish(self, obs=None) -> None:
+    def publish(self, obs: Any = None) -> None:
         """Every robot's observation (``obs``, else now's), the clock and the truth."""
         self.published_at = time.perf_counter()
-        obs = self.sim.observe() if obs is None else obs
-        truth = self.sim.truth()
+        obs = self.running.observe() if obs is None else obs
+        truth: Any = self.running.truth()
         team = self.scenario.is_team
         self.t_s = next(iter(obs.values())).t_s if team else obs.t_s
         self.clock_msg.clock = time_msg(self.t_s)
@@ -424,6 +441,13 @@ class Bridge:
             port.publish(o, t, self.t_s)
             if port.cmd_vel is not None:
                 port.awaiting_t_s = self.t_s
+
+    @property
+    def running(self) -> omniloop.Simulation:
+        """The simulation, made by the first episode."""
+        if self.sim is None:
+            raise RuntimeError("no episode yet: start_episode() makes the simulation")
+        return self.sim
 
     def start_episode(self, seed: int) -> None:
         """A new episode with ``seed``, its first observation published."""
@@ -475,7 +499,7 @@ class Bridge:
                 return
             left = deadline - time.monotonic()
             if left <= 0:
-                names = ", ".join(p.cmd_vel.topic_name for p in waiting)
+                names = ", ".join(p.cmd_vel.topic_name for p in waiting if p.cmd_vel)
                 self.node.get_logger().warning(
                     f"lockstep: no command on {names} for t = {self.t_s:.3f} s in "
                     f"{self.options.lockstep_timeout_s:g} s: going on without"
@@ -490,11 +514,11 @@ class Bridge:
     def step(self) -> None:
         """One control cycle with each robot's command, then its observation published."""
         if self.options.robot == "builtin":
-            obs = self.sim.step()
+            obs = self.running.step()
         elif self.scenario.is_team:
-            obs = self.sim.step({p.name: p.command_now(self.t_s) for p in self.ports})
+            obs = self.running.step({p.name: p.command_now(self.t_s) for p in self.ports})
         else:
-            obs = self.sim.step(self.ports[0].command_now(self.t_s))
+            obs = self.running.step(self.ports[0].command_now(self.t_s))
         self.publish(obs)
 
     def finish(self) -> None:
@@ -502,14 +526,14 @@ class Bridge:
         if self.written:
             return
         self.written = True
-        summary = self.sim.summary()
+        summary = self.running.summary()
         log = self.node.get_logger()
         log.info(
             f"run over at t = {self.t_s:.2f} s: reached goal {summary.get('reached_goal')}, "
             f"contacts {summary.get('wall_contacts')}"
         )
         wall = time.perf_counter() - self.episode_wall
-        cycles = self.sim.cycle
+        cycles = self.running.cycle
         line = f"{cycles} cycles in {wall:.2f} s wall ({cycles / max(wall, 1e-9):.1f} cycles/s)"
         if self.latencies_s:
             ms = sorted(1e3 * x for x in self.latencies_s)
@@ -517,7 +541,7 @@ class Bridge:
             line += f"; frame to answering command: median {median:.2f} ms, p95 {p95:.2f} ms"
         log.info(line)
         if self.options.out is not None:
-            self.sim.write(self.options.out)
+            self.running.write(self.options.out)
             self.node.get_logger().info(f"wrote the run to {self.options.out}")
 
     def spin(self) -> None:
@@ -531,7 +555,7 @@ class Bridge:
                 self.start_episode(self.seed())
                 wall0, sim0, next_progress = time.monotonic(), self.t_s, self.options.progress_s
                 continue
-            if self.sim.done:
+            if self.running.done:
                 self.finish()
                 if self.options.exit_at_end:
                     return
@@ -550,7 +574,7 @@ class Bridge:
             self.steps_asked = max(0, self.steps_asked - 1)
             self.step()
             if self.options.progress_s > 0 and self.t_s >= next_progress - 1e-9:
-                self.node.get_logger().info(f"t = {self.t_s:.1f} s, cycle {self.sim.cycle}")
+                self.node.get_logger().info(f"t = {self.t_s:.1f} s, cycle {self.running.cycle}")
                 next_progress += self.options.progress_s
 
     def pace(self, wall0: float, sim0: float) -> None:
@@ -576,14 +600,17 @@ class CommandWait:
     ``rclpy.wait_for_message`` uses it, without the executor's per-wait bookkeeping (a third
     of a millisecond a cycle on this path)."""
 
-    def __init__(self, node: Node, subs: list) -> None:
+    def __init__(self, node: Node, subs: List[Subscription[Any]]) -> None:
         from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
-        self.wait_set = _rclpy.WaitSet(len(subs), 0, 0, 0, 0, 0, node.context.handle)
+        context = node.context.handle
+        if context is None:
+            raise TypeError("the node's context is shut down")
+        self.wait_set = _rclpy.WaitSet(len(subs), 0, 0, 0, 0, 0, context)
         self.subs = subs
 
     @classmethod
-    def of(cls, node: Node, subs: list) -> Optional["CommandWait"]:
+    def of(cls, node: Node, subs: List[Subscription[Any]]) -> Optional["CommandWait"]:
         """The wait, or ``None`` where this rclpy lacks the wait set (the executor serves)."""
         try:
             return cls(node, subs)
@@ -604,12 +631,19 @@ class CommandWait:
             if sub.handle.pointer not in ready:
                 continue
             while (taken := sub.handle.take_message(sub.msg_type, sub.raw)) is not None:
-                sub.callback(taken[0])
+                # The command subscriptions' callbacks take the message alone.
+                cast(Callable[[Any], None], sub.callback)(taken[0])
                 took = True
         return took
 
 
-def transform(stamp: Time, parent: str, child: str, t, q):
+def transform(
+    stamp: Time,
+    parent: str,
+    child: str,
+    t: Sequence[float],
+    q: Tuple[float, float, float, float],
+) -> Any:
     msg = TransformStamped()
     msg.header.stamp, msg.header.frame_id, msg.child_frame_id = stamp, parent, child
     msg.transform.translation.x, msg.transform.translation.y, msg.transform.translation.z = t

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Mapping, Optional, Sequence, Tuple
+from typing import Any, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -65,12 +65,13 @@ def matrix_quaternion(r: Sequence[Sequence[float]]) -> Tuple[float, float, float
     return tuple(c / n for c in q)  # type: ignore[return-value]
 
 
-def panned(rotation: Sequence[Sequence[float]], pan_rad: float) -> list:
+def panned(rotation: Sequence[Sequence[float]], pan_rad: float) -> List[List[float]]:
     """A camera's frame in the body frame (``rotation``, its axes as columns, at pan 0) turned
     by its pan unit through ``pan_rad`` about the body's z axis."""
     c, s = math.cos(pan_rad), math.sin(pan_rad)
     rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-    return (rz @ np.asarray(rotation, dtype=float)).tolist()
+    turned: List[List[float]] = (rz @ np.asarray(rotation, dtype=float)).tolist()
+    return turned
 
 
 @dataclass
@@ -97,7 +98,7 @@ class OdometryCovariance:
     """Variances of the last reading's ``(vx_m_s, vy_m_s, omega_rad_s)``."""
 
     @classmethod
-    def from_spec(cls, spec: Mapping[str, float]) -> "OdometryCovariance":
+    def from_spec(cls, spec: Mapping[str, Any]) -> "OdometryCovariance":
         """From a robot's ``odometry`` dict (``Scenario.robot["odometry"]``)."""
         return cls(
             speed_frac=math.hypot(spec["speed_noise_frac"], spec["scale_bias_frac"]),
@@ -131,18 +132,18 @@ class OdometryCovariance:
         n22 = p22 + d2 * qw
         self.pose = np.array([[n00, n01, f02], [n01, n11, f12], [f02, f12, n22]])
 
-    def pose_6x6(self) -> list:
+    def pose_6x6(self) -> List[float]:
         """The pose covariance as ``nav_msgs/Odometry`` takes it (row-major 6 x 6 over x, y, z,
         roll, pitch, yaw)."""
         return _six(self.pose.tolist())
 
-    def twist_6x6(self) -> list:
+    def twist_6x6(self) -> List[float]:
         """The twist covariance as ``nav_msgs/Odometry`` takes it."""
         qx, qy, qw = self.twist.tolist()
         return _six([[qx, 0.0, 0.0], [0.0, qy, 0.0], [0.0, 0.0, qw]])
 
 
-def _six(p3: list) -> list:
+def _six(p3: List[List[float]]) -> List[float]:
     """A covariance over ``(x, y, yaw)`` spread over the 6 x 6 of ``(x, y, z, roll, pitch,
     yaw)``, the planar axes known."""
     out = [0.0] * 36
@@ -163,10 +164,10 @@ class Scan:
     angle_increment: float
     range_min: float
     range_max: float
-    ranges: list
+    ranges: List[float]
 
 
-def free_space_scan(free: Mapping) -> Scan:
+def free_space_scan(free: Mapping[str, Any]) -> Scan:
     """The free space of a frame (``FreeSpaceDetector.detect``) as a laser scan about the
     sensor's axis: one beam a direction of the polar template, at the direction's centre angle
     (``2 pi j / J`` in the robot frame); its range the free distance to the first obstacle cell,
@@ -194,13 +195,13 @@ class CameraInfo:
     width: int
     height: int
     distortion_model: str
-    d: list
-    k: list
-    r: list
-    p: list
+    d: List[float]
+    k: List[float]
+    r: List[float]
+    p: List[float]
 
 
-def camera_info(model: Mapping) -> CameraInfo:
+def camera_info(model: Mapping[str, Any]) -> CameraInfo:
     """A camera model (``Scenario.camera_model``) as ``camera_info``: a pinhole camera's ``K``
     with no distortion (``plumb_bob``, zeros); a mirror camera's fitted unified model as
     :data:`OMNIDIR_MODEL`."""
@@ -225,8 +226,12 @@ def camera_info(model: Mapping) -> CameraInfo:
 
 
 def command_at(
-    command: tuple, received_t_s: float, t_s: float, timeout_s: float, stop: tuple
-) -> tuple:
+    command: Tuple[float, ...],
+    received_t_s: float,
+    t_s: float,
+    timeout_s: float,
+    stop: Tuple[float, ...],
+) -> Tuple[float, ...]:
     """The command to apply at simulation time ``t_s``: ``command`` (received at
     ``received_t_s``), or ``stop`` once it is older than ``timeout_s``."""
     return stop if t_s - received_t_s > timeout_s + 1e-9 else command
@@ -240,7 +245,7 @@ def body_command(
     linear_x: float,
     linear_y: float,
     angular_z: float,
-    robot: Mapping,
+    robot: Mapping[str, Any],
 ) -> Tuple[float, ...]:
     """A ``cmd_vel`` (m/s, rad/s, body frame) as the command ``Simulation.step`` takes,
     clipped to ``robot``'s limits (``Scenario.robot``): the speed to ``max_speed_mm_s`` (the
@@ -254,7 +259,7 @@ def body_command(
         )
     vmax = float(robot["max_speed_mm_s"])
     vx, vy = linear_x / MM, linear_y / MM
-    diff: Optional[Mapping] = robot.get("differential")
+    diff: Optional[Mapping[str, Any]] = robot.get("differential")
     if diff is not None:
         vy = 0.0
     speed = math.hypot(vx, vy)

@@ -1,0 +1,42 @@
+"""The exceptions omniloop raises: `ScenarioError` (a `ValueError`) for a scenario, the
+`SimulationError` family (`RuntimeError`s) for a run that fails as it goes."""
+
+import numpy as np
+import pytest
+
+import omniloop
+
+
+def test_the_exceptions_are_exported_with_their_documented_bases():
+    assert issubclass(omniloop.ScenarioError, ValueError)
+    assert issubclass(omniloop.SimulationError, RuntimeError)
+    for kind in (omniloop.RobotSoftwareError, omniloop.RenderError, omniloop.RunFinishedError):
+        assert issubclass(kind, omniloop.SimulationError)
+    assert not issubclass(omniloop.SimulationError, ValueError)
+    assert omniloop.SimulationError.__module__ == "omniloop"
+
+
+def test_stepping_a_finished_simulation_raises_run_finished_error(pinhole):
+    sim = omniloop.Simulation(pinhole)
+    obs = sim.reset()
+    while not obs.done:
+        obs = sim.step((0.0, 0.0, 0.0))
+    with pytest.raises(omniloop.RunFinishedError, match="the run is over") as e:
+        sim.step((0.0, 0.0, 0.0))
+    assert isinstance(e.value, omniloop.SimulationError) and isinstance(e.value, RuntimeError)
+    assert not sim.reset().done, "reset() runs again"
+
+
+def test_stepping_a_finished_run_of_a_vector_raises_run_finished_error(pinhole):
+    vec = omniloop.VectorSimulation(pinhole, 2)
+    while not all(vec.done):
+        vec.step([(0.0, 0.0, 0.0)] * 2)
+    with pytest.raises(omniloop.RunFinishedError, match="run 0 is over"):
+        vec.step([(0.0, 0.0, 0.0)] * 2)
+    assert len(vec.step([(0.0, 0.0, 0.0)] * 2, active=[False, False])) == 2, "idle runs wait"
+
+
+def test_the_free_space_stage_failing_on_a_frame_raises_robot_software_error(corner):
+    detector = omniloop.Simulation(corner).free_space_detector()
+    with pytest.raises(omniloop.RobotSoftwareError, match="free space"):
+        detector.detect(np.zeros((16, 16, 3), dtype=np.uint8))
