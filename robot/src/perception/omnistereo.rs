@@ -18,9 +18,9 @@ use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::{MapLandmark, StereoRig};
 use crate::estimates::{LandmarkSighting, Measurement, MotionReading, NotFound};
-use crate::tables::ConfigProblem;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Vector2};
+use omniloop_problem::Problem;
 use omniloop_vision::VisionError;
 use omniloop_vision::omnistereo::{
     AngularProfile, FeaturePair, LandmarkRange, MirrorRim, OmnistereoConfig, RangedMark,
@@ -51,7 +51,7 @@ pub const ENTRY: StageEntry = StageEntry {
         if c.map.landmarks.is_empty() {
             let why = "omnistereo trilateration needs landmarks: add [[world.pillars]] of \
                        distinct colours";
-            p.push(ConfigProblem::new("control.pose_source", why));
+            p.push(Problem::new("control.pose_source", why));
         }
         p
     },

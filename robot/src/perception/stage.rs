@@ -6,9 +6,9 @@ use crate::RobotError;
 use crate::boundary::{ActuatorCommand, Observation};
 use crate::config::{RobotConfig, VisionSpec};
 use crate::estimates::{GroundReading, LandmarkSighting, Measurement, MotionReading, NotFound};
-use crate::tables::ConfigProblem;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Point2};
+use omniloop_problem::Problem;
 use omniloop_vision::forward::{FlowBalance, OdometryStep};
 use omniloop_vision::{FreeSpace, LocalizationQuality, RadialCalibration};
 
@@ -119,14 +119,14 @@ pub struct StageEntry {
     pub vision_table: Option<&'static str>,
     /// Parses and checks that table's values wherever it is written, naming each field at
     /// fault.
-    pub check_vision: fn(&VisionSpec) -> Vec<ConfigProblem>,
+    pub check_vision: fn(&VisionSpec) -> Vec<Problem>,
     /// Whether the robot's configuration asks for it (besides a controller that reads it).
     pub asked: fn(&RobotConfig) -> bool,
     /// What it needs of vision's camera.
     pub camera: CameraNeed,
     /// Checks what it needs of the robot (its camera, the map, its settings on that camera),
     /// naming each field at fault; its vision table's own values are `check_vision`'s.
-    pub check: fn(&RobotConfig) -> Vec<ConfigProblem>,
+    pub check: fn(&RobotConfig) -> Vec<Problem>,
     /// Builds it for a robot.
     pub build: fn(&RobotConfig) -> Result<Box<dyn Stage>, RobotError>,
 }
