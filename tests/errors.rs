@@ -5,7 +5,8 @@
 mod common;
 
 /// A scenario the check accepts whose robot's software cannot be built: its planner's grid of
-/// 5 mm cells over a 12 x 8 m field has more cells than the planner allows.
+/// 5 mm cells over a 12 x 8 m field has more cells than the planner allows (found when the
+/// controller is built, at the start of the run).
 const TOO_FINE_A_GRID: &str = r#"
 [run]
 duration_s = 1.0
@@ -17,9 +18,24 @@ half_width_mm = 4000.0
 [robot]
 start = { x_mm = 0.0, y_mm = 0.0 }
 
+[[robot.sensors]]
+name = "omni"
+width_px = 256
+height_px = 220
+[robot.sensors.hyperbolic]
+a_mm = 12.129
+b_mm = 15.650
+c_mm = 19.8
+focal_px = 479.37
+focus_height_mm = 205.08
+rim_radius_mm = 30.0
+
 [goal]
 x_mm = 500.0
 y_mm = 0.0
+
+[control]
+kind = "velocity_aware"
 
 [control.planner]
 kind = "grid"
