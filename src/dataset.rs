@@ -102,20 +102,20 @@ pub enum DatasetError {
     #[error(transparent)]
     Run(#[from] RunError),
     /// A file could not be written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {reason}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// Why.
-        source: std::io::Error,
+        /// Why (in the message, not a separate cause).
+        reason: std::io::Error,
     },
     /// A frame could not be written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {reason}")]
     Image {
         /// The file.
         path: PathBuf,
-        /// Why.
-        source: image::ImageError,
+        /// Why (in the message, not a separate cause).
+        reason: image::ImageError,
     },
     /// The camera model could not be fitted.
     #[error(transparent)]
@@ -200,7 +200,7 @@ pub fn write_dataset(
         let path = out.join("images").join(&name);
         let rgb: image::RgbImage = image::buffer::ConvertBuffer::convert(&s.image);
         rgb.save(&path)
-            .map_err(|source| DatasetError::Image { path, source })?;
+            .map_err(|reason| DatasetError::Image { path, reason })?;
         truth_files::write_depth_png(&out.join("depth").join(&name), &s.truth)
             .map_err(RunError::from)?;
         truth_files::write_label_png(&out.join("labels").join(&name), &s.truth)
@@ -262,7 +262,7 @@ fn write_camera_files(
             let path = out.join("calibration.json");
             cal.save(&path).map_err(|e| DatasetError::Io {
                 path,
-                source: std::io::Error::other(e.to_string()),
+                reason: std::io::Error::other(e.to_string()),
             })?;
             Some("calibration.json")
         }
@@ -470,17 +470,17 @@ fn run_samples(
 }
 
 fn create_dir(dir: &Path) -> Result<(), DatasetError> {
-    std::fs::create_dir_all(dir).map_err(|source| DatasetError::Io {
+    std::fs::create_dir_all(dir).map_err(|reason| DatasetError::Io {
         path: dir.to_path_buf(),
-        source,
+        reason,
     })
 }
 
 fn write_file(path: &Path, bytes: &[u8]) -> Result<(), DatasetError> {
     std::fs::File::create(path)
         .and_then(|mut f| f.write_all(bytes))
-        .map_err(|source| DatasetError::Io {
+        .map_err(|reason| DatasetError::Io {
             path: path.to_path_buf(),
-            source,
+            reason,
         })
 }

@@ -255,6 +255,7 @@ fn workspace_crates() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     [
         "src",
+        "problem/src",
         "sim/src",
         "vision/src",
         "control/src",

@@ -26,7 +26,7 @@ pub struct PyScenario {
 
 fn load_error(e: LoadError) -> PyErr {
     match e {
-        LoadError::Io { file, source } if source.kind() == std::io::ErrorKind::NotFound => {
+        LoadError::Io { file, reason } if reason.kind() == std::io::ErrorKind::NotFound => {
             PyFileNotFoundError::new_err(format!("no scenario file {}", file.display()))
         }
         LoadError::Io { .. } => PyOSError::new_err(e.to_string()),

@@ -64,7 +64,7 @@ fn os_error(path: &Path, source: &std::io::Error) -> PyErr {
 #[pyfunction]
 pub fn read_png_levels(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyArray2<u16>>> {
     let levels = py.detach(|| read_levels(&path)).map_err(|e| match e {
-        TruthFileError::Io { path, source } => os_error(&path, &source),
+        TruthFileError::Io { path, reason } => os_error(&path, &reason),
         png @ TruthFileError::Png { .. } => PyValueError::new_err(png.to_string()),
     })?;
     image_array(py, levels.height, levels.width, &levels.values)
@@ -88,8 +88,8 @@ fn dataset_error(e: DatasetError) -> PyErr {
     match e {
         DatasetError::Scenario { .. } => ScenarioError::new_err(e.to_string()),
         DatasetError::Run(run) => run_error(run),
-        DatasetError::Io { path, source } => os_error(&path, &source),
-        DatasetError::Image { path, source } => match source {
+        DatasetError::Io { path, reason } => os_error(&path, &reason),
+        DatasetError::Image { path, reason } => match reason {
             image::ImageError::IoError(io) => os_error(&path, &io),
             other => PyRuntimeError::new_err(format!("{}: {other}", path.display())),
         },

@@ -1,8 +1,9 @@
 //! The robot's software configuration: the `[vision]`, `[control]` and `[goal]` tables of a
 //! scenario, plus what the robot knows of its own body, cameras and start.
 
-use crate::tables::{ConfigProblem, Tables};
+use crate::tables::Tables;
 use nalgebra::{Isometry2, Point2};
+use omniloop_problem::Problem;
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::forward::ForwardCamera;
 use omniloop_vision::resection::{ColumnCalibration, StripePattern};
@@ -50,7 +51,7 @@ impl Default for ControlSpec {
 
 impl ControlSpec {
     /// Table `name` of `[control]` as its owner's settings.
-    pub fn table<T: DeserializeOwned + Default>(&self, name: &str) -> Result<T, ConfigProblem> {
+    pub fn table<T: DeserializeOwned + Default>(&self, name: &str) -> Result<T, Problem> {
         self.tables.parse("control", name)
     }
 }
@@ -75,7 +76,7 @@ pub struct VisionSpec {
 
 impl VisionSpec {
     /// Table `name` of `[vision]` as its owner's settings (their defaults when not written).
-    pub fn table<T: DeserializeOwned + Default>(&self, name: &str) -> Result<T, ConfigProblem> {
+    pub fn table<T: DeserializeOwned + Default>(&self, name: &str) -> Result<T, Problem> {
         self.tables.parse("vision", name)
     }
 }

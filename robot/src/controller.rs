@@ -8,10 +8,10 @@ use crate::config::{ControlSpec, RobotConfig};
 use crate::navigation::{MapSnapshot, NavigationReport};
 use crate::near_field::NearSpace;
 use crate::percept::{Percept, Percepts};
-use crate::tables::ConfigProblem;
 use crate::traffic::TrafficPoints;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::Surroundings;
+use omniloop_problem::{Problem, Problems};
 use omniloop_vision::FreeSpace;
 
 /// What a controller decides on.
@@ -66,7 +66,7 @@ pub struct ControlTable {
     /// Its name under `[control]`.
     pub name: &'static str,
     /// Parses and checks it.
-    pub check: fn(&ControlSpec) -> Vec<ConfigProblem>,
+    pub check: fn(&ControlSpec) -> Vec<Problem>,
 }
 
 /// A controller as the registry lists it: a new controller is its own file with one of these
@@ -83,13 +83,13 @@ pub struct ControllerEntry {
     /// The perception stages it reads, by name ([`crate::perception::STAGES`]).
     pub stages: &'static [&'static str],
     /// Checks what it needs of the robot (a camera, a map) when it is the robot's controller.
-    pub check_use: fn(&RobotConfig) -> Vec<ConfigProblem>,
+    pub check_use: fn(&RobotConfig) -> Vec<Problem>,
     /// Builds it for a robot.
     pub build: fn(&RobotConfig) -> Result<Box<dyn Controller>, RobotError>,
 }
 
 /// A check that finds nothing (for a controller without a table, or without needs).
-pub fn no_problems<T: ?Sized>(_: &T) -> Vec<ConfigProblem> {
+pub fn no_problems<T: ?Sized>(_: &T) -> Vec<Problem> {
     Vec::new()
 }
 
@@ -97,8 +97,8 @@ pub fn no_problems<T: ?Sized>(_: &T) -> Vec<ConfigProblem> {
 pub fn check_table<T: serde::de::DeserializeOwned + Default>(
     spec: &ControlSpec,
     name: &str,
-    check: impl FnOnce(&T, &mut crate::tables::Problems),
-) -> Vec<ConfigProblem> {
+    check: impl FnOnce(&T, &mut Problems),
+) -> Vec<Problem> {
     spec.tables.check("control", name, check)
 }
 
@@ -106,7 +106,7 @@ pub fn check_table<T: serde::de::DeserializeOwned + Default>(
 pub fn parses<T: serde::de::DeserializeOwned + Default>(
     spec: &ControlSpec,
     name: &str,
-) -> Vec<ConfigProblem> {
+) -> Vec<Problem> {
     spec.table::<T>(name).err().into_iter().collect()
 }
 

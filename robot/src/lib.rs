@@ -55,18 +55,26 @@ pub use perception::{
 };
 pub use remote::{Mailbox, Remote, RemoteHandle};
 pub use robot::{Robot, stages_of};
-pub use tables::{ConfigProblem, Tables};
+pub use tables::Tables;
 
 /// Why the robot's software could not be built or run a cycle.
+///
+/// Each variant either says all there is to say or is its cause itself (`transparent`), so that
+/// a chain of errors printed cause by cause names each cause once.
 #[derive(Debug, thiserror::Error)]
 pub enum RobotError {
     /// A vision stage could not be set up or failed on a frame.
-    #[error("vision: {0}")]
+    #[error(transparent)]
     Vision(#[from] omniloop_vision::VisionError),
     /// A controller could not be built.
-    #[error("control: {0}")]
+    #[error(transparent)]
     Control(#[from] omniloop_control::ControlError),
-    /// The configuration names a sensor or calibration the robot does not have.
+    /// A settings field breaks a rule (a table that does not parse, a value out of range),
+    /// naming the field.
+    #[error(transparent)]
+    Field(#[from] omniloop_problem::Problem),
+    /// The configuration asks for what the robot does not have (a sensor, a calibration, a
+    /// map); a field that breaks a rule is a [`RobotError::Field`].
     #[error("{0}")]
     Config(String),
     /// A user's robot software failed, and why.
@@ -80,11 +88,4 @@ pub enum RobotError {
         /// The stage that needed it.
         stage: &'static str,
     },
-}
-
-impl From<ConfigProblem> for RobotError {
-    /// A settings table that does not parse, naming its field.
-    fn from(p: ConfigProblem) -> Self {
-        Self::Config(p.to_string())
-    }
 }

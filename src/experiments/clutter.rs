@@ -12,7 +12,7 @@
 
 use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
 use crate::run::{RunError, RunOutput};
-use crate::scenario::{Checker, PoseSpec, Scenario};
+use crate::scenario::{PoseSpec, Problems, Scenario};
 use nalgebra::{Point2, Rotation2, Vector2};
 use omniloop_robot::GoalSpec;
 use omniloop_sim::{Cube, FieldSpec};
@@ -192,7 +192,7 @@ impl ClutterSpec {
         false
     }
 
-    fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Problems) {
         let p = "experiment.clutter";
         if self.cubes > MAX_CUBES {
             c.fail(
@@ -278,7 +278,7 @@ impl ExperimentSetup for ClutterSpec {
         }
     }
 
-    fn check(&self, s: &Scenario, c: &mut Checker) {
+    fn check(&self, s: &Scenario, c: &mut Problems) {
         self.validate(s, c);
     }
 

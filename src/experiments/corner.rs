@@ -7,7 +7,7 @@ use super::replay::{Replay, ReplayContext, ReplayRun, write_text};
 use crate::report::topview::{Marker, Panel, PathLayer, draw_panels};
 use crate::run::record::{Summary, TrajectoryRow};
 use crate::run::{RunError, RunOutput};
-use crate::scenario::Checker;
+use crate::scenario::Problems;
 use crate::scenario::{PoseSpec, Scenario};
 use nalgebra::{Point2, Vector2};
 use omniloop_robot::GoalSpec;
@@ -94,7 +94,7 @@ impl CornerSpec {
         }
     }
 
-    fn validate(&self, c: &mut Checker) {
+    fn validate(&self, c: &mut Problems) {
         let p = "experiment.corner";
         if !(self.angle_deg > 0.0 && self.angle_deg < 180.0) {
             c.fail(
@@ -137,7 +137,7 @@ impl ExperimentSetup for CornerSpec {
         CornerSpec::prepare(self, s);
     }
 
-    fn check(&self, _s: &Scenario, c: &mut Checker) {
+    fn check(&self, _s: &Scenario, c: &mut Problems) {
         self.validate(c);
     }
 

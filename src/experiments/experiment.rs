@@ -3,8 +3,8 @@
 //! ([`Experiment`]), and the entry that registers it ([`ExperimentEntry`]).
 
 use crate::run::{OutputFile, RunError, RunOutput, Simulation, Summary};
-use crate::scenario::{Checker, Scenario};
-use omniloop_robot::{ConfigProblem, Tables};
+use crate::scenario::{Problem, Problems, Scenario};
+use omniloop_robot::Tables;
 use serde::de::DeserializeOwned;
 
 /// The metrics an experiment adds to `summary.json`, by key.
@@ -64,7 +64,7 @@ pub trait ExperimentSetup {
     fn prepare(&self, _s: &mut Scenario) {}
 
     /// Checks the section against the rest of the scenario.
-    fn check(&self, s: &Scenario, c: &mut Checker);
+    fn check(&self, s: &Scenario, c: &mut Problems);
 
     /// Whether it takes frames of vision's camera itself (so the camera is rendered and
     /// calibrated whatever the robot's software reads).
@@ -89,14 +89,14 @@ pub struct ExperimentEntry {
     /// What it measures, in one line, with the paper and section it replays.
     pub summary: &'static str,
     /// Parses its section from the scenario's `[experiment]` tables.
-    pub setup: fn(&Tables) -> Result<Box<dyn ExperimentSetup>, ConfigProblem>,
+    pub setup: fn(&Tables) -> Result<Box<dyn ExperimentSetup>, Problem>,
 }
 
 /// Parses section `name` of `[experiment]` as `T` (the `setup` of an entry).
 pub fn setup<T: ExperimentSetup + DeserializeOwned + 'static>(
     tables: &Tables,
     name: &str,
-) -> Result<Box<dyn ExperimentSetup>, ConfigProblem> {
+) -> Result<Box<dyn ExperimentSetup>, Problem> {
     let spec: T = tables.parse_present("experiment", name)?;
     Ok(Box::new(spec))
 }

@@ -9,7 +9,7 @@ use super::replay::{Replay, ReplayContext, write_text};
 use crate::report::charts::{Chart, Series, Style, charts_png};
 use crate::report::output::write_run;
 use crate::run::{OutputFile, RunError, RunOutput};
-use crate::scenario::Checker;
+use crate::scenario::Problems;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Vector2};
 use omniloop_control::wrap_pi;
@@ -30,7 +30,7 @@ const SCRIPT: &str = "script";
 pub struct ForwardSpec {}
 
 impl ForwardSpec {
-    fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Problems) {
         let kind = s.control.kind.as_str();
         let odometry = s
             .vision
@@ -68,7 +68,7 @@ pub const ENTRY: ExperimentEntry = ExperimentEntry {
 };
 
 impl ExperimentSetup for ForwardSpec {
-    fn check(&self, s: &Scenario, c: &mut Checker) {
+    fn check(&self, s: &Scenario, c: &mut Problems) {
         self.validate(s, c);
     }
 

@@ -10,7 +10,7 @@ use super::replay::{Replay, ReplayContext, write_text};
 use crate::report::charts::{Chart, Series, Style, charts_png};
 use crate::run::record::Summary;
 use crate::run::{OutputFile, RunError, RunOutput, Simulation};
-use crate::scenario::Checker;
+use crate::scenario::{PoseChecks, Problems};
 use crate::scenario::{PoseSpec, Scenario};
 use nalgebra::{Isometry2, Vector2};
 use omniloop_sim::SimError;
@@ -66,7 +66,7 @@ pub const DIRECTIONS: [(&str, [f64; 2]); 4] = [
 ];
 
 impl HeadingSpec {
-    fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Problems) {
         let at = "experiment.heading";
         c.pose_in_world(
             &format!("{at}.checkpoint"),
@@ -103,7 +103,7 @@ pub const ENTRY: ExperimentEntry = ExperimentEntry {
 };
 
 impl ExperimentSetup for HeadingSpec {
-    fn check(&self, s: &Scenario, c: &mut Checker) {
+    fn check(&self, s: &Scenario, c: &mut Problems) {
         self.validate(s, c);
     }
 

@@ -10,7 +10,7 @@ use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, s
 use crate::report::topview::{Mark, Panel, Spots, panels_png};
 use crate::run::record::Summary;
 use crate::run::{OutputFile, RunError, RunOutput, Simulation};
-use crate::scenario::Checker;
+use crate::scenario::Problems;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::wrap_pi;
@@ -58,7 +58,7 @@ impl Default for MapSpec {
 }
 
 impl MapSpec {
-    fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Problems) {
         let at = "experiment.localization_map";
         if !(self.spacing_mm.is_finite() && self.spacing_mm >= 20.0) {
             c.fail(
@@ -107,7 +107,7 @@ pub const ENTRY: ExperimentEntry = ExperimentEntry {
 };
 
 impl ExperimentSetup for MapSpec {
-    fn check(&self, s: &Scenario, c: &mut Checker) {
+    fn check(&self, s: &Scenario, c: &mut Problems) {
         self.validate(s, c);
     }
 

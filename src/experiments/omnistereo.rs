@@ -11,7 +11,7 @@ use crate::report::charts::{Chart, Series, Style, charts_png};
 use crate::run::record::Summary;
 use crate::run::score::quantile;
 use crate::run::{OutputFile, RunError, RunOutput};
-use crate::scenario::Checker;
+use crate::scenario::Problems;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::wrap_pi;
@@ -36,7 +36,7 @@ fn default_band() -> [f64; 2] {
 }
 
 impl OmnistereoSpec {
-    fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Problems) {
         let [a, b] = self.range_band_mm;
         if !(a >= 0.0 && b > a) {
             c.fail(
@@ -62,7 +62,7 @@ pub const ENTRY: ExperimentEntry = ExperimentEntry {
 };
 
 impl ExperimentSetup for OmnistereoSpec {
-    fn check(&self, s: &Scenario, c: &mut Checker) {
+    fn check(&self, s: &Scenario, c: &mut Problems) {
         self.validate(s, c);
     }
 

@@ -10,7 +10,7 @@ use crate::report::output::write_run;
 use crate::report::topview::{Marker, Panel, PathLayer, draw_panels};
 use crate::run::record::Summary;
 use crate::run::{RunError, RunOutput, Simulation};
-use crate::scenario::Checker;
+use crate::scenario::{PoseChecks, Problems};
 use crate::scenario::{PoseSpec, Scenario};
 use anyhow::Context;
 use nalgebra::{Isometry2, Point2};
@@ -41,7 +41,7 @@ fn default_frames_per_place() -> u32 {
 }
 
 impl PlacesSpec {
-    fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Problems) {
         if self.places.is_empty() {
             c.fail("experiment.places.places", "needs at least one place");
         }
@@ -74,7 +74,7 @@ pub const ENTRY: ExperimentEntry = ExperimentEntry {
 };
 
 impl ExperimentSetup for PlacesSpec {
-    fn check(&self, s: &Scenario, c: &mut Checker) {
+    fn check(&self, s: &Scenario, c: &mut Problems) {
         self.validate(s, c);
     }
 

@@ -3,8 +3,7 @@
 
 use super::experiment::{ExperimentEntry, ExperimentSetup};
 use super::{clutter, corner, forward, heading, localization_map, omnistereo, places, resection};
-use crate::scenario::{Checker, Scenario};
-use omniloop_robot::ConfigProblem;
+use crate::scenario::{Problem, Problems, Scenario};
 
 /// Every experiment a scenario can belong to (`[experiment.NAME]`).
 pub const EXPERIMENTS: &[ExperimentEntry] = &[
@@ -24,13 +23,13 @@ pub fn find(name: &str) -> Option<&'static ExperimentEntry> {
 }
 
 /// The scenario's experiment section, parsed by its own type: `None` without one.
-pub fn setup_of(s: &Scenario) -> Result<Option<Box<dyn ExperimentSetup>>, ConfigProblem> {
+pub fn setup_of(s: &Scenario) -> Result<Option<Box<dyn ExperimentSetup>>, Problem> {
     let Some(name) = s.experiment_name() else {
         return Ok(None);
     };
     let entry = find(name).ok_or_else(|| {
         let names: Vec<&str> = EXPERIMENTS.iter().map(|e| e.name).collect();
-        ConfigProblem::new(
+        Problem::new(
             format!("experiment.{name}"),
             format!(
                 "unknown experiment `{name}`, expected one of {}",
@@ -50,11 +49,11 @@ pub fn prepare(s: &mut Scenario) {
 }
 
 /// The scenario's experiment's own checks (its section parsed, then checked against the rest).
-pub fn check(s: &Scenario, c: &mut Checker) {
+pub fn check(s: &Scenario, c: &mut Problems) {
     match setup_of(s) {
         Ok(Some(setup)) => setup.check(s, c),
         Ok(None) => {}
-        Err(p) => c.problems(vec![p]),
+        Err(p) => c.extend([p]),
     }
 }
 

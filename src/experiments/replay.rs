@@ -92,7 +92,7 @@ impl ReplayContext<'_> {
         let mut scenario = (self.load)(text, path, &stem)?;
         edit(&mut scenario)?;
         if let Some(v) = crate::scenario::validate(&scenario).first() {
-            anyhow::bail!("{file} ({name}): field `{}`: {}", v.path, v.message);
+            anyhow::bail!("{file} ({name}): field `{}`: {}", v.field, v.message);
         }
         if let Some(seed) = self.seed {
             scenario.seed = seed;

@@ -11,7 +11,7 @@ use crate::report::output::write_run;
 use crate::report::topview::{Mark, Marker, Panel, Spots, panels_png};
 use crate::run::record::Summary;
 use crate::run::{OutputFile, RunError, RunOutput, Simulation};
-use crate::scenario::Checker;
+use crate::scenario::{PoseChecks, Problems};
 use crate::scenario::{PoseSpec, Scenario};
 use nalgebra::Point2;
 use omniloop_control::wrap_pi;
@@ -36,7 +36,7 @@ fn default_timeout() -> f64 {
 }
 
 impl ResectionSpec {
-    fn validate(&self, s: &Scenario, c: &mut Checker) {
+    fn validate(&self, s: &Scenario, c: &mut Problems) {
         if self.places.is_empty() {
             c.fail("experiment.resection.places", "needs at least one place");
         }
@@ -67,7 +67,7 @@ pub const ENTRY: ExperimentEntry = ExperimentEntry {
 };
 
 impl ExperimentSetup for ResectionSpec {
-    fn check(&self, s: &Scenario, c: &mut Checker) {
+    fn check(&self, s: &Scenario, c: &mut Problems) {
         self.validate(s, c);
     }
 

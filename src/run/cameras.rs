@@ -383,7 +383,7 @@ impl Cameras {
             let stem = format!("{}_{:06}", c.sensor.name, cycle);
             let path = dir.join(format!("{stem}.png"));
             img.save(&path)
-                .map_err(|source| RunError::Frame { path, source })?;
+                .map_err(|reason| RunError::Frame { path, reason })?;
             if let Some(truth) = self.truth.get(k).and_then(Option::as_ref) {
                 truth_files::write_truth(dir, &stem, truth)?;
                 let legend = dir.join("legend.json");

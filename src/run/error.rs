@@ -1,6 +1,7 @@
 //! Why a run could not be carried out.
 
-use omniloop_robot::{ConfigProblem, RobotError};
+use omniloop_problem::Problem;
+use omniloop_robot::RobotError;
 use omniloop_sim::{RenderError, SimError};
 use omniloop_vision::VisionError;
 use std::path::PathBuf;
@@ -12,16 +13,16 @@ pub enum RunError {
     #[error(transparent)]
     Sim(#[from] SimError),
     /// The simulator's pilot could not be built.
-    #[error("control: {0}")]
+    #[error(transparent)]
     Control(#[from] omniloop_control::ControlError),
     /// The renderer could not open or render.
     #[error(transparent)]
     Render(#[from] RenderError),
     /// A calibration file could not be used.
-    #[error("vision: {0}")]
+    #[error(transparent)]
     Vision(#[from] VisionError),
     /// The robot's software could not be built or failed.
-    #[error("robot: {0}")]
+    #[error(transparent)]
     Robot(#[from] RobotError),
     /// The robot commanded an actuator it does not have.
     #[error("actuator: {0}")]
@@ -52,21 +53,21 @@ pub enum RunError {
     #[error("{0}")]
     Team(String),
     /// A frame's truth could not be written.
-    #[error("writing a frame's truth: {0}")]
+    #[error(transparent)]
     Truth(#[from] super::truth_files::TruthFileError),
     /// A frame could not be written.
-    #[error("writing frame {path}: {source}")]
+    #[error("writing frame {path}: {reason}")]
     Frame {
         /// The file.
         path: PathBuf,
-        /// The cause.
-        source: image::ImageError,
+        /// Why (in the message, not a separate cause).
+        reason: image::ImageError,
     },
 }
 
-impl From<ConfigProblem> for RunError {
+impl From<Problem> for RunError {
     /// A settings table that does not parse (a scenario not checked first).
-    fn from(p: ConfigProblem) -> Self {
+    fn from(p: Problem) -> Self {
         Self::Scenario(p.to_string())
     }
 }

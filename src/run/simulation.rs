@@ -792,7 +792,7 @@ fn frame_folders(dir: &std::path::Path, robots: Option<&[String]>) -> Result<(),
     for path in folders {
         std::fs::create_dir_all(&path).map_err(|e| RunError::Frame {
             path,
-            source: image::ImageError::IoError(e),
+            reason: image::ImageError::IoError(e),
         })?;
     }
     Ok(())

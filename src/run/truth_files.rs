@@ -15,12 +15,12 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum TruthFileError {
     /// Writing or reading the file failed.
-    #[error("{path}: {source}")]
+    #[error("{path}: {reason}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// Why.
-        source: std::io::Error,
+        /// Why (in the message, not a separate cause).
+        reason: std::io::Error,
     },
     /// Encoding or decoding the PNG failed.
     #[error("{path}: {why}")]
@@ -33,9 +33,9 @@ pub enum TruthFileError {
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> TruthFileError + '_ {
-    move |source| TruthFileError::Io {
+    move |reason| TruthFileError::Io {
         path: path.to_path_buf(),
-        source,
+        reason,
     }
 }
 

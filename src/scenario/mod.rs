@@ -11,8 +11,8 @@ pub mod rules;
 pub mod schema;
 pub mod team;
 
-pub use check::{Checker, FieldPath, PathSeg, Violation};
-pub use parse::{LoadError, Problem, load_scenario_with, parse_scenario_with};
+pub use check::{FieldPath, Location, PathSeg, PoseChecks, Problem, Problems};
+pub use parse::{LoadError, load_scenario_with, parse_scenario_with};
 pub use rules::validate;
 pub use schema::{
     DEFAULT_ROBOT_NAME, DifferentialSpec, OdometrySpec, OtherRobotSpec, PilotChoice, PoseSpec,

@@ -2,58 +2,31 @@
 //! column and field. The experiments' own preparation and checks come in as arguments from
 //! the layer that knows them ([`crate::experiments::parse_scenario`]).
 
-use super::check::Violation;
-use super::check::{Checker, FieldPath, PathSeg};
+use super::check::{FieldPath, Location, PathSeg, Problem, Problems};
 use super::rules::validate;
 use super::schema::{RobotSpec, Scenario};
 use super::team;
 use omniloop_robot::VisionSpec;
 use omniloop_sim::optics::Optics;
-use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::de::{DeTable, DeValue};
-
-/// One problem in a scenario file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Problem {
-    /// The file.
-    pub file: PathBuf,
-    /// 1-based line.
-    pub line: usize,
-    /// 1-based column.
-    pub column: usize,
-    /// The dotted path of the field (empty when the problem is in the TOML syntax).
-    pub field: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl fmt::Display for Problem {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}: ", self.file.display(), self.line, self.column)?;
-        if !self.field.is_empty() {
-            write!(f, "field `{}`: ", self.field)?;
-        }
-        write!(f, "{}", self.message)
-    }
-}
 
 /// Why a scenario could not be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum LoadError {
     /// The file could not be read.
-    #[error("cannot read scenario {}: {source}", file.display())]
+    #[error("cannot read scenario {}: {reason}", file.display())]
     Io {
         /// The file.
         file: PathBuf,
-        /// The cause.
-        source: std::io::Error,
+        /// Why (in the message, not a separate cause).
+        reason: std::io::Error,
     },
     /// The file is not a valid scenario.
     #[error("{}", problems.iter().map(|p| p.to_string()).collect::<Vec<_>>().join("\n"))]
     Invalid {
-        /// Every problem found, in file order.
+        /// Every problem found, in file order, each located in the file.
         problems: Vec<Problem>,
     },
 }
@@ -63,11 +36,11 @@ pub enum LoadError {
 pub fn load_scenario_with(
     path: &Path,
     prepare: impl FnOnce(&mut Scenario),
-    check: impl FnOnce(&Scenario, &mut Checker),
+    check: impl FnOnce(&Scenario, &mut Problems),
 ) -> Result<Scenario, LoadError> {
-    let text = std::fs::read_to_string(path).map_err(|source| LoadError::Io {
+    let text = std::fs::read_to_string(path).map_err(|reason| LoadError::Io {
         file: path.to_path_buf(),
-        source,
+        reason,
     })?;
     let stem = path
         .file_stem()
@@ -84,81 +57,96 @@ pub fn parse_scenario_with(
     file: &Path,
     default_name: &str,
     prepare: impl FnOnce(&mut Scenario),
-    check: impl FnOnce(&Scenario, &mut Checker),
+    check: impl FnOnce(&Scenario, &mut Problems),
 ) -> Result<Scenario, LoadError> {
     let doc = DeTable::parse(text).ok();
-    let locate = |span: Option<Range<usize>>| -> (usize, usize) {
-        span.map(|s| line_col(text, s.start)).unwrap_or((1, 1))
+    let at = Locator {
+        text,
+        file,
+        doc: doc.as_ref().map(|d| d.get_ref()),
     };
-    let mut scenario = match Scenario::from_toml(text) {
-        Ok(s) => s,
-        Err(e) => {
-            let span = e.span();
-            let field = match (&doc, &span) {
-                (Some(d), Some(s)) => path_at(d.get_ref(), s.start)
-                    .map(|p| p.to_string())
-                    .unwrap_or_default(),
-                _ => String::new(),
-            };
-            let (line, column) = locate(span);
-            return Err(LoadError::Invalid {
-                problems: vec![Problem {
-                    file: file.to_path_buf(),
-                    line,
-                    column,
-                    field,
-                    message: e.message().trim().to_string(),
-                }],
-            });
-        }
-    };
+    let mut scenario = Scenario::from_toml(text).map_err(|e| at.syntax_error(&e))?;
     if scenario.name.is_empty() {
         scenario.name = default_name.to_string();
     }
-    let located = |violations: Vec<Violation>| {
-        let mut problems: Vec<Problem> = violations
-            .into_iter()
-            .map(|v| {
-                let span = doc.as_ref().and_then(|d| span_of(d.get_ref(), &v.path));
-                let (line, column) = locate(span);
-                Problem {
-                    file: file.to_path_buf(),
-                    line,
-                    column,
-                    field: v.path.to_string(),
-                    message: v.message,
-                }
-            })
-            .collect();
-        problems.sort_by_key(|p| (p.line, p.column));
-        LoadError::Invalid { problems }
-    };
     // A team's robots: each entry of [[robots]] over the shared tables.
     if !scenario.robots.is_empty() {
         let raw: toml::Table = toml::from_str(text).unwrap_or_default();
-        scenario.team = team::resolve(&raw).map_err(&located)?;
+        scenario.team = team::resolve(&raw).map_err(|p| at.invalid(p))?;
     }
     // An experiment may build part of the world (the corner's corridor, start and goal).
     prepare(&mut scenario);
-    // Paths in a scenario are relative to its file; calibrated cameras read their files now
-    // (what fails is reported with the rules).
+    resolve_scenario_files(&mut scenario, file);
+    let mut problems = Problems::new();
+    problems.extend(if scenario.is_team() {
+        team::validate_team(&scenario)
+    } else {
+        validate(&scenario)
+    });
+    let mut own = Problems::new();
+    check(&scenario, &mut own);
+    problems.extend(own);
+    if problems.is_empty() {
+        return Ok(scenario);
+    }
+    Err(at.invalid(problems.into_vec()))
+}
+
+/// Locates problems in the scenario's text (its parsed document, when it parses as TOML).
+struct Locator<'a> {
+    text: &'a str,
+    file: &'a Path,
+    doc: Option<&'a DeTable<'a>>,
+}
+
+impl Locator<'_> {
+    /// The location of a byte span (the start of the file without one).
+    fn location(&self, span: Option<Range<usize>>) -> Location {
+        let (line, column) = span.map_or((1, 1), |s| line_col(self.text, s.start));
+        Location {
+            file: self.file.to_path_buf(),
+            line,
+            column,
+        }
+    }
+
+    /// A text that is no scenario (TOML syntax, an unknown key, a wrong type), named by the
+    /// field at the error's place when there is one.
+    fn syntax_error(&self, e: &toml::de::Error) -> LoadError {
+        let span = e.span();
+        let field = match (self.doc, &span) {
+            (Some(d), Some(s)) => path_at(d, s.start).unwrap_or_default(),
+            _ => FieldPath::default(),
+        };
+        let problem = Problem::new(field, e.message().trim()).located(self.location(span));
+        LoadError::Invalid {
+            problems: vec![problem],
+        }
+    }
+
+    /// The scenario's problems, each located at its field, in file order.
+    fn invalid(&self, problems: Vec<Problem>) -> LoadError {
+        let mut problems: Vec<Problem> = problems
+            .into_iter()
+            .map(|p| {
+                let span = self.doc.and_then(|d| span_of(d, &p.field));
+                let at = self.location(span);
+                p.located(at)
+            })
+            .collect();
+        problems.sort_by_key(|p| p.location.as_ref().map(|l| (l.line, l.column)));
+        LoadError::Invalid { problems }
+    }
+}
+
+/// Paths in a scenario are relative to its file; calibrated cameras read their files now
+/// (what fails is reported with the rules).
+fn resolve_scenario_files(scenario: &mut Scenario, file: &Path) {
     let dir = file.parent().unwrap_or(Path::new(""));
     resolve_files(&mut scenario.vision, &mut scenario.robot, dir);
     for m in &mut scenario.team {
         resolve_files(&mut m.vision, &mut m.robot, dir);
     }
-    let mut violations = if scenario.is_team() {
-        team::validate_team(&scenario)
-    } else {
-        validate(&scenario)
-    };
-    let mut c = Checker::new();
-    check(&scenario, &mut c);
-    violations.extend(c.into_violations());
-    if violations.is_empty() {
-        return Ok(scenario);
-    }
-    Err(located(violations))
 }
 
 /// Makes a robot's file paths relative to the scenario's folder `dir` (vision's calibration
@@ -277,6 +265,20 @@ y_mm = 0.0
         }
     }
 
+    fn line_col_of(p: &Problem) -> (usize, usize) {
+        let at = p.location.as_ref().expect("a located problem");
+        assert_eq!(at.file, Path::new("t.toml"));
+        (at.line, at.column)
+    }
+
+    #[test]
+    fn a_syntax_error_is_located_without_a_field() {
+        let p = &problems("[robot\n")[0];
+        assert!(p.field.is_empty(), "{p}");
+        assert!(p.to_string().starts_with("t.toml:1:"), "{p}");
+        assert!(!p.to_string().contains("field `"), "{p}");
+    }
+
     #[test]
     fn a_minimal_scenario_is_valid_and_named_after_its_file() {
         let s = parse_scenario_with(GOOD, Path::new("t.toml"), "t", |_| {}, |_, _| {}).unwrap();
@@ -288,8 +290,8 @@ y_mm = 0.0
     fn unknown_keys_are_located() {
         let text = GOOD.replace("[goal]\n", "[goal]\nspeed = 3\n");
         let p = &problems(&text)[0];
-        assert_eq!((p.line, p.column), (6, 1), "{p}");
-        assert_eq!(p.field, "goal.speed");
+        assert_eq!(line_col_of(p), (6, 1), "{p}");
+        assert_eq!(p.field.to_string(), "goal.speed");
         assert!(p.message.contains("unknown field"), "{p}");
     }
 
@@ -297,8 +299,8 @@ y_mm = 0.0
     fn wrong_types_are_located() {
         let text = GOOD.replace("x_mm = 500.0", "x_mm = \"far\"");
         let p = &problems(&text)[0];
-        assert_eq!((p.line, p.column), (6, 8), "{p}");
-        assert_eq!(p.field, "goal.x_mm");
+        assert_eq!(line_col_of(p), (6, 8), "{p}");
+        assert_eq!(p.field.to_string(), "goal.x_mm");
     }
 
     #[test]
@@ -308,8 +310,8 @@ y_mm = 0.0
             "start = { x_mm = 0.0, y_mm = 0.0 }\nradius_mm = -90.0",
         );
         let p = &problems(&text)[0];
-        assert_eq!(p.field, "robot.radius_mm");
-        assert_eq!((p.line, p.column), (4, 1), "{p}");
+        assert_eq!(p.field.to_string(), "robot.radius_mm");
+        assert_eq!(line_col_of(p), (4, 1), "{p}");
         assert!(p.message.contains("> 0"));
     }
 
@@ -317,7 +319,7 @@ y_mm = 0.0
     fn a_field_left_at_its_default_points_at_its_table() {
         let text = "[run]\nphysics_step_s = 0.003\n[robot]\nstart = { x_mm = 0.0, y_mm = 0.0 }\n[goal]\nx_mm = 1.0\ny_mm = 0.0\n";
         let p = &problems(text)[0];
-        assert_eq!(p.field, "run.physics_step_s");
-        assert_eq!(p.line, 2);
+        assert_eq!(p.field.to_string(), "run.physics_step_s");
+        assert_eq!(line_col_of(p).0, 2);
     }
 }

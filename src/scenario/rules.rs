@@ -1,9 +1,10 @@
 //! The rules a parsed scenario must satisfy, checked once, each failure naming the dotted path
 //! of the field it concerns (each experiment adds its own through its registry entry).
 
-use super::check::{Checker, Violation};
+use super::check::PoseChecks;
 use super::schema::{PilotChoice, Scenario, TimingSpec};
 use nalgebra::Point2;
+use omniloop_problem::{FieldPath, Problem, Problems};
 use omniloop_robot::controllers::{self, CONTROLLERS};
 use omniloop_robot::perception::{self, CameraNeed, STAGES};
 use omniloop_robot::{ControllerEntry, RobotConfig, StageEntry};
@@ -15,8 +16,39 @@ fn in_floor(world: &Layout, p: Point2<f64>) -> bool {
 }
 
 /// Every rule the scenario breaks (empty when it is valid).
-pub fn validate(s: &Scenario) -> Vec<Violation> {
-    let mut c = Checker::new();
+pub fn validate(s: &Scenario) -> Vec<Problem> {
+    let mut c = Problems::new();
+    check_run(&mut c, s);
+    check_world(&mut c, &s.world);
+    check_robot(&mut c, s);
+    check_other_robots(&mut c, s);
+    check_goal(&mut c, s);
+    check_software(&mut c, s);
+    if let Some(g) = &s.goal {
+        for (k, wp) in g.waypoints_mm.iter().enumerate() {
+            if !in_floor(&s.world, Point2::new(wp[0], wp[1])) {
+                c.fail(
+                    format!("goal.waypoints_mm[{k}]"),
+                    format!("({}, {}) mm is outside the floor region", wp[0], wp[1]),
+                );
+            }
+        }
+    }
+    if s.experiment.0.len() > 1 {
+        let names: Vec<&str> = s.experiment.names().collect();
+        c.fail(
+            "experiment",
+            format!(
+                "a scenario belongs to one experiment (found {})",
+                names.join(", ")
+            ),
+        );
+    }
+    c.into_vec()
+}
+
+/// `[run]`: positive times, the physics step dividing the control period.
+fn check_run(c: &mut Problems, s: &Scenario) {
     let r = &s.run;
     c.positive("run.duration_s", r.duration_s);
     c.positive("run.control_period_s", r.control_period_s);
@@ -34,8 +66,10 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             );
         }
     }
+}
 
-    let w = &s.world;
+/// `[world]`: positive sizes, corridors and walls of some length.
+fn check_world(c: &mut Problems, w: &Layout) {
     if let Some(f) = &w.field {
         for (name, v) in [
             ("half_length_mm", f.half_length_mm),
@@ -100,7 +134,11 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         c.positive(format!("world.pillars[{i}].radius_mm"), p.radius_mm);
         c.positive(format!("world.pillars[{i}].height_mm"), p.height_mm);
     }
+}
 
+/// `[robot]`: its body, where it starts, and its sensors (named once each).
+fn check_robot(c: &mut Problems, s: &Scenario) {
+    let w = &s.world;
     let rb = &s.robot;
     if let Some(d) = &rb.differential {
         c.positive("robot.differential.track_mm", d.track_mm);
@@ -125,7 +163,7 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
         ),
     }
     for (i, sensor) in rb.sensors.iter().enumerate() {
-        check_sensor(&mut c, &format!("robot.sensors[{i}]"), sensor);
+        check_sensor(c, &format!("robot.sensors[{i}]"), sensor);
         if rb.sensors[..i].iter().any(|o| o.name == sensor.name) {
             c.fail(
                 format!("robot.sensors[{i}].name"),
@@ -133,7 +171,11 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             );
         }
     }
+}
 
+/// `[[other_robots]]`: their bodies, starts and waypoints on the floor.
+fn check_other_robots(c: &mut Problems, s: &Scenario) {
+    let w = &s.world;
     for (i, o) in s.other_robots.iter().enumerate() {
         let p = format!("other_robots[{i}]");
         c.positive(format!("{p}.radius_mm"), o.radius_mm);
@@ -150,7 +192,11 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             }
         }
     }
+}
 
+/// `[goal]`: a finite point on the floor, a tolerance with room for the estimate's margin.
+fn check_goal(c: &mut Problems, s: &Scenario) {
+    let w = &s.world;
     if let Some(g) = &s.goal {
         c.finite("goal.x_mm", g.x_mm);
         c.finite("goal.y_mm", g.y_mm);
@@ -174,32 +220,10 @@ pub fn validate(s: &Scenario) -> Vec<Violation> {
             );
         }
     }
-    check_software(&mut c, s);
-    if let Some(g) = &s.goal {
-        for (k, wp) in g.waypoints_mm.iter().enumerate() {
-            if !in_floor(w, Point2::new(wp[0], wp[1])) {
-                c.fail(
-                    format!("goal.waypoints_mm[{k}]"),
-                    format!("({}, {}) mm is outside the floor region", wp[0], wp[1]),
-                );
-            }
-        }
-    }
-    if s.experiment.0.len() > 1 {
-        let names: Vec<&str> = s.experiment.names().collect();
-        c.fail(
-            "experiment",
-            format!(
-                "a scenario belongs to one experiment (found {})",
-                names.join(", ")
-            ),
-        );
-    }
-    c.out
 }
 
 /// `[robot.timing]`: latencies >= 0 (a command's in whole physics steps), a drop rate below 1.
-fn check_timing(c: &mut Checker, t: &TimingSpec, physics_step_s: f64) {
+fn check_timing(c: &mut Problems, t: &TimingSpec, physics_step_s: f64) {
     for (key, v) in [
         ("frame_latency_s", t.frame_latency_s),
         ("command_latency_s", t.command_latency_s),
@@ -233,7 +257,7 @@ fn check_timing(c: &mut Checker, t: &TimingSpec, physics_step_s: f64) {
 /// The robot's software: its controller and pose source by their registered names, their
 /// tables, the stages they run and what those need of the robot (checked by their own code),
 /// the odometry's errors, and vision's camera.
-fn check_software(c: &mut Checker, s: &Scenario) {
+fn check_software(c: &mut Problems, s: &Scenario) {
     let o = &s.odometry;
     for (key, v) in [
         ("speed_noise_frac", o.speed_noise_frac),
@@ -292,14 +316,14 @@ fn check_software(c: &mut Checker, s: &Scenario) {
     let Some(config) = software_config(c, s, &stages) else {
         return;
     };
-    c.problems((controller.check_use)(&config));
+    c.merge((controller.check_use)(&config));
     for stage in &stages {
-        c.problems((stage.check)(&config));
+        c.merge((stage.check)(&config));
     }
 }
 
 /// The registered controller `control.kind` names, or the problem.
-fn controller(c: &mut Checker, s: &Scenario) -> Option<&'static ControllerEntry> {
+fn controller(c: &mut Problems, s: &Scenario) -> Option<&'static ControllerEntry> {
     let kind = &s.control.kind;
     let Some(entry) = controllers::find(kind) else {
         let why = if kind == "go_to_goal_truth" {
@@ -326,13 +350,13 @@ fn controller(c: &mut Checker, s: &Scenario) -> Option<&'static ControllerEntry>
 
 /// Every table written under `[control]` belongs to a registered controller or stage, which
 /// checks it (a table controllers share is checked once; the chosen controller's always).
-fn check_tables(c: &mut Checker, s: &Scenario, chosen: &ControllerEntry) {
+fn check_tables(c: &mut Problems, s: &Scenario, chosen: &ControllerEntry) {
     let spec = &s.control;
     let controller_tables = || CONTROLLERS.iter().flat_map(|e| e.tables.iter());
     let mut checked: Vec<&str> = Vec::new();
     for name in spec.tables.names() {
         if let Some(table) = controller_tables().find(|t| t.name == name) {
-            c.problems((table.check)(spec));
+            c.merge((table.check)(spec));
             checked.push(name);
         } else if !STAGES.iter().any(|e| e.table == Some(name)) {
             let tables = controller_tables().map(|t| t.name);
@@ -342,16 +366,16 @@ fn check_tables(c: &mut Checker, s: &Scenario, chosen: &ControllerEntry) {
         }
     }
     for table in chosen.tables.iter().filter(|t| !checked.contains(&t.name)) {
-        c.problems((table.check)(spec));
+        c.merge((table.check)(spec));
     }
 }
 
 /// Every table written under `[vision]` belongs to a registered stage, which checks its values
 /// (a table stages share is checked once), whether or not the stage runs.
-fn check_vision_tables(c: &mut Checker, s: &Scenario) {
+fn check_vision_tables(c: &mut Problems, s: &Scenario) {
     for name in s.vision.tables.names() {
         if let Some(owner) = STAGES.iter().find(|e| e.vision_table == Some(name)) {
-            c.problems((owner.check_vision)(&s.vision));
+            c.merge((owner.check_vision)(&s.vision));
         } else {
             let tables = STAGES.iter().filter_map(|e| e.vision_table);
             unknown_table(c, "vision", name, &["sensor", "calibration_file"], tables);
@@ -362,7 +386,7 @@ fn check_vision_tables(c: &mut Checker, s: &Scenario) {
 /// Table `name` of `section` is no registered part's: the problem lists the section's own
 /// `keys` and the registered `tables`.
 fn unknown_table<'a>(
-    c: &mut Checker,
+    c: &mut Problems,
     section: &str,
     name: &str,
     keys: &[&'a str],
@@ -382,7 +406,7 @@ fn unknown_table<'a>(
 }
 
 /// What the stages need of the world that the robot is not told (its map holds the rest).
-fn check_world_for(c: &mut Checker, s: &Scenario, stages: &[&'static StageEntry]) {
+fn check_world_for(c: &mut Problems, s: &Scenario, stages: &[&'static StageEntry]) {
     let runs = |name: &str| stages.iter().any(|e| e.name == name);
     if runs("floor_localization") && s.world.field.is_none() {
         c.fail(
@@ -391,9 +415,9 @@ fn check_world_for(c: &mut Checker, s: &Scenario, stages: &[&'static StageEntry]
         );
     }
     if runs("omnistereo")
-        && let Err((field, why)) = s.stereo_rig()
+        && let Err(p) = s.stereo_rig()
     {
-        c.fail(field, why);
+        c.extend([p]);
     }
     if runs("resection") {
         check_resection_camera(c, s);
@@ -403,7 +427,7 @@ fn check_world_for(c: &mut Checker, s: &Scenario, stages: &[&'static StageEntry]
 /// The configuration the robot's software is built from, with vision's camera calibrated when
 /// a stage needs it, or `None` when the camera cannot serve (the problem recorded).
 fn software_config(
-    c: &mut Checker,
+    c: &mut Problems,
     s: &Scenario,
     stages: &[&'static StageEntry],
 ) -> Option<RobotConfig> {
@@ -474,7 +498,7 @@ fn software_config(
 }
 
 /// The named boards (the robot's striped marks) are named once and striped well.
-fn check_boards(c: &mut Checker, s: &Scenario) {
+fn check_boards(c: &mut Problems, s: &Scenario) {
     let mut names: Vec<&str> = Vec::new();
     for (i, b) in s.world.boards.iter().enumerate() {
         let Some(name) = &b.name else { continue };
@@ -496,7 +520,7 @@ fn check_boards(c: &mut Checker, s: &Scenario) {
 }
 
 /// Resection reads bearings through vision's camera, level when it is a pinhole.
-fn check_resection_camera(c: &mut Checker, s: &Scenario) {
+fn check_resection_camera(c: &mut Problems, s: &Scenario) {
     match s.vision_sensor_index() {
         Err(e) => c.fail(
             "vision.sensor",
@@ -519,7 +543,7 @@ fn check_resection_camera(c: &mut Checker, s: &Scenario) {
     }
 }
 
-fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
+fn check_sensor(c: &mut Problems, p: &str, s: &SensorSpec) {
     if s.name.trim().is_empty() {
         c.fail(format!("{p}.name"), "must not be empty");
     }
@@ -552,15 +576,17 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
             format!("must be 2..=256 (got {n})"),
         );
     }
-    for (key, why) in s.optics.problems() {
-        c.fail(format!("{p}.{key}"), why);
-    }
-    for (key, why) in s.effects.problems() {
-        c.fail(format!("{p}.effects.{key}"), why);
-    }
-    for (key, why) in s.mounting.problems() {
-        c.fail(format!("{p}.mounting.{key}"), why);
-    }
+    let sensor = FieldPath::parse(p);
+    c.extend(s.optics.problems().into_iter().map(|q| q.under(&sensor)));
+    let effects = FieldPath::parse(&format!("{p}.effects"));
+    c.extend(s.effects.problems().into_iter().map(|q| q.under(&effects)));
+    let mounting = FieldPath::parse(&format!("{p}.mounting"));
+    c.extend(
+        s.mounting
+            .problems()
+            .into_iter()
+            .map(|q| q.under(&mounting)),
+    );
     if !s.mounting.is_nominal() && matches!(s.optics, Optics::Pinhole(_) | Optics::Calibrated(_)) {
         c.fail(
             format!("{p}.mounting"),
@@ -577,7 +603,7 @@ fn check_sensor(c: &mut Checker, p: &str, s: &SensorSpec) {
 
 /// A calibrated camera's image is the one its model was calibrated for.
 fn check_calibrated_size(
-    c: &mut Checker,
+    c: &mut Problems,
     p: &str,
     s: &SensorSpec,
     model: &omniloop_vision::camera_model::CameraFile,

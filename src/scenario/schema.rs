@@ -5,6 +5,7 @@
 
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::DifferentialDrive;
+use omniloop_problem::Problem;
 use omniloop_robot::perception::CameraNeed;
 use omniloop_robot::{
     BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StageEntry,
@@ -646,11 +647,8 @@ impl Scenario {
     }
 
     /// The omnistereo rig of `vision.omnistereo`'s two sensors, or the field at fault and why.
-    pub fn stereo_rig(&self) -> Result<StereoRig, (String, String)> {
-        let o: OmnistereoConfig = self
-            .vision
-            .table("omnistereo")
-            .map_err(|e| (e.field, e.message))?;
+    pub fn stereo_rig(&self) -> Result<StereoRig, Problem> {
+        let o: OmnistereoConfig = self.vision.table("omnistereo")?;
         let cone = |key: &str, name: &str| {
             let field = format!("vision.omnistereo.{key}");
             let s = self
@@ -658,15 +656,17 @@ impl Scenario {
                 .sensors
                 .iter()
                 .find(|s| s.name == name)
-                .ok_or_else(|| (field.clone(), format!("the robot has no sensor {name:?}")))?;
+                .ok_or_else(|| {
+                    Problem::new(field.as_str(), format!("the robot has no sensor {name:?}"))
+                })?;
             let m = s.optics.conical().ok_or_else(|| {
-                (
-                    field.clone(),
+                Problem::new(
+                    field.as_str(),
                     format!("sensor {name:?} is not a conical mirror"),
                 )
             })?;
             if (m.apex_angle_deg - 90.0).abs() > 1e-9 {
-                return Err((
+                return Err(Problem::new(
                     field,
                     format!(
                         "eqs. (1)-(2) hold for 90-degree cones; {name:?} has {} degrees",
@@ -678,22 +678,22 @@ impl Scenario {
         };
         let (ls, lower) = cone("lower_sensor", &o.lower_sensor)?;
         let (us, upper) = cone("upper_sensor", &o.upper_sensor)?;
-        let field = || "vision.omnistereo.upper_sensor".to_string();
+        let field = || "vision.omnistereo.upper_sensor";
         if ls.mount_mm != us.mount_mm {
-            return Err((
+            return Err(Problem::new(
                 field(),
-                "the two cones must be coaxial (the same mount_mm)".into(),
+                "the two cones must be coaxial (the same mount_mm)",
             ));
         }
         if lower.radius_mm != upper.radius_mm || lower.tip_distance_mm != upper.tip_distance_mm {
-            return Err((
+            return Err(Problem::new(
                 field(),
-                "the two cones must be alike (radius_mm, tip_distance_mm)".into(),
+                "the two cones must be alike (radius_mm, tip_distance_mm)",
             ));
         }
         let s = upper.lens_height_mm - lower.lens_height_mm;
         if s <= 0.0 {
-            return Err((
+            return Err(Problem::new(
                 field(),
                 format!(
                     "must stand above the lower sensor (lens_height_mm {} <= {})",

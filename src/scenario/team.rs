@@ -9,9 +9,9 @@
 //! A problem in a key the entry writes is named `robots[K].KEY`; in a key it takes from the
 //! shared tables, by that table's path (`control.kind`), once for the whole team.
 
-use super::check::{Checker, FieldPath, PathSeg, Violation};
 use super::rules::validate;
 use super::schema::{OdometrySpec, RobotSpec, Scenario, TeamMember};
+use omniloop_problem::{FieldPath, PathSeg, Problem, Problems};
 use omniloop_robot::{ControlSpec, GoalSpec, VisionSpec};
 use serde::de::DeserializeOwned;
 use toml::{Table, Value};
@@ -26,7 +26,7 @@ const OWN_KEYS: [&str; 2] = ["name", "start"];
 
 /// The team of a scenario document: each entry of `[[robots]]` over the shared tables (empty
 /// without `[[robots]]`).
-pub fn resolve(doc: &Table) -> Result<Vec<TeamMember>, Vec<Violation>> {
+pub fn resolve(doc: &Table) -> Result<Vec<TeamMember>, Vec<Problem>> {
     let Some(Value::Array(entries)) = doc.get("robots") else {
         return Ok(Vec::new());
     };
@@ -53,7 +53,7 @@ pub fn resolve(doc: &Table) -> Result<Vec<TeamMember>, Vec<Violation>> {
 }
 
 /// Robot `k` of the team: `entry` over the shared tables of `doc`.
-fn member(doc: &Table, k: usize, entry: &Table) -> Result<TeamMember, Violation> {
+fn member(doc: &Table, k: usize, entry: &Table) -> Result<TeamMember, Problem> {
     let robot_keys: Table = entry
         .iter()
         .filter(|(key, _)| !SECTIONS.contains(&key.as_str()))
@@ -84,7 +84,7 @@ fn section<T: DeserializeOwned>(
     entry: &Table,
     name: &str,
     own: Option<&Table>,
-) -> Result<T, Violation> {
+) -> Result<T, Problem> {
     let mut merged = match doc.get(name) {
         Some(Value::Table(t)) => t.clone(),
         _ => Table::new(),
@@ -132,11 +132,8 @@ pub fn write_over(base: &mut Table, over: &Table) {
     }
 }
 
-fn violation(path: FieldPath, message: &str) -> Violation {
-    Violation {
-        path,
-        message: message.to_string(),
-    }
+fn violation(path: FieldPath, message: &str) -> Problem {
+    Problem::new(path, message)
 }
 
 /// Where a problem of robot `k` at `path` (in its one-robot form: `robot.KEY`,
@@ -179,28 +176,21 @@ fn writes_path(table: &Table, path: &[PathSeg]) -> bool {
 /// Every rule a team scenario breaks: each robot's, in its one-robot form, named where it is
 /// written (a shared table's problem once), and the team's own: names, starts apart, no
 /// experiment.
-pub fn validate_team(s: &Scenario) -> Vec<Violation> {
-    let mut out: Vec<Violation> = Vec::new();
+pub fn validate_team(s: &Scenario) -> Vec<Problem> {
+    let mut out = Problems::new();
     for (k, entry) in s.robots.iter().enumerate() {
-        for v in validate(&s.member(k)) {
-            let v = Violation {
-                path: attribute(entry, k, &v.path),
-                message: v.message,
-            };
-            if !out.contains(&v) {
-                out.push(v);
-            }
-        }
+        out.merge(validate(&s.member(k)).into_iter().map(|p| Problem {
+            field: attribute(entry, k, &p.field),
+            ..p
+        }));
     }
-    let mut c = Checker::new();
-    team_rules(s, &mut c);
-    out.extend(c.into_violations());
-    out
+    team_rules(s, &mut out);
+    out.into_vec()
 }
 
 /// The team's own rules: every robot named once, with a name fit for files and topics; no
 /// two robots overlapping at the start; no experiment.
-fn team_rules(s: &Scenario, c: &mut Checker) {
+fn team_rules(s: &Scenario, c: &mut Problems) {
     for (k, m) in s.team.iter().enumerate() {
         let field = format!("robots[{k}].name");
         if m.name.is_empty() {
@@ -241,7 +231,7 @@ fn team_rules(s: &Scenario, c: &mut Checker) {
 }
 
 /// No robot of the team starts overlapping another robot of the team or a scripted one.
-fn starts_apart(s: &Scenario, c: &mut Checker) {
+fn starts_apart(s: &Scenario, c: &mut Problems) {
     let others = s
         .other_robots
         .iter()
@@ -330,7 +320,7 @@ goal = { x_mm = 1.0, y_mm = 2.0 }
             "[robot]\nradius_mm = \"wide\"\n[[robots]]\nname = \"a\"\n[[robots]]\nname = \"b\"\nheight_mm = \"tall\"\n",
         );
         let problems = resolve(&doc).unwrap_err();
-        let paths: Vec<String> = problems.iter().map(|p| p.path.to_string()).collect();
+        let paths: Vec<String> = problems.iter().map(|p| p.field.to_string()).collect();
         assert_eq!(
             paths,
             ["robot.radius_mm", "robots[1].height_mm"],
@@ -338,7 +328,7 @@ goal = { x_mm = 1.0, y_mm = 2.0 }
         );
         let doc = table("[[robots]]\nname = \"a\"\nspeed = 3\n");
         let problems = resolve(&doc).unwrap_err();
-        assert_eq!(problems[0].path.to_string(), "robots[0].speed");
+        assert_eq!(problems[0].field.to_string(), "robots[0].speed");
         assert!(problems[0].message.contains("unknown field"));
     }
 

@@ -143,9 +143,9 @@ const MAX_RUNS: usize = 100_000;
 /// Builds and validates every run of `sets` x `seeds` over the scenario `file`.
 pub fn plan(file: &Path, sets: &[Set], seeds: &Seeds) -> Result<Plan, PlanError> {
     let base = load_scenario(file)?;
-    let text = std::fs::read_to_string(file).map_err(|source| LoadError::Io {
+    let text = std::fs::read_to_string(file).map_err(|reason| LoadError::Io {
         file: file.to_path_buf(),
-        source,
+        reason,
     })?;
     let doc: Table = toml::from_str(&text)
         .map_err(|e| PlanError::Invalid(vec![format!("{}: {}", file.display(), e.message())]))?;
@@ -272,7 +272,7 @@ fn combination(
                 };
                 match sets
                     .iter()
-                    .position(|s| !p.field.is_empty() && s.covers(&p.field))
+                    .position(|s| !p.field.is_empty() && s.covers(&p.field.to_string()))
                 {
                     Some(k) => format!(
                         "--set {}:1:{}: {} = {}: {what}",

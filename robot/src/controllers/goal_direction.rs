@@ -7,8 +7,8 @@ use crate::controller::{
     ControlTable, Controller, ControllerEntry, Situation, check_table, no_problems, settings,
     with_surroundings,
 };
-use crate::tables::{ConfigProblem, Problems};
 use omniloop_control::{AccelLimitedDrive, AvoidanceConfig, GoalDirection, SpeedChoice};
+use omniloop_problem::{Problem, Problems};
 
 /// The registry's entry.
 pub const ENTRY: ControllerEntry = ControllerEntry {
@@ -36,7 +36,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
 };
 
 /// Parses and checks `[control.avoidance]`.
-pub fn check_avoidance(spec: &ControlSpec) -> Vec<ConfigProblem> {
+pub fn check_avoidance(spec: &ControlSpec) -> Vec<Problem> {
     check_table(
         spec,
         "avoidance",

@@ -18,6 +18,7 @@ pub mod wander;
 use crate::RobotError;
 use crate::config::RobotConfig;
 use crate::controller::{Controller, ControllerEntry};
+use omniloop_problem::Problem;
 
 /// Every controller a scenario can name, in the order `omniloop run --print-default` lists
 /// them.
@@ -48,9 +49,9 @@ pub fn names() -> String {
 pub fn build(config: &RobotConfig) -> Result<Box<dyn Controller>, RobotError> {
     let kind = &config.control.kind;
     let entry = find(kind).ok_or_else(|| {
-        RobotError::Config(format!(
-            "control.kind: no controller {kind:?} (there are: {})",
-            names()
+        RobotError::Field(Problem::new(
+            "control.kind",
+            format!("no controller {kind:?} (there are: {})", names()),
         ))
     })?;
     (entry.build)(config)

@@ -22,9 +22,9 @@ use crate::config::ControlSpec;
 use crate::controller::{
     ControlTable, Controller, ControllerEntry, Situation, check_table, no_problems, settings,
 };
-use crate::tables::{ConfigProblem, Problems};
 use nalgebra::Vector2;
 use omniloop_control::wrap_pi;
+use omniloop_problem::{Problem, Problems};
 use omniloop_vision::FreeSpace;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
@@ -97,7 +97,7 @@ impl Default for WallFollowConfig {
 }
 
 /// Parses and checks `[control.wall_follow]`.
-fn check_wall_follow(spec: &ControlSpec) -> Vec<ConfigProblem> {
+fn check_wall_follow(spec: &ControlSpec) -> Vec<Problem> {
     check_table(
         spec,
         "wall_follow",

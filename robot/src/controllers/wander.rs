@@ -16,8 +16,8 @@ use crate::config::{ControlSpec, RobotConfig, WorldMap};
 use crate::controller::{
     ControlTable, Controller, ControllerEntry, Situation, check_table, settings,
 };
-use crate::tables::{ConfigProblem, Problems};
 use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_problem::{Problem, Problems};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Serialize};
@@ -35,7 +35,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     stages: &[],
     check_use: |c| {
         if c.map.segments.is_empty() && c.map.boxes.is_empty() {
-            return vec![ConfigProblem::new(
+            return vec![Problem::new(
                 "control.kind",
                 "\"wander\" drives on a map of the world's walls and pillars: the world has no walls",
             )];
@@ -71,7 +71,7 @@ impl Default for WanderConfig {
 }
 
 /// Parses and checks `[control.wander]`.
-fn check_wander(spec: &ControlSpec) -> Vec<ConfigProblem> {
+fn check_wander(spec: &ControlSpec) -> Vec<Problem> {
     check_table(spec, "wander", |w: &WanderConfig, p: &mut Problems| {
         p.positive("clearance_mm", w.clearance_mm);
         p.positive("turn_rate_deg_s", w.turn_rate_deg_s);
@@ -113,8 +113,9 @@ impl Wander {
             ("control.wander.turn_rate_deg_s", w.turn_rate_deg_s),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(RobotError::Config(format!(
-                    "{name} = {v}: must be positive"
+                return Err(RobotError::Field(Problem::new(
+                    name,
+                    format!("must be positive (got {v})"),
                 )));
             }
         }

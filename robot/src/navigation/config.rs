@@ -1,7 +1,7 @@
 //! The planner's settings, `[control.planner]`, and their check.
 
 use crate::config::ControlSpec;
-use crate::tables::{ConfigProblem, Problems};
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// Which planner chooses where the controller heads (`control.planner.kind`).
@@ -97,7 +97,7 @@ impl Default for PlannerConfig {
 pub const TABLE: &str = "planner";
 
 /// Parses and checks `[control.planner]`, naming each field at fault.
-pub fn check_planner(spec: &ControlSpec) -> Vec<ConfigProblem> {
+pub fn check_planner(spec: &ControlSpec) -> Vec<Problem> {
     spec.tables
         .check("control", TABLE, |c: &PlannerConfig, p: &mut Problems| {
             if !(c.cell_mm.is_finite() && (5.0..=200.0).contains(&c.cell_mm)) {

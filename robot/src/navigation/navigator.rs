@@ -49,6 +49,7 @@ use super::planner::{CostMap, CostSettings, Suspects, length};
 use crate::RobotError;
 use crate::config::RobotConfig;
 use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_problem::Problem;
 use omniloop_vision::FreeSpace;
 
 /// Strayed this far from the plan, the robot replans, mm.
@@ -781,12 +782,15 @@ fn grid_geometry(config: &RobotConfig, cell_mm: f64) -> Result<GridGeometry, Rob
     let hi = points.iter().fold(points[0], |a, p| a.sup(p)) + Vector2::repeat(pad);
     let g = GridGeometry::covering(lo, hi, cell_mm);
     if g.len() > MAX_CELLS {
-        return Err(RobotError::Config(format!(
-            "control.planner.cell_mm: a grid of {cell_mm} mm cells over {:.0} x {:.0} mm has {} \
-             cells, more than {MAX_CELLS}: raise cell_mm",
-            hi.x - lo.x,
-            hi.y - lo.y,
-            g.len()
+        return Err(RobotError::Field(Problem::new(
+            "control.planner.cell_mm",
+            format!(
+                "a grid of {cell_mm} mm cells over {:.0} x {:.0} mm has {} cells, more than \
+                 {MAX_CELLS}: raise cell_mm",
+                hi.x - lo.x,
+                hi.y - lo.y,
+                g.len()
+            ),
         )));
     }
     Ok(g)

@@ -11,7 +11,7 @@ use super::stage::{
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::estimates::{Measurement, NotFound};
-use crate::tables::Problems;
+use omniloop_problem::Problems;
 use omniloop_vision::{FloorLocalizer, Localization, LocalizationConfig, RadialCalibration};
 
 /// The stage's name, in the estimates record and the registry.
@@ -65,7 +65,7 @@ fn check(l: &LocalizationConfig, p: &mut Problems) {
         for (sub, r) in [("r", class.r), ("g", class.g)] {
             if !(0.0..=1.0).contains(&r[0]) || !(0.0..=1.0).contains(&r[1]) || r[0] > r[1] {
                 let why = format!("must be [min, max] within 0..1 (got [{}, {}])", r[0], r[1]);
-                p.fail(&format!("{key}.{sub}"), why);
+                p.fail(format!("{key}.{sub}"), why);
             }
         }
     }

@@ -6,7 +6,7 @@ use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::{RobotConfig, VisionSpec};
 use crate::percept::Percept;
-use crate::tables::ConfigProblem;
+use omniloop_problem::Problem;
 use omniloop_vision::forward::{
     FlowBalance, FlowConfig, ForwardCamera, ForwardOdometry, Grey, GroundConfig, GroundSegmenter,
     OdometryConfig, OdometryStep, grey, horn_schunck, reduce,
@@ -72,11 +72,11 @@ const TABLE: &str = "forward";
 
 /// The forward camera's stages, and the controllers that read them, need vision's camera to be
 /// a forward pinhole.
-pub fn needs_forward_camera(c: &RobotConfig) -> Vec<ConfigProblem> {
+pub fn needs_forward_camera(c: &RobotConfig) -> Vec<Problem> {
     if c.forward_camera.is_some() {
         return Vec::new();
     }
-    vec![ConfigProblem::new(
+    vec![Problem::new(
         "vision.sensor",
         "the forward camera's avoidance and visual odometry need vision's camera to be a \
          pinhole ([robot.sensors.pinhole])",
@@ -89,7 +89,7 @@ fn settings(c: &RobotConfig) -> Result<ForwardVisionConfig, RobotError> {
 }
 
 /// `[vision.forward]` parses.
-fn check_vision(v: &VisionSpec) -> Vec<ConfigProblem> {
+fn check_vision(v: &VisionSpec) -> Vec<Problem> {
     v.tables
         .check::<ForwardVisionConfig>("vision", TABLE, |_, _| {})
 }

@@ -9,9 +9,9 @@ use crate::boundary::Observation;
 use crate::config::RobotConfig;
 use crate::estimates::NotFound;
 use crate::percept::Percept;
-use crate::tables::{ConfigProblem, Problems};
 use image::RgbaImage;
 use nalgebra::Isometry2;
+use omniloop_problem::{Problem, Problems};
 use omniloop_vision::FreeSpace;
 use omniloop_vision::freespace::PolarTemplate;
 use omniloop_vision::image_centre::dark_disc_centre;
@@ -52,7 +52,7 @@ const TABLE: &str = "freespace";
 
 /// The polar template on vision's camera's calibration, when the settings are good and the
 /// calibration known.
-fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
+fn check(c: &RobotConfig) -> Vec<Problem> {
     let cal = c.vision_camera().and_then(|cam| c.calibration(cam));
     let fs = c.vision.table::<FreeSpaceConfig>(TABLE);
     let (Some(cal), Ok(fs)) = (cal, fs) else {
@@ -63,15 +63,15 @@ fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
     }
     match PolarTemplate::new(&fs, cal) {
         Ok(_) => Vec::new(),
-        Err(e) => vec![ConfigProblem::new("vision.freespace", e.to_string())],
+        Err(e) => vec![Problem::new("vision.freespace", e.to_string())],
     }
 }
 
 /// `[vision.freespace]`'s values, each problem naming its field.
-fn check_vision_values(fs: &FreeSpaceConfig) -> Vec<ConfigProblem> {
+fn check_vision_values(fs: &FreeSpaceConfig) -> Vec<Problem> {
     let mut p = Problems::under("vision.freespace");
     check_values(fs, &mut p);
-    p.list
+    p.into_vec()
 }
 
 /// `[vision.freespace]`'s values.

@@ -86,7 +86,10 @@ mod tests {
             spec.tables.0.insert(table.to_string(), stray);
             let problems = (entry.check_vision)(&spec);
             assert_eq!(problems.len(), 1, "{}: {problems:?}", entry.name);
-            assert_eq!(problems[0].field, format!("vision.{table}.no_such_key"));
+            assert_eq!(
+                problems[0].field.to_string(),
+                format!("vision.{table}.no_such_key")
+            );
         }
     }
 }

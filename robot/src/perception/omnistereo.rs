@@ -19,9 +19,9 @@ use crate::boundary::Observation;
 use crate::config::{MapLandmark, StereoRig};
 use crate::estimates::{Measurement, NotFound};
 use crate::percept::Percept;
-use crate::tables::ConfigProblem;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Vector2};
+use omniloop_problem::Problem;
 use omniloop_vision::VisionError;
 use omniloop_vision::omnistereo::{
     AngularProfile, FeaturePair, LandmarkRange, MirrorRim, OmnistereoConfig, RangedMark,
@@ -59,7 +59,7 @@ pub const ENTRY: StageEntry = StageEntry {
         if c.map.landmarks.is_empty() {
             let why = "omnistereo trilateration needs landmarks: add [[world.pillars]] of \
                        distinct colours";
-            p.push(ConfigProblem::new("control.pose_source", why));
+            p.push(Problem::new("control.pose_source", why));
         }
         p
     },

@@ -28,8 +28,8 @@ use crate::RobotError;
 use crate::boundary::{ActuatorCommand, ActuatorState, Observation};
 use crate::config::{MapMark, RobotConfig};
 use crate::estimates::{Measurement, NotFound};
-use crate::tables::{ConfigProblem, Problems};
 use nalgebra::{Isometry2, Point2, Vector2};
+use omniloop_problem::{Problem, Problems};
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::resection::{
     ColumnCalibration, MarkBearing, ResectionConfig, StripePattern, find_marks, find_marks_ring,
@@ -68,7 +68,7 @@ pub const ENTRY: StageEntry = StageEntry {
 };
 
 /// `[control.resection]` and the map's marks.
-fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
+fn check(c: &RobotConfig) -> Vec<Problem> {
     let mut out = Vec::new();
     match c.control.table::<SearchConfig>("resection") {
         Err(e) => out.push(e),
@@ -80,7 +80,7 @@ fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
                 let why = format!("must be in (0, 1] (got {})", r.central_fraction);
                 p.fail("central_fraction", why);
             }
-            out.extend(p.list);
+            out.extend(p);
         }
     }
     if c.map.marks.len() != 3 {
@@ -88,7 +88,7 @@ fn check(c: &RobotConfig) -> Vec<ConfigProblem> {
             "resection needs exactly three marks: name three [[world.boards]] (found {})",
             c.map.marks.len()
         );
-        out.push(ConfigProblem::new("control.pose_source", why));
+        out.push(Problem::new("control.pose_source", why));
     }
     out
 }

@@ -7,9 +7,9 @@ use crate::boundary::{ActuatorCommand, Observation};
 use crate::config::{RobotConfig, VisionSpec};
 use crate::estimates::{Measurement, NotFound};
 use crate::percept::{Percept, Percepts};
-use crate::tables::ConfigProblem;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Point2};
+use omniloop_problem::Problem;
 use omniloop_vision::{LocalizationQuality, RadialCalibration};
 
 /// What the stages of one cycle found: their outputs by type, fixes for the estimator, the
@@ -126,7 +126,7 @@ pub struct StageEntry {
     pub vision_table: Option<&'static str>,
     /// Parses and checks that table's values wherever it is written, naming each field at
     /// fault.
-    pub check_vision: fn(&VisionSpec) -> Vec<ConfigProblem>,
+    pub check_vision: fn(&VisionSpec) -> Vec<Problem>,
     /// Whether the robot's configuration asks for it (besides a controller that reads it).
     pub asked: fn(&RobotConfig) -> bool,
     /// What it needs of vision's camera.
@@ -136,7 +136,7 @@ pub struct StageEntry {
     pub world: &'static [WorldNeed],
     /// Checks what it needs of the robot (its camera, the map, its settings on that camera),
     /// naming each field at fault; its vision table's own values are `check_vision`'s.
-    pub check: fn(&RobotConfig) -> Vec<ConfigProblem>,
+    pub check: fn(&RobotConfig) -> Vec<Problem>,
     /// Builds it for a robot.
     pub build: fn(&RobotConfig) -> Result<Box<dyn Stage>, RobotError>,
 }

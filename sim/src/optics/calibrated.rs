@@ -15,9 +15,9 @@
 //! `u = c_u + X`, `v = c_v - Y`, the sensor's principal point being the model's plus half a
 //! pixel ([`CalibratedCamera::principal_point_px`]).
 
-use super::problems::Problems;
 use super::ray::Ray;
 use nalgebra::{Matrix3, Point3};
+use omniloop_problem::{Problem, Problems};
 use omniloop_vision::VisionError;
 use omniloop_vision::camera_model::{CameraFile, FORMATS, read_camera_file};
 use serde::{Deserialize, Serialize};
@@ -147,8 +147,8 @@ impl CalibratedCamera {
     }
 
     /// Its numbers that break a rule: the key and why.
-    pub fn problems(&self) -> Vec<(&'static str, String)> {
-        let mut p = Problems::default();
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::new();
         if !FORMATS.contains(&self.format.as_str()) {
             p.fail(
                 "format",
@@ -191,7 +191,7 @@ impl CalibratedCamera {
                 "must be a rotation (orthonormal rows, determinant 1)",
             );
         }
-        p.0
+        p.into_vec()
     }
 
     /// How far the viewpoint is from the sensor's axis, horizontally.
@@ -254,7 +254,7 @@ mod tests {
             rotation: Some([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0]]),
             ..c
         };
-        assert_eq!(bent.problems()[0].0, "rotation");
+        assert_eq!(bent.problems()[0].field.to_string(), "rotation");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

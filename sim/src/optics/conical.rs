@@ -8,9 +8,9 @@
 //! `h1 - h2 = v s / (r + d)`, which is eq. (1) `r = v s / (h1 - h2) - d`, and the rim images at
 //! `r_m = v R / (d + R)`, eq. (2) `v = (d / R + 1) r_m`.
 
-use super::problems::Problems;
 use super::ray::{Ray, reflect};
 use nalgebra::{Point3, Vector3};
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// A conical mirror above a camera looking up.
@@ -36,8 +36,8 @@ fn default_apex() -> f64 {
 
 impl ConicalMirror {
     /// Its numbers that break a rule: the key and why.
-    pub fn problems(&self) -> Vec<(&'static str, String)> {
-        let mut p = Problems::default();
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::new();
         if !(self.apex_angle_deg > 0.0 && self.apex_angle_deg < 180.0) {
             let why = format!("must lie in (0, 180) (got {})", self.apex_angle_deg);
             p.fail("apex_angle_deg", why);
@@ -46,7 +46,7 @@ impl ConicalMirror {
         p.positive("tip_distance_mm", self.tip_distance_mm);
         p.positive("focal_px", self.focal_px);
         p.positive("lens_height_mm", self.lens_height_mm);
-        p.0
+        p.into_vec()
     }
 
     /// The scene ray for image coordinates `(X, Y)`; `None` outside the rim.

@@ -6,9 +6,9 @@
 //! the floor. For such a mirror the image-to-floor map has the form
 //! `r = f(R) = R / (A - B sqrt(C + R^2))` (Sect. 5 of the corner paper, model of Yagi [6]).
 
-use super::problems::Problems;
 use super::ray::{Ray, reflect, solve_quadratic};
 use nalgebra::{Point3, Vector3};
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// A hyperboloidal mirror with its camera at the outer focus.
@@ -32,8 +32,8 @@ pub struct HyperbolicMirror {
 
 impl HyperbolicMirror {
     /// Its numbers that break a rule: the key and why.
-    pub fn problems(&self) -> Vec<(&'static str, String)> {
-        let mut p = Problems::default();
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::new();
         for (k, v) in [
             ("a_mm", self.a_mm),
             ("b_mm", self.b_mm),
@@ -57,7 +57,7 @@ impl HyperbolicMirror {
                 "puts the camera (2 c below the focus) under the floor",
             );
         }
-        p.0
+        p.into_vec()
     }
 
     /// The mirror reconstructed from the corner paper's calibration (`docs/experiments.md`):

@@ -15,7 +15,6 @@ pub mod conical;
 pub mod hyperbolic;
 pub mod mounting;
 pub mod pinhole;
-pub mod problems;
 pub mod ray;
 pub mod spherical;
 
@@ -23,6 +22,7 @@ pub use calibrated::CalibratedCamera;
 pub use conical::ConicalMirror;
 pub use hyperbolic::HyperbolicMirror;
 pub use mounting::{MirrorFrame, MirrorMounting};
+use omniloop_problem::{Problem, Problems};
 pub use pinhole::PinholeCamera;
 pub use ray::{Ray, reflect, solve_quadratic};
 pub use spherical::SphericalMirror;
@@ -67,9 +67,9 @@ impl Optics {
         }
     }
 
-    /// Its numbers that break a rule: the field under the sensor (`hyperbolic.c_mm`) and what
-    /// is wrong, each mirror checking its own.
-    pub fn problems(&self) -> Vec<(String, String)> {
+    /// Its numbers that break a rule, each naming its field under the sensor
+    /// (`hyperbolic.c_mm`), each mirror checking its own.
+    pub fn problems(&self) -> Vec<Problem> {
         let list = match self {
             Optics::Hyperbolic(m) => m.problems(),
             Optics::Conical(m) => m.problems(),
@@ -77,10 +77,9 @@ impl Optics {
             Optics::Pinhole(c) => c.problems(),
             Optics::Calibrated(c) => c.problems(),
         };
-        let table = self.kind();
-        list.into_iter()
-            .map(|(key, why)| (format!("{table}.{key}"), why))
-            .collect()
+        let mut p = Problems::under(self.kind());
+        p.extend(list);
+        p.into_vec()
     }
 
     /// The pinhole camera, when the optics are one.

@@ -13,6 +13,7 @@
 
 use super::ray::{Ray, reflect, solve_quadratic};
 use nalgebra::{Point3, Rotation3, Unit, Vector3};
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// How the mirror is off its nominal place; the default is where it should be.
@@ -43,29 +44,26 @@ impl MirrorMounting {
         Rotation3::from_axis_angle(&axis, self.mirror_tilt_deg.to_radians())
     }
 
-    /// Its values that break a rule: the key and why.
-    pub fn problems(&self) -> Vec<(&'static str, String)> {
-        let mut p = Vec::new();
+    /// Its values that break a rule, each naming its key.
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::new();
         if !(self.mirror_tilt_deg.is_finite() && (0.0..=30.0).contains(&self.mirror_tilt_deg)) {
-            p.push((
+            p.fail(
                 "mirror_tilt_deg",
                 format!("must lie in [0, 30] (got {})", self.mirror_tilt_deg),
-            ));
+            );
         }
         if !self.tilt_azimuth_deg.is_finite() {
-            p.push(("tilt_azimuth_deg", "must be a finite number".to_string()));
+            p.fail("tilt_azimuth_deg", "must be a finite number");
         }
         if self
             .mirror_offset_mm
             .iter()
             .any(|v| !v.is_finite() || v.abs() > 100.0)
         {
-            p.push((
-                "mirror_offset_mm",
-                "must be three numbers within 100 mm".to_string(),
-            ));
+            p.fail("mirror_offset_mm", "must be three numbers within 100 mm");
         }
-        p
+        p.into_vec()
     }
 }
 

@@ -1,9 +1,9 @@
 //! A plain pinhole camera on the robot, panned about the vertical and tilted about its own
 //! horizontal axis (for forward-looking experiments).
 
-use super::problems::Problems;
 use super::ray::Ray;
 use nalgebra::{Point3, Vector3};
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// A pinhole camera looking out from the robot.
@@ -31,8 +31,8 @@ fn default_pan_rate() -> f64 {
 
 impl PinholeCamera {
     /// Its numbers that break a rule: the key and why.
-    pub fn problems(&self) -> Vec<(&'static str, String)> {
-        let mut p = Problems::default();
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::new();
         p.positive("focal_px", self.focal_px);
         p.positive("height_mm", self.height_mm);
         p.positive("pan_rate_limit_deg_s", self.pan_rate_limit_deg_s);
@@ -48,7 +48,7 @@ impl PinholeCamera {
                 format!("must lie in [-90, 90] (got {})", self.tilt_deg),
             );
         }
-        p.0
+        p.into_vec()
     }
 
     /// Forward, right and up unit vectors of the camera in the robot frame.

@@ -3,9 +3,9 @@
 //! A ball of radius `radius_mm` with its centre `camera_distance_mm` above the camera's pinhole;
 //! the camera sees its lower half. Non-central: the scene rays do not share a viewpoint.
 
-use super::problems::Problems;
 use super::ray::{Ray, reflect, solve_quadratic};
 use nalgebra::{Point3, Vector3};
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// A spherical mirror above a camera looking up.
@@ -24,8 +24,8 @@ pub struct SphericalMirror {
 
 impl SphericalMirror {
     /// Its numbers that break a rule: the key and why.
-    pub fn problems(&self) -> Vec<(&'static str, String)> {
-        let mut p = Problems::default();
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::new();
         p.positive("radius_mm", self.radius_mm);
         p.positive("focal_px", self.focal_px);
         p.positive("lens_height_mm", self.lens_height_mm);
@@ -36,7 +36,7 @@ impl SphericalMirror {
                 format!("must exceed radius_mm = {r} (got {d})"),
             );
         }
-        p.0
+        p.into_vec()
     }
 
     /// The scene ray for image coordinates `(X, Y)`; `None` when the camera ray misses the ball.

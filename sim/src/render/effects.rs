@@ -15,6 +15,7 @@ use super::error::RenderError;
 use super::noise::{self, FrameNoise};
 use image::RgbaImage;
 use nalgebra::{Isometry2, Vector2};
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// A sensor's camera effects; the default is a perfect camera.
@@ -73,12 +74,12 @@ impl CameraEffects {
         }
     }
 
-    /// Its values that break a rule: the key and why.
-    pub fn problems(&self) -> Vec<(&'static str, String)> {
-        let mut p = Vec::new();
-        let mut check = |key: &'static str, v: f64, ok: bool, rule: &str| {
+    /// Its values that break a rule, each naming its key.
+    pub fn problems(&self) -> Vec<Problem> {
+        let mut p = Problems::new();
+        let mut check = |key: &str, v: f64, ok: bool, rule: &str| {
             if !(v.is_finite() && ok) {
-                p.push((key, format!("must be {rule} (got {v})")));
+                p.fail(key, format!("must be {rule} (got {v})"));
             }
         };
         check(
@@ -107,18 +108,18 @@ impl CameraEffects {
             ">= 0",
         );
         if !(1..=64).contains(&self.exposure_samples) {
-            p.push((
+            p.fail(
                 "exposure_samples",
                 format!("must be 1..=64 (got {})", self.exposure_samples),
-            ));
+            );
         }
         if self.jpeg_quality > 100 {
-            p.push((
+            p.fail(
                 "jpeg_quality",
                 format!("must be 0 (raw) or 1..=100 (got {})", self.jpeg_quality),
-            ));
+            );
         }
-        p
+        p.into_vec()
     }
 }
 
