@@ -6,7 +6,7 @@ use super::schema::{PilotChoice, Scenario, TimingSpec};
 use nalgebra::Point2;
 use omniloop_problem::{FieldPath, Problem, Problems};
 use omniloop_robot::controllers::{self, CONTROLLERS};
-use omniloop_robot::perception::{self, CameraNeed, STAGES};
+use omniloop_robot::perception::{self, CameraNeed, STAGES, WorldNeed};
 use omniloop_robot::{ControllerEntry, RobotConfig, StageEntry};
 use omniloop_sim::optics::Optics;
 use omniloop_sim::{Layout, SensorSpec};
@@ -405,22 +405,29 @@ fn unknown_table<'a>(
     c.fail(format!("{section}.{name}"), why);
 }
 
-/// What the stages need of the world that the robot is not told (its map holds the rest).
+/// What the stages need of the world that the robot is not told (its map holds the rest), as
+/// their registry entries declare it ([`WorldNeed`]).
 fn check_world_for(c: &mut Problems, s: &Scenario, stages: &[&'static StageEntry]) {
-    let runs = |name: &str| stages.iter().any(|e| e.name == name);
-    if runs("floor_localization") && s.world.field.is_none() {
-        c.fail(
-            "control.pose_source",
-            "self-localization matches the floor region to the field: add [world.field]",
-        );
+    let mut needs: Vec<WorldNeed> = Vec::new();
+    for need in stages.iter().flat_map(|e| e.world) {
+        if !needs.contains(need) {
+            needs.push(*need);
+        }
     }
-    if runs("omnistereo")
-        && let Err(p) = s.stereo_rig()
-    {
-        c.extend([p]);
-    }
-    if runs("resection") {
-        check_resection_camera(c, s);
+    for need in needs {
+        match need {
+            WorldNeed::Field if s.world.field.is_none() => c.fail(
+                "control.pose_source",
+                "self-localization matches the floor region to the field: add [world.field]",
+            ),
+            WorldNeed::Field => {}
+            WorldNeed::StereoRig => {
+                if let Err(p) = s.stereo_rig() {
+                    c.extend([p]);
+                }
+            }
+            WorldNeed::ResectionCamera => check_resection_camera(c, s),
+        }
     }
 }
 
