@@ -28,7 +28,8 @@ pub trait Metrics: Serialize + DeserializeOwned {
     }
 
     /// The metrics of `summary`, if its experiment wrote these (`None`: another experiment's,
-    /// or none).
+    /// or none; a struct whose every field may be absent reads from any summary, its fields
+    /// `None`).
     fn of(summary: &Summary) -> Option<Self> {
         Self::deserialize(&summary.experiment).ok()
     }
