@@ -5,6 +5,8 @@ mod common;
 
 use common::{cpu, omniloop, scenario, tmp};
 use omniloop::Summary;
+use omniloop::experiments::Metrics;
+use omniloop::experiments::corner::CornerMetrics;
 use omniloop::run_scenario;
 use std::path::Path;
 
@@ -31,10 +33,10 @@ fn both_controllers_turn_the_corner_and_the_velocity_aware_one_turns_earlier_and
         let e = m.freespace_error_mm.unwrap();
         assert!(e < 40.0, "median free-space error {e} mm");
     }
-    let onset = |m: &Summary| m.metric("turn_onset_mm").unwrap();
+    let onset = |m: &Summary| CornerMetrics::of(m).unwrap().turn_onset_mm.unwrap();
     let (gd_onset, va_onset) = (onset(&gd), onset(&va));
     assert!(va_onset > gd_onset, "turn onset {va_onset} vs {gd_onset}");
-    let over = |m: &Summary| m.metric("overshoot_mm").unwrap();
+    let over = |m: &Summary| CornerMetrics::of(m).unwrap().overshoot_mm.unwrap();
     let (gd_over, va_over) = (over(&gd), over(&va));
     assert!(va_over < gd_over, "overshoot {va_over} vs {gd_over}");
 }

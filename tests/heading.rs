@@ -6,7 +6,8 @@ mod common;
 
 use common::{cpu, scenario};
 use nalgebra::{Isometry2, Vector2};
-use omniloop::experiments::heading::heading_results;
+use omniloop::experiments::Metrics;
+use omniloop::experiments::heading::HeadingMetrics;
 use omniloop::run_scenario;
 use omniloop::scenario::calibrate::calibrate_sensor;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
@@ -16,7 +17,7 @@ use omniloop_vision::luminance_heading::{LuminanceConfig, near_ring};
 fn e3_turns_are_read_within_a_degree_and_translations_turn_na() {
     let s = scenario("heading_room.toml");
     let out = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
-    let h = heading_results(&out.summary).unwrap();
+    let h = HeadingMetrics::of(&out.summary).unwrap();
     eprintln!("{h:#?}");
     // The paper's turns, 20 noisy frames each: every frame within +-1 degree, none N/A.
     assert_eq!(h.rotations.len(), 3);

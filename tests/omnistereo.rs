@@ -7,18 +7,16 @@ mod common;
 
 use common::{cpu, omniloop, scenario, scenario_path, tmp};
 use nalgebra::{Isometry2, Vector2};
+use omniloop::experiments::Metrics;
+use omniloop::experiments::omnistereo::OmnistereoMetrics;
 use omniloop::run_scenario;
 use omniloop_sim::optics::Optics;
 use omniloop_sim::{Renderer, Scene, SensorNoise, World};
 use omniloop_vision::omnistereo::{AngularProfile, CompassConfig, MirrorRim};
 
-/// The experiment's metric `key`'s statistic `q` (median, p95, n).
-fn stat(m: &omniloop::run::record::Summary, key: &str, q: &str) -> f64 {
-    m.experiment
-        .get(key)
-        .and_then(|v| v.get(q))
-        .and_then(serde_json::Value::as_f64)
-        .unwrap_or_else(|| panic!("{key}.{q} missing: {:?}", m.experiment))
+/// The experiment's metrics of a run.
+fn metrics(m: &omniloop::run::record::Summary) -> OmnistereoMetrics {
+    OmnistereoMetrics::of(m).unwrap_or_else(|| panic!("no E4 metrics: {m:?}"))
 }
 
 #[test]
@@ -27,21 +25,25 @@ fn e4_wander_of_450_frames_meets_the_targets() {
     let out = run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
     let m = &out.summary;
     eprintln!("{}", omniloop::experiments::omnistereo::omnistereo_table(m));
-    assert_eq!(m.experiment["frames"], 450);
+    let e = metrics(m);
+    assert_eq!(e.frames, 450);
     assert_eq!(m.wall_contacts, 0);
     // It wandered (450 frames at 300 mm/s are 6.75 m without turns), and every frame ranged
     // pillars.
     assert!(m.path_length_mm > 3000.0, "{}", m.path_length_mm);
-    assert!(stat(m, "range_error_pct", "n") > 3.0 * 450.0);
-    assert!(stat(m, "range_error_pct", "median") <= 1.0);
-    assert!(stat(m, "range_error_pct", "p95") <= 3.0);
-    assert!(stat(m, "trilateration_error_mm", "n") >= 400.0);
-    assert!(stat(m, "trilateration_error_mm", "median") <= 40.0);
-    assert!(stat(m, "trilateration_error_mm", "p95") <= 100.0);
-    assert_eq!(stat(m, "compass_error_deg", "n"), 449.0);
-    assert!(stat(m, "compass_error_deg", "median") <= 0.3);
-    assert!(stat(m, "interframe_translation_error_mm", "n") >= 400.0);
-    assert!(stat(m, "interframe_translation_error_mm", "median") <= 10.0);
+    let range = e.range_error_pct.stats;
+    assert!(range.n > 3 * 450, "{range:?}");
+    assert!(range.median.unwrap() <= 1.0, "{range:?}");
+    assert!(range.p95.unwrap() <= 3.0, "{range:?}");
+    let tri = e.trilateration_error_mm;
+    assert!(tri.n >= 400, "{tri:?}");
+    assert!(tri.median.unwrap() <= 40.0, "{tri:?}");
+    assert!(tri.p95.unwrap() <= 100.0, "{tri:?}");
+    assert_eq!(e.compass_error_deg.n, 449);
+    assert!(e.compass_error_deg.median.unwrap() <= 0.3, "{e:?}");
+    let interframe = e.interframe_translation_error_mm;
+    assert!(interframe.n >= 400, "{interframe:?}");
+    assert!(interframe.median.unwrap() <= 10.0, "{interframe:?}");
     // The robot drove on its estimate: it stayed well inside the 200 mm clearance the wander
     // keeps from the map's obstacles.
     let worst = out
@@ -111,10 +113,12 @@ fn e4_holds_its_targets_at_noise_sigma_8() {
         "{}",
         omniloop::experiments::omnistereo::omnistereo_table(&m)
     );
-    assert!(stat(&m, "range_error_pct", "n") > 3.0 * 150.0);
-    assert!(stat(&m, "range_error_pct", "median") <= 1.0);
-    assert!(stat(&m, "range_error_pct", "p95") <= 3.0);
-    assert!(stat(&m, "trilateration_error_mm", "median") <= 40.0);
+    let e = metrics(&m);
+    let range = e.range_error_pct.stats;
+    assert!(range.n > 3 * 150, "{range:?}");
+    assert!(range.median.unwrap() <= 1.0, "{range:?}");
+    assert!(range.p95.unwrap() <= 3.0, "{range:?}");
+    assert!(e.trilateration_error_mm.median.unwrap() <= 40.0, "{e:?}");
 }
 
 #[test]
@@ -206,8 +210,9 @@ fn e4_ranges_pillars_through_a_defocused_lens() {
     );
     // Fewer pillars are ranged than sharp (347 ranges and 57 fixes in 150 frames, against
     // about 600 and 150), but more than one a frame, within the targets.
-    assert!(stat(&m, "range_error_pct", "n") >= 150.0);
-    assert!(stat(&m, "trilateration_error_mm", "n") >= 30.0);
-    assert!(stat(&m, "range_error_pct", "median") <= 1.0);
-    assert!(stat(&m, "trilateration_error_mm", "median") <= 40.0);
+    let e = metrics(&m);
+    assert!(e.range_error_pct.stats.n >= 150, "{e:?}");
+    assert!(e.trilateration_error_mm.n >= 30, "{e:?}");
+    assert!(e.range_error_pct.stats.median.unwrap() <= 1.0, "{e:?}");
+    assert!(e.trilateration_error_mm.median.unwrap() <= 40.0, "{e:?}");
 }

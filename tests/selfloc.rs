@@ -6,7 +6,7 @@
 mod common;
 
 use common::{cpu, omniloop, scenario, tmp};
-use omniloop::experiments::localization_map::mode_stats;
+use omniloop::experiments::localization_map::{Mode, mode_stats};
 use omniloop::experiments::places::PlacesSpec;
 use omniloop::experiments::places::{place_results, places_table};
 use omniloop::run::record::Summary;
@@ -133,8 +133,8 @@ fn the_replay_maps_the_whole_field_in_both_modes_with_no_gross_error() {
     }
     let text = std::fs::read_to_string(out.join("map/summary.json")).unwrap();
     let m: Summary = serde_json::from_str(&text).unwrap();
-    let global = mode_stats(&m, "global").unwrap();
-    let tracking = mode_stats(&m, "tracking").unwrap();
+    let global = mode_stats(&m, Mode::Global).unwrap();
+    let tracking = mode_stats(&m, Mode::Tracking).unwrap();
     eprintln!("global: {global:?}\ntracking: {tracking:?}");
     // The grid covers the floor region at 150 mm, four headings a point: some hundreds of
     // places, each one row per mode in the CSV.

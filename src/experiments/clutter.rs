@@ -10,7 +10,7 @@
 //! (`path_ratio`: the path's length over the shortest way into the goal's tolerance circle,
 //! `straight_mm - goal_tolerance_mm`) to `summary.json`.
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use crate::run::{RunError, RunOutput};
 use crate::scenario::{PoseSpec, Problems, Scenario};
 use nalgebra::{Point2, Rotation2, Vector2};
@@ -295,28 +295,103 @@ struct Clutter {
     goal: Option<(Point2<f64>, f64)>,
 }
 
-impl Experiment for Clutter {
-    fn metrics(&self, out: &RunOutput) -> Metrics {
-        let mut m = Metrics::new();
+/// The benchmark's metrics (`summary.json`: `straight_mm`, `path_ratio`, each left out when
+/// `None`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ClutterMetrics {
+    /// Straight-line distance from the start to the goal, mm (`None`: no goal or no cycle).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub straight_mm: Option<f64>,
+    /// The path's length over `straight_mm` less the goal's tolerance (`None`: the goal was
+    /// not reached, or the start was within the tolerance).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub path_ratio: Option<f64>,
+}
+
+impl Metrics for ClutterMetrics {}
+
+impl Clutter {
+    /// The metrics of a finished run.
+    fn measure(&self, out: &RunOutput) -> ClutterMetrics {
         let (Some(first), Some((goal, tolerance))) = (out.trajectory.first(), self.goal) else {
-            return m;
+            return ClutterMetrics {
+                straight_mm: None,
+                path_ratio: None,
+            };
         };
         let straight = (goal - Point2::new(first.x_mm, first.y_mm)).norm();
-        m.insert("straight_mm".into(), straight.into());
         let shortest = straight - tolerance;
-        if out.summary.reached_goal && shortest > 0.0 {
-            m.insert(
-                "path_ratio".into(),
-                (out.summary.path_length_mm / shortest).into(),
-            );
+        ClutterMetrics {
+            straight_mm: Some(straight),
+            path_ratio: (out.summary.reached_goal && shortest > 0.0)
+                .then(|| out.summary.path_length_mm / shortest),
         }
-        m
+    }
+}
+
+impl Experiment for Clutter {
+    fn metrics(&self, out: &RunOutput) -> MetricKeys {
+        self.measure(out).keys()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiments::experiment::tests::{round_trip, summary_with};
+    use crate::run::record::TrajectoryRow;
+
+    /// A run from (0, 0) whose path was `path_mm` long, its goal reached or not.
+    fn output(reached_goal: bool, path_mm: f64) -> RunOutput {
+        let mut summary = summary_with(MetricKeys::new());
+        summary.reached_goal = reached_goal;
+        summary.path_length_mm = path_mm;
+        RunOutput {
+            summary,
+            trajectory: vec![TrajectoryRow {
+                t_s: 0.0,
+                x_mm: 0.0,
+                y_mm: 0.0,
+                theta_rad: 0.0,
+                vx_mm_s: 0.0,
+                vy_mm_s: 0.0,
+                cmd_vx_mm_s: 0.0,
+                cmd_vy_mm_s: 0.0,
+                est_x_mm: None,
+                est_y_mm: None,
+                est_theta_rad: None,
+            }],
+            estimates: Vec::new(),
+            floor_scores: Vec::new(),
+            other_paths: Vec::new(),
+            files: Vec::new(),
+            map: None,
+            robots: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_path_ratio_is_written_only_for_a_goal_reached_and_reads_back() {
+        let c = Clutter {
+            goal: Some((Point2::new(1000.0, 0.0), 100.0)),
+        };
+        let m = c.measure(&output(true, 1350.0));
+        assert_eq!(m.straight_mm, Some(1000.0));
+        assert_eq!(m.path_ratio, Some(1.5));
+        let s = round_trip(&m);
+        assert_eq!(
+            serde_json::to_string(&s.experiment).unwrap(),
+            r#"{"straight_mm":1000.0,"path_ratio":1.5}"#
+        );
+        let missed = c.measure(&output(false, 1350.0));
+        let s = round_trip(&missed);
+        assert_eq!(
+            serde_json::to_string(&s.experiment).unwrap(),
+            r#"{"straight_mm":1000.0}"#
+        );
+        let no_goal = Clutter { goal: None }.measure(&output(true, 1350.0));
+        assert_eq!(round_trip(&no_goal).experiment.len(), 0);
+    }
 
     #[test]
     fn a_seed_gives_one_layout_with_start_and_goal_apart_and_clear() {

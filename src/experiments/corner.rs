@@ -2,7 +2,7 @@
 //! corner of any angle and width to a goal; the turn is measured along the first leg. Its replay, `corner55`, runs the
 //! 55-degree corner with both avoidance controllers.
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use super::replay::{Replay, ReplayContext, ReplayRun, write_text};
 use crate::report::topview::{Marker, Panel, PathLayer, draw_panels};
 use crate::run::record::{Summary, TrajectoryRow};
@@ -146,15 +146,19 @@ impl ExperimentSetup for CornerSpec {
     }
 }
 
-/// The E1 metrics of a trajectory.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The E1 metrics of a trajectory (`summary.json`: `turn_onset_mm`, left out when `None`, and
+/// `overshoot_mm`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CornerMetrics {
     /// `(K - p).u1` at the first cycle, after `v.u1` exceeded 200 mm/s, where `v.u1` falls below
     /// 75% of its running maximum; `None` if that never happens.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
     pub turn_onset_mm: Option<f64>,
-    /// `max (p - K).u1` over the run.
-    pub overshoot_mm: f64,
+    /// `max (p - K).u1` over the run (`None`, written as `null`: no trajectory).
+    pub overshoot_mm: Option<f64>,
 }
+
+impl Metrics for CornerMetrics {}
 
 /// The E1 metrics of a trajectory around the corner `k` with first-leg direction `u1` (unit).
 pub fn corner_metrics(rows: &[TrajectoryRow], k: Vector2<f64>, u1: Vector2<f64>) -> CornerMetrics {
@@ -177,7 +181,7 @@ pub fn corner_metrics(rows: &[TrajectoryRow], k: Vector2<f64>, u1: Vector2<f64>)
     }
     CornerMetrics {
         turn_onset_mm: onset,
-        overshoot_mm: overshoot,
+        overshoot_mm: overshoot.is_finite().then_some(overshoot),
     }
 }
 
@@ -186,15 +190,9 @@ pub fn corner_metrics(rows: &[TrajectoryRow], k: Vector2<f64>, u1: Vector2<f64>)
 pub struct Corner;
 
 impl Experiment for Corner {
-    fn metrics(&self, out: &RunOutput) -> Metrics {
+    fn metrics(&self, out: &RunOutput) -> MetricKeys {
         // The metric frame: K at the origin, leg 1 along +x.
-        let m = corner_metrics(&out.trajectory, Vector2::zeros(), Vector2::x());
-        let mut keys = Metrics::new();
-        if let Some(onset) = m.turn_onset_mm {
-            keys.insert("turn_onset_mm".into(), onset.into());
-        }
-        keys.insert("overshoot_mm".into(), m.overshoot_mm.into());
-        keys
+        corner_metrics(&out.trajectory, Vector2::zeros(), Vector2::x()).keys()
     }
 }
 
@@ -289,6 +287,16 @@ fn draw_comparison(file: &Path, runs: &[ReplayRun]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The turn onset of a run's summary, if it has one.
+fn onset(m: &Summary) -> Option<f64> {
+    CornerMetrics::of(m)?.turn_onset_mm
+}
+
+/// The overshoot of a run's summary, if it has one.
+fn overshoot(m: &Summary) -> Option<f64> {
+    CornerMetrics::of(m)?.overshoot_mm
+}
+
 fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     v.map_or("-".to_string(), |x| format!("{x:.digits$}"))
 }
@@ -318,8 +326,8 @@ pub fn corner_table(runs: &[ReplayRun]) -> String {
         ("reached_goal", |m| m.reached_goal.to_string()),
         ("wall_contacts", |m| m.wall_contacts.to_string()),
         ("time_to_goal_s", |m| fmt_opt(m.time_to_goal_s, 2)),
-        ("turn_onset_mm", |m| fmt_opt(m.metric("turn_onset_mm"), 1)),
-        ("overshoot_mm", |m| fmt_opt(m.metric("overshoot_mm"), 1)),
+        ("turn_onset_mm", |m| fmt_opt(onset(m), 1)),
+        ("overshoot_mm", |m| fmt_opt(overshoot(m), 1)),
         ("min_clearance_mm", |m| format!("{:.1}", m.min_clearance_mm)),
         ("path_length_mm", |m| format!("{:.1}", m.path_length_mm)),
         ("peak_speed_mm_s", |m| format!("{:.1}", m.peak_speed_mm_s)),
@@ -340,14 +348,14 @@ pub fn corner_table(runs: &[ReplayRun]) -> String {
         let (a, b) = (&gd.output.summary, &va.output.summary);
         let _ = writeln!(s);
         let yes = |c: bool| if c { "yes" } else { "NO" };
-        if let (Some(x), Some(y)) = (a.metric("turn_onset_mm"), b.metric("turn_onset_mm")) {
+        if let (Some(x), Some(y)) = (onset(a), onset(b)) {
             let _ = writeln!(
                 s,
                 "- velocity-aware turns earlier: {} ({y:.1} vs {x:.1} mm before K)",
                 yes(y > x)
             );
         }
-        if let (Some(x), Some(y)) = (a.metric("overshoot_mm"), b.metric("overshoot_mm")) {
+        if let (Some(x), Some(y)) = (overshoot(a), overshoot(b)) {
             let _ = writeln!(
                 s,
                 "- velocity-aware overshoots less: {} ({y:.1} vs {x:.1} mm past K)",
@@ -366,6 +374,7 @@ pub fn corner_table(runs: &[ReplayRun]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiments::experiment::tests::round_trip;
 
     fn row(x: f64, y: f64, vx: f64, vy: f64) -> TrajectoryRow {
         TrajectoryRow {
@@ -397,6 +406,33 @@ mod tests {
         ];
         let m = corner_metrics(&rows, Vector2::zeros(), Vector2::new(1.0, 0.0));
         assert_eq!(m.turn_onset_mm, Some(700.0));
-        assert_eq!(m.overshoot_mm, 120.0);
+        assert_eq!(m.overshoot_mm, Some(120.0));
+    }
+
+    #[test]
+    fn the_metrics_are_the_summary_keys_and_read_back() {
+        let rows = vec![
+            row(-1500.0, 0.0, 400.0, 0.0),
+            row(-700.0, 50.0, 290.0, 100.0),
+            row(120.0, 300.0, -50.0, 300.0),
+        ];
+        let m = corner_metrics(&rows, Vector2::zeros(), Vector2::x());
+        let summary = round_trip(&m);
+        assert_eq!(
+            serde_json::to_string(&summary.experiment).unwrap(),
+            r#"{"turn_onset_mm":700.0,"overshoot_mm":120.0}"#
+        );
+        assert_eq!(
+            (onset(&summary), overshoot(&summary)),
+            (Some(700.0), Some(120.0))
+        );
+        // No onset: the key is left out; no trajectory: the overshoot is null.
+        let none = corner_metrics(&[], Vector2::zeros(), Vector2::x());
+        let summary = round_trip(&none);
+        assert_eq!(
+            serde_json::to_string(&summary.experiment).unwrap(),
+            r#"{"overshoot_mm":null}"#
+        );
+        assert_eq!((onset(&summary), overshoot(&summary)), (None, None));
     }
 }

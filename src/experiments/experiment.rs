@@ -5,10 +5,35 @@
 use crate::run::{OutputFile, RunError, RunOutput, Simulation, Summary};
 use crate::scenario::{Problem, Problems, Scenario};
 use omniloop_robot::Tables;
+use serde::Serialize;
 use serde::de::DeserializeOwned;
 
-/// The metrics an experiment adds to `summary.json`, by key.
-pub type Metrics = serde_json::Map<String, serde_json::Value>;
+/// An experiment's metrics as `summary.json` holds them: its keys, in order, beside the run's
+/// own ([`Summary::experiment`]).
+pub type MetricKeys = serde_json::Map<String, serde_json::Value>;
+
+/// An experiment's metrics, typed: a struct whose fields are the keys it adds to
+/// `summary.json`, in the order they are declared (`skip_serializing_if` on a key the summary
+/// leaves out). The experiment builds it and hands its [`Metrics::keys`] to the summary
+/// ([`Experiment::metrics`]); whatever reads the metrics back from a summary (the experiment's
+/// table, the robustness replay) reads the struct with [`Metrics::of`], so that a renamed
+/// field fails to compile where it is read instead of reading nothing.
+pub trait Metrics: Serialize + DeserializeOwned {
+    /// The metrics as the summary's keys.
+    fn keys(&self) -> MetricKeys {
+        match serde_json::to_value(self) {
+            Ok(serde_json::Value::Object(keys)) => keys,
+            _ => MetricKeys::new(),
+        }
+    }
+
+    /// The metrics of `summary`, if its experiment wrote these (`None`: another experiment's,
+    /// or none; a struct whose every field may be absent reads from any summary, its fields
+    /// `None`).
+    fn of(summary: &Summary) -> Option<Self> {
+        Self::deserialize(&summary.experiment).ok()
+    }
+}
 
 /// What an experiment does with the simulation, and what it measures.
 pub trait Experiment: Send {
@@ -29,9 +54,10 @@ pub trait Experiment: Send {
         true
     }
 
-    /// The experiment's own metrics of a finished run.
-    fn metrics(&self, _out: &RunOutput) -> Metrics {
-        Metrics::new()
+    /// The experiment's own metrics of a finished run, as the summary's keys (its
+    /// [`Metrics`] struct's [`Metrics::keys`]).
+    fn metrics(&self, _out: &RunOutput) -> MetricKeys {
+        MetricKeys::new()
     }
 
     /// The experiment's own files (tables, figures) of a finished run, written beside the
@@ -99,4 +125,56 @@ pub fn setup<T: ExperimentSetup + DeserializeOwned + 'static>(
 ) -> Result<Box<dyn ExperimentSetup>, Problem> {
     let spec: T = tables.parse_present("experiment", name)?;
     Ok(Box::new(spec))
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use std::fmt::Debug;
+
+    /// A run's summary whose experiment wrote `keys`.
+    pub(crate) fn summary_with(keys: MetricKeys) -> Summary {
+        let text = r#"{"scenario":"s","seed":1,"controller":"c","cycles":1,"sim_time_s":0.1,
+            "wall_time_s":0.1,"cycles_per_s":10.0,"wall_contacts":0,"peak_speed_mm_s":0.0,
+            "peak_accel_mm_s2":0.0,"reached_goal":false,"time_to_goal_s":null,
+            "min_clearance_mm":5.0,"path_length_mm":0.0}"#;
+        let mut s: Summary = serde_json::from_str(text).unwrap();
+        s.experiment = keys;
+        s
+    }
+
+    /// Writes `m` into a summary as its experiment would, through `summary.json`'s text, and
+    /// checks that it reads back whole; returns the summary read back.
+    pub(crate) fn round_trip<T: Metrics + PartialEq + Debug>(m: &T) -> Summary {
+        let text = serde_json::to_string_pretty(&summary_with(m.keys())).unwrap();
+        let summary: Summary = serde_json::from_str(&text).unwrap();
+        assert_eq!(T::of(&summary).as_ref(), Some(m), "{text}");
+        summary
+    }
+
+    #[derive(Debug, PartialEq, Serialize, serde::Deserialize)]
+    struct Two {
+        b: f64,
+        #[serde(skip_serializing_if = "Option::is_none", default)]
+        a: Option<usize>,
+    }
+
+    impl Metrics for Two {}
+
+    #[test]
+    fn metrics_are_keys_in_declaration_order_and_read_back_only_whole() {
+        let m = Two { b: 1.5, a: Some(2) };
+        let s = round_trip(&m);
+        assert_eq!(
+            serde_json::to_string(&s.experiment).unwrap(),
+            r#"{"b":1.5,"a":2}"#
+        );
+        let none = Two { b: 0.0, a: None };
+        assert_eq!(
+            serde_json::to_string(&round_trip(&none).experiment).unwrap(),
+            r#"{"b":0.0}"#
+        );
+        // Another experiment's keys, or none, are not these metrics.
+        assert_eq!(Two::of(&summary_with(MetricKeys::new())), None);
+    }
 }

@@ -4,11 +4,11 @@
 //! turns, Lucas-Kanade and cross-correlation the straight runs). Its replay, `forward`, runs
 //! both avoidance methods for a minute, the square of Fig. 8 and the two tests of Fig. 10.
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use super::replay::{Replay, ReplayContext, write_text};
 use crate::report::charts::{Chart, Series, Style, charts_png};
 use crate::report::output::write_run;
-use crate::run::{OutputFile, RunError, RunOutput};
+use crate::run::{OutputFile, RunError, RunOutput, Summary};
 use crate::scenario::Problems;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Vector2};
@@ -97,6 +97,44 @@ pub struct MoveResult {
     /// Frames of the move with no cross-correlation translation.
     pub ncc_gaps: usize,
 }
+
+/// An avoidance run's figures (`summary.json`: `avoidance`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AvoidanceResult {
+    /// The avoidance controller (`segmentation`, `optical_flow`).
+    pub method: String,
+    /// Contacts with the obstacles and walls.
+    pub contacts: u32,
+    /// Distance driven, mm.
+    pub distance_mm: f64,
+    /// Closed-loop cycles per wall-clock second.
+    pub fps: f64,
+}
+
+impl AvoidanceResult {
+    /// The figures of a run of controller `method` with summary `s`.
+    fn of(method: &str, s: &Summary) -> Self {
+        Self {
+            method: method.to_string(),
+            contacts: s.wall_contacts,
+            distance_mm: s.path_length_mm,
+            fps: s.cycles_per_s,
+        }
+    }
+}
+
+/// E6's metrics (`summary.json`): a scripted run's moves, or an avoidance run's figures.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ForwardMetrics {
+    /// The scripted moves, scored (a run of the script).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub moves: Option<Vec<MoveResult>>,
+    /// The avoidance run's figures (a run of an avoidance controller).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub avoidance: Option<AvoidanceResult>,
+}
+
+impl Metrics for ForwardMetrics {}
 
 /// The procedure is driving; the metrics depend on the controller.
 pub struct Forward {
@@ -207,23 +245,13 @@ impl Forward {
 }
 
 impl Experiment for Forward {
-    fn metrics(&self, out: &RunOutput) -> Metrics {
-        let mut m = Metrics::new();
-        let s = &out.summary;
-        if self.kind == SCRIPT {
-            m.insert("moves".into(), serde_json::json!(self.moves(out)));
-        } else {
-            m.insert(
-                "avoidance".into(),
-                serde_json::json!({
-                    "method": self.kind,
-                    "contacts": s.wall_contacts,
-                    "distance_mm": s.path_length_mm,
-                    "fps": s.cycles_per_s,
-                }),
-            );
+    fn metrics(&self, out: &RunOutput) -> MetricKeys {
+        let scripted = self.kind == SCRIPT;
+        ForwardMetrics {
+            moves: scripted.then(|| self.moves(out)),
+            avoidance: (!scripted).then(|| AvoidanceResult::of(&self.kind, &out.summary)),
         }
-        m
+        .keys()
     }
 
     fn files(&self, scenario: &Scenario, out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
@@ -331,11 +359,9 @@ pub const PAPER_LEGS_IN: [(f64, f64, f64); 4] = [
 ];
 
 /// The scripted moves of a summary (`moves`), empty without them.
-pub fn moves_of(summary: &crate::run::Summary) -> Vec<MoveResult> {
-    summary
-        .experiment
-        .get("moves")
-        .and_then(|v| serde_json::from_value(v.clone()).ok())
+pub fn moves_of(summary: &Summary) -> Vec<MoveResult> {
+    ForwardMetrics::of(summary)
+        .and_then(|m| m.moves)
         .unwrap_or_default()
 }
 
@@ -351,7 +377,7 @@ fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
             Ok(())
         })?;
         write_run(&out.join(kind), &run.scenario, &run.output)?;
-        avoidance.push(run.output.summary.experiment["avoidance"].clone());
+        avoidance.push(AvoidanceResult::of(kind, &run.output.summary));
     }
     let mut charts = Vec::new();
     let mut runs = Vec::new();
@@ -391,12 +417,24 @@ fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
     Ok(md)
 }
 
-/// `summary.json` of the replay: `square_turns_deg` ([read, true]), `lk_legs_in` and
-/// `ncc_legs_in` ([read, true], test 1 then test 2), `avoidance`.
+/// `summary.json` of the replay.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ForwardSummary {
+    /// The square's turns, [read by the scan line, true], degrees.
+    pub square_turns_deg: Vec<[f64; 2]>,
+    /// The legs by Lucas-Kanade, [read, true], inches, test 1 then test 2.
+    pub lk_legs_in: Vec<[f64; 2]>,
+    /// The legs by cross-correlation, as `lk_legs_in`.
+    pub ncc_legs_in: Vec<[f64; 2]>,
+    /// Each avoidance run's figures.
+    pub avoidance: Vec<AvoidanceResult>,
+}
+
+/// `summary.json` of the replay, from the scripted runs' moves and the avoidance runs.
 pub fn replay_summary(
     runs: &[(&str, Vec<MoveResult>)],
-    avoidance: &[serde_json::Value],
-) -> serde_json::Value {
+    avoidance: &[AvoidanceResult],
+) -> ForwardSummary {
     let turns: Vec<[f64; 2]> = runs
         .iter()
         .filter(|(n, _)| *n == "square")
@@ -410,24 +448,21 @@ pub fn replay_summary(
             .filter_map(|m| Some([pick(m)? / INCH_MM, m.truth / INCH_MM]))
             .collect()
     };
-    serde_json::json!({
-        "square_turns_deg": turns,
-        "lk_legs_in": legs(|m| m.lk_mm),
-        "ncc_legs_in": legs(|m| m.ncc_mm),
-        "avoidance": avoidance,
-    })
+    ForwardSummary {
+        square_turns_deg: turns,
+        lk_legs_in: legs(|m| m.lk_mm),
+        ncc_legs_in: legs(|m| m.ncc_mm),
+        avoidance: avoidance.to_vec(),
+    }
 }
 
 /// `forward.md`: the paper's figures beside ours.
-pub fn forward_table(summary: &serde_json::Value) -> String {
-    let pairs = |key: &str| -> Vec<[f64; 2]> {
-        serde_json::from_value(summary[key].clone()).unwrap_or_default()
-    };
+pub fn forward_table(summary: &ForwardSummary) -> String {
     let mut md = String::from("# E6: forward camera (Ahmed, Saatchi and Caparrelli)\n\n");
     md.push_str("## Square path (Fig. 8): turns read by the scan line\n\n");
     md.push_str("| turn | paper read (deg) | ours read (deg) | ours true (deg) | error (deg) |\n");
     md.push_str("|---:|---:|---:|---:|---:|\n");
-    for (k, t) in pairs("square_turns_deg").iter().enumerate() {
+    for (k, t) in summary.square_turns_deg.iter().enumerate() {
         let paper = PAPER_TURNS_DEG.get(k).copied().unwrap_or(f64::NAN);
         let _ = writeln!(
             md,
@@ -443,8 +478,8 @@ pub fn forward_table(summary: &serde_json::Value) -> String {
         "| test, leg | paper true | paper LK | paper NCC | ours true | ours LK | ours NCC |\n",
     );
     md.push_str("|---|---:|---:|---:|---:|---:|---:|\n");
-    let (lk, ncc) = (pairs("lk_legs_in"), pairs("ncc_legs_in"));
-    for (k, (l, n)) in lk.iter().zip(&ncc).enumerate() {
+    let (lk, ncc) = (&summary.lk_legs_in, &summary.ncc_legs_in);
+    for (k, (l, n)) in lk.iter().zip(ncc).enumerate() {
         let (pt, pl, pn) = PAPER_LEGS_IN
             .get(k)
             .copied()
@@ -465,15 +500,15 @@ pub fn forward_table(summary: &serde_json::Value) -> String {
     md.push_str("\n## Avoidance among eight obstacles\n\n");
     md.push_str("| method | contacts | distance (m) | frames/s (closed loop) | paper frames/s |\n");
     md.push_str("|---|---:|---:|---:|---:|\n");
-    for a in summary["avoidance"].as_array().into_iter().flatten() {
-        let method = a["method"].as_str().unwrap_or("?");
+    for a in &summary.avoidance {
+        let method = &a.method;
         let paper = if method == "segmentation" { 2.46 } else { 3.5 };
         let _ = writeln!(
             md,
             "| {method} | {} | {:.1} | {:.0} | {paper} |",
-            a["contacts"],
-            a["distance_mm"].as_f64().unwrap_or(f64::NAN) / 1000.0,
-            a["fps"].as_f64().unwrap_or(f64::NAN)
+            a.contacts,
+            a.distance_mm / 1000.0,
+            a.fps
         );
     }
     md.push_str(

@@ -5,7 +5,7 @@
 //! directions), and reads its heading error from each frame, or N/A. Its replay, `heading`,
 //! runs it in the 8 m x 6 m room.
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use super::replay::{Replay, ReplayContext, write_text};
 use crate::report::charts::{Chart, Series, Style, charts_png};
 use crate::run::record::Summary;
@@ -291,12 +291,8 @@ impl Experiment for Heading {
         Ok(())
     }
 
-    fn metrics(&self, _out: &RunOutput) -> Metrics {
-        let m = heading_metrics(self);
-        match serde_json::to_value(m) {
-            Ok(serde_json::Value::Object(map)) => map,
-            _ => Metrics::new(),
-        }
+    fn metrics(&self, _out: &RunOutput) -> MetricKeys {
+        heading_metrics(self).keys()
     }
 
     fn files(&self, _scenario: &Scenario, out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
@@ -336,7 +332,7 @@ pub struct RotationResult {
     pub frames: usize,
 }
 
-/// E3's metrics.
+/// E3's metrics (`summary.json`: a key per field).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HeadingMetrics {
     /// The circle's image radius, px.
@@ -413,10 +409,7 @@ fn heading_metrics(h: &Heading) -> HeadingMetrics {
     }
 }
 
-/// E3's metrics of a summary.
-pub fn heading_results(m: &Summary) -> Option<HeadingMetrics> {
-    serde_json::from_value(serde_json::Value::Object(m.experiment.clone())).ok()
-}
+impl Metrics for HeadingMetrics {}
 
 /// Every reading, one row each.
 fn heading_csv(h: &Heading) -> String {
@@ -517,7 +510,7 @@ fn heading_figure(
     let sweep_chart = Chart {
         title: format!(
             "sweep: reading - truth (max {:.1} deg, {} N/A)",
-            heading_results(summary)
+            HeadingMetrics::of(summary)
                 .and_then(|m| m.sweep_max_abs_error_deg)
                 .unwrap_or(f64::NAN),
             h.sweep
@@ -590,7 +583,7 @@ fn heading_figure(
 pub fn heading_table(m: &Summary) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# E3: heading error from a luminance circle\n");
-    let Some(h) = heading_results(m) else {
+    let Some(h) = HeadingMetrics::of(m) else {
         let _ = writeln!(s, "(no E3 results in this summary)");
         return s;
     };
@@ -675,6 +668,7 @@ fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiments::experiment::tests::round_trip;
 
     #[test]
     fn the_sweep_covers_the_whole_turn_and_angles_wrap() {
@@ -684,5 +678,57 @@ mod tests {
         assert_eq!(wrap_deg(190.0), -170.0);
         assert_eq!(wrap_deg(-180.0), 180.0);
         assert_eq!(wrap_deg(-179.0), -179.0);
+    }
+
+    /// A reading at turn `true_deg`, `off` mm along the first direction, read `error` degrees
+    /// off (N/A when `error` is `None`).
+    fn reading(true_deg: f64, off: f64, error: Option<f64>) -> Reading {
+        let shift = true_deg + error.unwrap_or(0.0);
+        Reading {
+            true_deg,
+            offset_mm: [off, 0.0],
+            signs_deg: shift,
+            differences_deg: shift,
+            match_percent: if error.is_some() { 90.0 } else { 10.0 },
+            required_percent: 50.0,
+        }
+    }
+
+    #[test]
+    fn the_metrics_read_back_from_the_summary_for_the_table() {
+        let spec: HeadingSpec = toml::from_str(
+            "checkpoint = { x_mm = 0.0, y_mm = 0.0 }\nrotations_deg = [60.0]\n\
+             translation_step_mm = 100.0\ntranslation_max_mm = 100.0",
+        )
+        .unwrap();
+        let mut h = Heading::new(&spec, &LuminanceConfig::default());
+        h.radius_px = 42.5;
+        h.rotations = vec![reading(60.0, 0.0, Some(0.5)), reading(60.0, 0.0, None)];
+        h.sweep = vec![reading(-180.0, 0.0, Some(-0.3))];
+        for k in 0..DIRECTIONS.len() {
+            h.translations.push((k, reading(0.0, 0.0, Some(0.0))));
+            h.translations.push((k, reading(0.0, 100.0, None)));
+        }
+        let m = heading_metrics(&h);
+        assert_eq!(m.rotations[0].max_abs_error_deg, Some(0.5));
+        assert_eq!((m.rotations[0].na_frames, m.sweep_na), (1, 0));
+        assert_eq!(m.translation_na_cm["-y"], serde_json::json!(10.0));
+        let summary = round_trip(&m);
+        let keys: Vec<&String> = summary.experiment.keys().collect();
+        assert_eq!(
+            keys,
+            [
+                "circle_radius_px",
+                "rotations",
+                "sweep_max_abs_error_deg",
+                "sweep_na",
+                "methods_disagree",
+                "translation_na_cm",
+                "translation_shift_deg"
+            ]
+        );
+        let table = heading_table(&summary);
+        assert!(table.contains("R = 42.5 px"), "{table}");
+        assert!(table.contains("max error 0.3 deg, 0 N/A"), "{table}");
     }
 }

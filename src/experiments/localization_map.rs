@@ -6,7 +6,7 @@
 //! with the reason. `omniloop replay selfloc` runs it after E2 and writes `selfloc_map.png`
 //! (the figure a user looks at first) and `selfloc_map.csv` (one row per place and mode).
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use crate::report::topview::{Mark, Panel, Spots, panels_png};
 use crate::run::record::Summary;
 use crate::run::{OutputFile, RunError, RunOutput, Simulation};
@@ -257,6 +257,29 @@ impl Band {
     }
 }
 
+/// The map's metrics (`summary.json`: `map`, then a key per mode).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LocalizationMapMetrics {
+    /// How the map was made.
+    pub map: MapSettings,
+    /// The figures of global mode.
+    pub global: ModeStats,
+    /// The figures of tracking mode.
+    pub tracking: ModeStats,
+}
+
+impl Metrics for LocalizationMapMetrics {}
+
+impl LocalizationMapMetrics {
+    /// The figures of `mode`.
+    pub fn mode(&self, mode: Mode) -> &ModeStats {
+        match mode {
+            Mode::Global => &self.global,
+            Mode::Tracking => &self.tracking,
+        }
+    }
+}
+
 /// The procedure and metrics of the map.
 pub struct LocalizationMap {
     spec: MapSpec,
@@ -334,6 +357,21 @@ fn score(
     e
 }
 
+impl LocalizationMap {
+    /// The metrics of the places localized so far.
+    fn measure(&self) -> LocalizationMapMetrics {
+        let stats = |mode| ModeStats::of(self.entries.iter().filter(|e| e.mode == mode));
+        LocalizationMapMetrics {
+            map: MapSettings {
+                method: self.config.method,
+                spec: self.spec.clone(),
+            },
+            global: stats(Mode::Global),
+            tracking: stats(Mode::Tracking),
+        }
+    }
+}
+
 impl Experiment for LocalizationMap {
     fn drives(&self) -> bool {
         false
@@ -388,24 +426,8 @@ impl Experiment for LocalizationMap {
         Ok(())
     }
 
-    fn metrics(&self, _out: &RunOutput) -> Metrics {
-        let mut keys = Metrics::new();
-        let settings = MapSettings {
-            method: self.config.method,
-            spec: self.spec.clone(),
-        };
-        keys.insert(
-            "map".into(),
-            serde_json::to_value(settings).unwrap_or_default(),
-        );
-        for mode in Mode::ALL {
-            let stats = ModeStats::of(self.entries.iter().filter(|e| e.mode == mode));
-            keys.insert(
-                mode.name().into(),
-                serde_json::to_value(stats).unwrap_or_default(),
-            );
-        }
-        keys
+    fn metrics(&self, _out: &RunOutput) -> MetricKeys {
+        self.measure().keys()
     }
 
     fn files(&self, scenario: &Scenario, out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
@@ -500,20 +522,15 @@ fn reason_kind(reason: &str) -> String {
 }
 
 /// The figures of one mode in a summary.
-pub fn mode_stats(m: &Summary, mode: &str) -> Option<ModeStats> {
-    m.experiment
-        .get(mode)
-        .and_then(|v| serde_json::from_value(v.clone()).ok())
+pub fn mode_stats(m: &Summary, mode: Mode) -> Option<ModeStats> {
+    LocalizationMapMetrics::of(m).map(|x| x.mode(mode).clone())
 }
 
 /// The map as a Markdown table, one row per mode.
 pub fn map_table(m: &Summary) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Self-localization error map\n");
-    let settings: Option<MapSettings> = m
-        .experiment
-        .get("map")
-        .and_then(|v| serde_json::from_value(v.clone()).ok());
+    let settings = LocalizationMapMetrics::of(m).map(|x| x.map);
     let how = settings.map_or(String::new(), |st| {
         format!(
             " Method: {}. Grid {} mm apart at most, headings {:?} deg; tracking priors {} mm and \
@@ -547,7 +564,7 @@ pub fn map_table(m: &Summary) -> String {
         })
     };
     for mode in Mode::ALL {
-        let Some(st) = mode_stats(m, mode.name()) else {
+        let Some(st) = mode_stats(m, mode) else {
             continue;
         };
         let _ = writeln!(
@@ -567,7 +584,7 @@ pub fn map_table(m: &Summary) -> String {
         );
     }
     for mode in Mode::ALL {
-        if let Some(st) = mode_stats(m, mode.name())
+        if let Some(st) = mode_stats(m, mode)
             && !st.not_localized.is_empty()
         {
             let reasons: Vec<String> = st
@@ -665,7 +682,7 @@ fn map_figure(
                     }
                 })
                 .collect();
-            let st = mode_stats(summary, mode.name()).unwrap_or_default();
+            let st = mode_stats(summary, mode).unwrap_or_default();
             Panel {
                 title: format!(
                     "{} mode: {} of {} places localized, {} gross",
@@ -688,6 +705,7 @@ fn map_figure(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiments::experiment::tests::round_trip;
 
     #[test]
     fn reasons_are_grouped_by_their_words() {
@@ -725,5 +743,43 @@ mod tests {
         assert_eq!(Band::of(&e), Band::Gross);
         e.error_mm = None;
         assert_eq!(Band::of(&e), Band::NotLocalized);
+    }
+
+    #[test]
+    fn the_metrics_read_back_from_the_summary_for_the_table() {
+        let mut map = LocalizationMap::new(&MapSpec::default(), LocalizationConfig::default());
+        let entry = |mode, error_mm: Option<f64>| MapEntry {
+            mode,
+            truth: [100.0, -200.0, 90.0],
+            prior: None,
+            error_mm,
+            error_deg: error_mm.map(|_| 0.4),
+            wrong_twin: false,
+            resolved_by_goals: true,
+            quality: None,
+            reason: if error_mm.is_some() {
+                String::new()
+            } else {
+                "fit residual 31.2 mm (at most 25.0)".into()
+            },
+        };
+        map.entries = vec![
+            entry(Mode::Global, Some(12.0)),
+            entry(Mode::Global, None),
+            entry(Mode::Tracking, Some(4.0)),
+        ];
+        let m = map.measure();
+        assert_eq!((m.global.places, m.global.localized), (2, 1));
+        assert_eq!(m.tracking.median_error_mm, Some(4.0));
+        let summary = round_trip(&m);
+        let keys: Vec<&String> = summary.experiment.keys().collect();
+        assert_eq!(keys, ["map", "global", "tracking"]);
+        assert_eq!(mode_stats(&summary, Mode::Global), Some(m.global.clone()));
+        let table = map_table(&summary);
+        assert!(
+            table.contains("Not localized, global: fit residual (1)."),
+            "{table}"
+        );
+        assert!(table.contains("| tracking | 1 | 1 (100.0%) |"), "{table}");
     }
 }

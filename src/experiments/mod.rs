@@ -18,7 +18,7 @@ pub mod resection;
 pub mod run;
 pub mod session;
 
-pub use experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, drive};
+pub use experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, drive};
 pub use registry::EXPERIMENTS;
 pub use replay::{Replay, ReplayContext, ReplayRun};
 pub use run::{Runner, load_scenario, parse_scenario, run_dyn, run_scenario, run_scenario_with};

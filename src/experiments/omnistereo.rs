@@ -5,7 +5,7 @@
 //! compass's rotation and the interframe translation since the previous frame. Its replay,
 //! `omnistereo`, runs `scenarios/omnistereo_arena.toml`.
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use super::replay::{Replay, ReplayContext, write_text};
 use crate::report::charts::{Chart, Series, Style, charts_png};
 use crate::run::record::Summary;
@@ -189,42 +189,85 @@ impl Omnistereo {
     }
 }
 
-/// Median and 95th percentile of `v`, with their count, as JSON.
-fn stats(v: &[f64]) -> serde_json::Value {
-    serde_json::json!({
-        "median": quantile(v, 0.5),
-        "p95": quantile(v, 0.95),
-        "n": v.len(),
-    })
+/// Median and 95th percentile of a quantity, with their count (`summary.json`: `median`,
+/// `p95`, `n`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Stats {
+    /// Median (`None`: no value).
+    pub median: Option<f64>,
+    /// 95th percentile.
+    pub p95: Option<f64>,
+    /// How many values.
+    pub n: usize,
+}
+
+impl Stats {
+    /// The statistics of `v`.
+    fn of(v: &[f64]) -> Self {
+        Self {
+            median: quantile(v, 0.5),
+            p95: quantile(v, 0.95),
+            n: v.len(),
+        }
+    }
+}
+
+/// The range errors' statistics (percent of the true range), with the band of true ranges
+/// they cover and the nearest true range of any observation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RangeStats {
+    /// The errors' statistics, within the band.
+    #[serde(flatten)]
+    pub stats: Stats,
+    /// The band of true ranges scored, mm.
+    pub band_mm: [f64; 2],
+    /// The nearest true range of an observation, mm (`None`: nothing ranged).
+    pub nearest_ranged_mm: Option<f64>,
+}
+
+/// E4's metrics (`summary.json`: a key per field).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct OmnistereoMetrics {
+    /// |range error| of the pillars ranged within the band, percent.
+    pub range_error_pct: RangeStats,
+    /// Trilateration's position error per frame, mm.
+    pub trilateration_error_mm: Stats,
+    /// The visual compass's turn error per frame pair, degrees.
+    pub compass_error_deg: Stats,
+    /// The interframe translation's error per frame pair, mm.
+    pub interframe_translation_error_mm: Stats,
+    /// Frames scored.
+    pub frames: usize,
+}
+
+impl Metrics for OmnistereoMetrics {}
+
+impl Omnistereo {
+    /// E4's metrics of its scores.
+    fn measure(&self, s: &Scores) -> OmnistereoMetrics {
+        let pct: Vec<f64> = self.in_band(s).map(|r| r.error_pct().abs()).collect();
+        let second = |v: &[(usize, f64)]| Stats::of(&v.iter().map(|x| x.1).collect::<Vec<f64>>());
+        OmnistereoMetrics {
+            range_error_pct: RangeStats {
+                stats: Stats::of(&pct),
+                band_mm: self.band,
+                nearest_ranged_mm: s
+                    .ranges
+                    .iter()
+                    .map(|r| r.true_mm)
+                    .fold(None::<f64>, |a, x| Some(a.map_or(x, |a| a.min(x)))),
+            },
+            trilateration_error_mm: second(&s.trilateration_mm),
+            compass_error_deg: second(&s.compass_deg),
+            interframe_translation_error_mm: second(&s.interframe_mm),
+            frames: s.frames,
+        }
+    }
 }
 
 impl Experiment for Omnistereo {
-    fn metrics(&self, out: &RunOutput) -> Metrics {
-        let s = self.scores(out);
-        let band: Vec<&RangeScore> = self.in_band(&s).collect();
-        let pct: Vec<f64> = band.iter().map(|r| r.error_pct().abs()).collect();
-        let second = |v: &[(usize, f64)]| v.iter().map(|x| x.1).collect::<Vec<f64>>();
-        let mut m = Metrics::new();
-        let mut range = stats(&pct);
-        range["band_mm"] = serde_json::json!(self.band);
-        range["nearest_ranged_mm"] = serde_json::json!(
-            s.ranges
-                .iter()
-                .map(|r| r.true_mm)
-                .fold(None::<f64>, |a, x| Some(a.map_or(x, |a| a.min(x))))
-        );
-        m.insert("range_error_pct".into(), range);
-        m.insert(
-            "trilateration_error_mm".into(),
-            stats(&second(&s.trilateration_mm)),
-        );
-        m.insert("compass_error_deg".into(), stats(&second(&s.compass_deg)));
-        m.insert(
-            "interframe_translation_error_mm".into(),
-            stats(&second(&s.interframe_mm)),
-        );
-        m.insert("frames".into(), serde_json::json!(s.frames));
-        m
+    fn metrics(&self, out: &RunOutput) -> MetricKeys {
+        self.measure(&self.scores(out)).keys()
     }
 
     fn files(&self, _scenario: &Scenario, out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
@@ -364,22 +407,13 @@ pub fn omnistereo_table(m: &Summary) -> String {
         s,
         "# E4: conical omnistereo, trilateration and interframe motion\n"
     );
-    let get = |key: &str, q: &str| {
-        m.experiment
-            .get(key)
-            .and_then(|v| v.get(q))
-            .and_then(serde_json::Value::as_f64)
-    };
-    let n = |key: &str| get(key, "n").unwrap_or(0.0) as u64;
+    let e = OmnistereoMetrics::of(m);
     let _ = writeln!(
         s,
         "Renderer: {}. Seed {}. {} frames, {} wall contacts, path {:.1} m.\n",
         m.renderer.clone().unwrap_or_else(|| "-".into()),
         m.seed,
-        m.experiment
-            .get("frames")
-            .and_then(serde_json::Value::as_u64)
-            .unwrap_or(0),
+        e.map_or(0, |e| e.frames),
         m.wall_contacts,
         m.path_length_mm / 1000.0
     );
@@ -388,12 +422,7 @@ pub fn omnistereo_table(m: &Summary) -> String {
     let f = |v: Option<f64>, unit: &str, digits: usize| {
         v.map_or("-".into(), |x| format!("{x:.digits$} {unit}"))
     };
-    let band = m
-        .experiment
-        .get("range_error_pct")
-        .and_then(|v| v.get("band_mm"))
-        .and_then(|b| serde_json::from_value::<[f64; 2]>(b.clone()).ok())
-        .unwrap_or(default_band());
+    let band = e.map_or(default_band(), |e| e.range_error_pct.band_mm);
     let rows = [
         (
             format!(
@@ -401,43 +430,43 @@ pub fn omnistereo_table(m: &Summary) -> String {
                 band[0] / 1000.0,
                 band[1] / 1000.0
             ),
-            "range_error_pct",
+            e.map(|e| e.range_error_pct.stats),
             "%",
             2,
             "median <= 1%, p95 <= 3%",
         ),
         (
             "trilateration position error".into(),
-            "trilateration_error_mm",
+            e.map(|e| e.trilateration_error_mm),
             "mm",
             1,
             "median <= 40 mm, p95 <= 100 mm",
         ),
         (
             "visual compass error per frame pair".into(),
-            "compass_error_deg",
+            e.map(|e| e.compass_error_deg),
             "deg",
             3,
             "median <= 0.3 deg",
         ),
         (
             "interframe translation error".into(),
-            "interframe_translation_error_mm",
+            e.map(|e| e.interframe_translation_error_mm),
             "mm",
             1,
             "median <= 10 mm",
         ),
     ];
-    for (label, key, unit, digits, target) in rows {
+    for (label, stats, unit, digits, target) in rows {
         let _ = writeln!(
             s,
             "| {label} | {} | {} | {} | {target} |",
-            n(key),
-            f(get(key, "median"), unit, digits),
-            f(get(key, "p95"), unit, digits)
+            stats.map_or(0, |x| x.n),
+            f(stats.and_then(|x| x.median), unit, digits),
+            f(stats.and_then(|x| x.p95), unit, digits)
         );
     }
-    if let Some(near) = get("range_error_pct", "nearest_ranged_mm") {
+    if let Some(near) = e.and_then(|e| e.range_error_pct.nearest_ranged_mm) {
         let _ = writeln!(
             s,
             "\nNearest pillar ranged: {:.2} m. Nearer, a pillar's top is above the lower \

@@ -3,7 +3,7 @@
 //! frames with fresh sensor noise; each place is scored by its RMS errors. Its replay,
 //! `selfloc`, runs the six places on the Small-Size field.
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use super::localization_map::map_table;
 use super::replay::{Replay, ReplayContext, write_text};
 use crate::report::output::write_run;
@@ -227,30 +227,32 @@ impl Experiment for Places {
         Ok(())
     }
 
-    fn metrics(&self, _out: &RunOutput) -> Metrics {
-        let mut keys = Metrics::new();
-        keys.insert(
-            "places".into(),
-            serde_json::to_value(&self.results).unwrap_or_default(),
-        );
-        let how = PlacesMethod {
-            method: self.method,
-            mode: "global".into(),
-        };
-        keys.insert(
-            "localization".into(),
-            serde_json::to_value(how).unwrap_or_default(),
-        );
-        keys
+    fn metrics(&self, _out: &RunOutput) -> MetricKeys {
+        PlacesMetrics {
+            places: self.results.clone(),
+            localization: PlacesMethod {
+                method: self.method,
+                mode: "global".into(),
+            },
+        }
+        .keys()
     }
 }
 
-/// The per-place results of a summary (`places`).
+/// E2's metrics (`summary.json`: `places`, `localization`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlacesMetrics {
+    /// Per place, in the order of `[experiment.places]`.
+    pub places: Vec<PlaceResult>,
+    /// How it localized.
+    pub localization: PlacesMethod,
+}
+
+impl Metrics for PlacesMetrics {}
+
+/// The per-place results of a summary (`places`), empty without them.
 pub fn place_results(m: &Summary) -> Vec<PlaceResult> {
-    m.experiment
-        .get("places")
-        .and_then(|v| serde_json::from_value(v.clone()).ok())
-        .unwrap_or_default()
+    PlacesMetrics::of(m).map(|p| p.places).unwrap_or_default()
 }
 
 /// `omniloop replay selfloc`.
@@ -342,14 +344,10 @@ fn draw_places(file: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Res
 pub fn places_table(m: &Summary) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# E2: self-localization on the field\n");
-    let method = m
-        .experiment
-        .get("localization")
-        .and_then(|v| serde_json::from_value::<PlacesMethod>(v.clone()).ok())
-        .map_or("-", |h| match h.method {
-            LocalizationMethod::Paper => "the paper's (Sect. 4, steps 1-7, as published)",
-            LocalizationMethod::Robust => "robust (boundary points, decision rule)",
-        });
+    let method = PlacesMetrics::of(m).map_or("-", |p| match p.localization.method {
+        LocalizationMethod::Paper => "the paper's (Sect. 4, steps 1-7, as published)",
+        LocalizationMethod::Robust => "robust (boundary points, decision rule)",
+    });
     let _ = writeln!(
         s,
         "Renderer: {}. Seed {}. Method: {method}. Global mode: every frame from no prior. \
@@ -378,4 +376,52 @@ pub fn places_table(m: &Summary) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::experiment::tests::round_trip;
+    use nalgebra::Vector2;
+
+    /// A place's result from its tally: two fixes 3 mm and 4 mm off, one frame lost.
+    fn place_result() -> PlaceResult {
+        let place = PoseSpec {
+            x_mm: 500.0,
+            y_mm: -250.0,
+            heading_deg: 90.0,
+        };
+        let truth = place.isometry();
+        let mut tally = Tally::default();
+        for dx in [3.0, 4.0] {
+            let pose = Isometry2::new(truth.translation.vector + Vector2::new(dx, 0.0), 1.6);
+            let fix = Measurement::Pose {
+                pose,
+                alternative: None,
+                unambiguous: true,
+            };
+            tally.add(Some(&fix), &truth);
+        }
+        tally.add(None, &truth);
+        tally.result(&place, 3)
+    }
+
+    #[test]
+    fn the_metrics_read_back_from_the_summary_for_the_table_and_the_places() {
+        let m = PlacesMetrics {
+            places: vec![place_result()],
+            localization: PlacesMethod {
+                method: LocalizationMethod::Robust,
+                mode: "global".into(),
+            },
+        };
+        let summary = round_trip(&m);
+        let keys: Vec<&String> = summary.experiment.keys().collect();
+        assert_eq!(keys, ["places", "localization"]);
+        let places = place_results(&summary);
+        assert_eq!(places, m.places);
+        assert_eq!((places[0].frames, places[0].not_localized), (3, 1));
+        assert!((places[0].rms_position_mm - 12.5f64.sqrt()).abs() < 1e-9);
+        assert!(places_table(&summary).contains("Method: robust"));
+    }
 }

@@ -5,7 +5,7 @@
 //! moment of the fix. Its replay, `resection`, runs the ten places of Table 1 and a place
 //! behind a cabinet with the panning camera, then again with an omnidirectional camera.
 
-use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, Metrics, setup};
+use super::experiment::{Experiment, ExperimentEntry, ExperimentSetup, MetricKeys, Metrics, setup};
 use super::replay::{Replay, ReplayContext, write_text};
 use crate::report::output::write_run;
 use crate::report::topview::{Mark, Marker, Panel, Spots, panels_png};
@@ -190,28 +190,8 @@ impl Experiment for Resection {
         Ok(())
     }
 
-    fn metrics(&self, _out: &RunOutput) -> Metrics {
-        let mut keys = Metrics::new();
-        keys.insert("camera".into(), self.camera.clone().into());
-        keys.insert(
-            "places".into(),
-            serde_json::to_value(&self.results).unwrap_or_default(),
-        );
-        let max = self
-            .results
-            .iter()
-            .filter_map(|r| r.error_cm)
-            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
-        keys.insert("max_error_cm".into(), max.into());
-        keys.insert(
-            "located".into(),
-            self.results
-                .iter()
-                .filter(|r| r.error_cm.is_some())
-                .count()
-                .into(),
-        );
-        keys
+    fn metrics(&self, _out: &RunOutput) -> MetricKeys {
+        ResectionMetrics::new(&self.camera, &self.results).keys()
     }
 
     fn files(&self, scenario: &Scenario, _out: &RunOutput) -> Result<Vec<OutputFile>, RunError> {
@@ -224,11 +204,40 @@ impl Experiment for Resection {
     }
 }
 
-/// The per-place results of a summary (`places`).
+/// E5's metrics (`summary.json`: a key per field).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResectionMetrics {
+    /// The camera that located the robot.
+    pub camera: String,
+    /// Per place, in the order of `[experiment.resection]`.
+    pub places: Vec<PlaceResult>,
+    /// The largest position error of the places located, cm (`None`: none was).
+    pub max_error_cm: Option<f64>,
+    /// Places located.
+    pub located: usize,
+}
+
+impl ResectionMetrics {
+    /// The metrics of the places' `results` with `camera`.
+    pub fn new(camera: &str, results: &[PlaceResult]) -> Self {
+        Self {
+            camera: camera.to_string(),
+            places: results.to_vec(),
+            max_error_cm: results
+                .iter()
+                .filter_map(|r| r.error_cm)
+                .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e)))),
+            located: results.iter().filter(|r| r.error_cm.is_some()).count(),
+        }
+    }
+}
+
+impl Metrics for ResectionMetrics {}
+
+/// The per-place results of a summary (`places`), empty without them.
 pub fn place_results(m: &Summary) -> Vec<PlaceResult> {
-    m.experiment
-        .get("places")
-        .and_then(|v| serde_json::from_value(v.clone()).ok())
+    ResectionMetrics::of(m)
+        .map(|r| r.places)
         .unwrap_or_default()
 }
 
@@ -331,13 +340,7 @@ pub fn resection_table(runs: &[&Summary]) -> String {
     let Some(first) = runs.first() else {
         return s;
     };
-    let camera = |m: &Summary| {
-        m.experiment
-            .get("camera")
-            .and_then(|v| v.as_str())
-            .unwrap_or("-")
-            .to_string()
-    };
+    let camera = |m: &Summary| ResectionMetrics::of(m).map_or("-".into(), |r| r.camera);
     let _ = writeln!(
         s,
         "Renderer: {}. Seed {}. Cameras: {}. Positions in cm; error = distance from the true \
@@ -393,16 +396,12 @@ pub fn resection_table(runs: &[&Summary]) -> String {
     }
     s.push('\n');
     for m in runs {
-        let max = m
-            .experiment
-            .get("max_error_cm")
-            .and_then(|v| v.as_f64())
+        let r = ResectionMetrics::of(m);
+        let max = r
+            .as_ref()
+            .and_then(|r| r.max_error_cm)
             .map_or("-".into(), |e| format!("{e:.2} cm"));
-        let located = m
-            .experiment
-            .get("located")
-            .and_then(|v| v.as_u64())
-            .unwrap_or(0);
+        let located = r.as_ref().map_or(0, |r| r.located);
         let _ = writeln!(
             s,
             "- {}: located at {located} of {} places, largest error {max}.",
@@ -445,4 +444,47 @@ fn replay(ctx: &mut ReplayContext<'_>) -> anyhow::Result<String> {
     let md = resection_table(&[&pan.output.summary, &omni.output.summary]);
     write_text(&out.join("resection.md"), &md)?;
     Ok(md)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::experiment::tests::round_trip;
+
+    /// A place's result: located `error_cm` off, or not located.
+    fn result(place_cm: [f64; 2], error_cm: Option<f64>) -> PlaceResult {
+        PlaceResult {
+            place_cm,
+            true_cm: place_cm,
+            estimate_cm: error_cm.map(|e| [place_cm[0] + e, place_cm[1]]),
+            error_cm,
+            heading_error_deg: error_cm.map(|_| 0.5),
+            pan_search_s: 12.0,
+            moved: false,
+            failure: error_cm.is_none().then(|| GAVE_UP.to_string()),
+        }
+    }
+
+    #[test]
+    fn the_metrics_read_back_from_the_summary_for_the_table() {
+        let results = [
+            result([100.0, 200.0], Some(1.25)),
+            result([300.0, 50.0], None),
+            result([150.0, 120.0], Some(0.5)),
+        ];
+        let m = ResectionMetrics::new("pan", &results);
+        assert_eq!((m.max_error_cm, m.located), (Some(1.25), 2));
+        let summary = round_trip(&m);
+        let keys: Vec<&String> = summary.experiment.keys().collect();
+        assert_eq!(keys, ["camera", "places", "max_error_cm", "located"]);
+        assert_eq!(place_results(&summary), results);
+        let table = resection_table(&[&summary]);
+        assert!(
+            table.contains("- pan: located at 2 of 3 places, largest error 1.25 cm."),
+            "{table}"
+        );
+        let none = ResectionMetrics::new("omni", &[]);
+        assert_eq!((none.max_error_cm, none.located), (None, 0));
+        round_trip(&none);
+    }
 }

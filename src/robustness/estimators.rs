@@ -1,11 +1,13 @@
 //! The estimators the robustness replay scores: each one's scenario (an experiment's own, as
 //! its replay runs it), its error and its own target.
-//! A new estimator is one more entry in [`ESTIMATORS`].
+//! A new estimator is one more entry in [`ESTIMATORS`]. Each reads its experiment's typed metrics ([`crate::experiments::Metrics`]) from the run's
+//! summary, so that a metric renamed there fails to compile here.
 
-use crate::experiments::heading::RotationResult;
-use crate::experiments::{corner, forward, heading, omnistereo, places, resection};
+use crate::experiments::heading::HeadingMetrics;
+use crate::experiments::omnistereo::OmnistereoMetrics;
+use crate::experiments::resection::ResectionMetrics;
+use crate::experiments::{Metrics, corner, forward, heading, omnistereo, places, resection};
 use crate::run::Summary;
-use serde::de::DeserializeOwned;
 
 /// An estimator's error in one run, and how it missed its target there, if it did.
 #[derive(Debug, Clone, PartialEq)]
@@ -120,15 +122,14 @@ pub const ESTIMATORS: &[Estimator] = &[
         target: "every turn read, within 1 degree (E3)",
         bound: Some(1.0),
         score: |s| {
-            let turns: Vec<RotationResult> = field(s, "rotations")?;
-            let sweep: Option<f64> = field(s, "sweep_max_abs_error_deg");
-            let sweep_na: usize = field(s, "sweep_na")?;
-            let worst = turns
+            let h = HeadingMetrics::of(s)?;
+            let worst = h
+                .rotations
                 .iter()
                 .filter_map(|r| r.max_abs_error_deg)
-                .chain(sweep)
+                .chain(h.sweep_max_abs_error_deg)
                 .reduce(f64::max)?;
-            let na: usize = turns.iter().map(|r| r.na_frames).sum::<usize>() + sweep_na;
+            let na: usize = h.rotations.iter().map(|r| r.na_frames).sum::<usize>() + h.sweep_na;
             Some(Score::new(
                 worst,
                 &[
@@ -146,8 +147,8 @@ pub const ESTIMATORS: &[Estimator] = &[
         target: "median <= 1%, p95 <= 3% (E4)",
         bound: Some(1.0),
         score: |s| {
-            let median = nested(s, "range_error_pct", "median")?;
-            let p95 = nested(s, "range_error_pct", "p95")?;
+            let range = OmnistereoMetrics::of(s)?.range_error_pct.stats;
+            let (median, p95) = (range.median?, range.p95?);
             Some(Score::new(
                 median,
                 &[
@@ -165,8 +166,8 @@ pub const ESTIMATORS: &[Estimator] = &[
         target: "median <= 40 mm, p95 <= 100 mm (E4)",
         bound: Some(40.0),
         score: |s| {
-            let median = nested(s, "trilateration_error_mm", "median")?;
-            let p95 = nested(s, "trilateration_error_mm", "p95")?;
+            let position = OmnistereoMetrics::of(s)?.trilateration_error_mm;
+            let (median, p95) = (position.median?, position.p95?);
             Some(Score::new(
                 median,
                 &[
@@ -184,10 +185,8 @@ pub const ESTIMATORS: &[Estimator] = &[
         target: "every place located, within 2 cm (E5)",
         bound: Some(2.0),
         score: |s| {
-            let worst = s.metric("max_error_cm")?;
-            let located: usize = field(s, "located")?;
-            let places: Vec<serde_json::Value> = field(s, "places")?;
-            let n = places.len();
+            let r = ResectionMetrics::of(s)?;
+            let (worst, located, n) = (r.max_error_cm?, r.located, r.places.len());
             Some(Score::new(
                 worst,
                 &[
@@ -235,12 +234,142 @@ pub fn estimator(name: &str) -> Option<&'static Estimator> {
     ESTIMATORS.iter().find(|e| e.name == name)
 }
 
-/// The experiment's summary key `key`, read as `T`.
-fn field<T: DeserializeOwned>(s: &Summary, key: &str) -> Option<T> {
-    serde_json::from_value(s.experiment.get(key)?.clone()).ok()
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::MetricKeys;
+    use crate::experiments::experiment::tests::summary_with;
+    use crate::experiments::forward::{ForwardMetrics, MoveResult};
+    use crate::experiments::heading::RotationResult;
+    use crate::experiments::omnistereo::{RangeStats, Stats};
+    use crate::experiments::places::{PlaceResult, PlacesMethod, PlacesMetrics};
+    use omniloop_vision::LocalizationMethod;
 
-/// The number `inner` of the experiment's summary object `key`.
-fn nested(s: &Summary, key: &str, inner: &str) -> Option<f64> {
-    s.experiment.get(key)?.get(inner)?.as_f64()
+    /// Estimator `name`'s score of a run whose experiment wrote `m`.
+    fn score(name: &str, m: &impl Metrics) -> Option<Score> {
+        (estimator(name).unwrap().score)(&summary_with(m.keys()))
+    }
+
+    fn stats(median: f64, p95: f64) -> Stats {
+        Stats {
+            median: Some(median),
+            p95: Some(p95),
+            n: 10,
+        }
+    }
+
+    #[test]
+    fn each_estimator_reads_its_experiments_metrics() {
+        let turn = |max: f64, na_frames| RotationResult {
+            true_deg: 60.0,
+            median_deg: Some(60.0),
+            max_abs_error_deg: Some(max),
+            na_frames,
+            frames: 20,
+        };
+        let heading = HeadingMetrics {
+            circle_radius_px: 40.0,
+            rotations: vec![turn(0.5, 0), turn(1.5, 2)],
+            sweep_max_abs_error_deg: Some(0.7),
+            sweep_na: 1,
+            methods_disagree: 0,
+            translation_na_cm: serde_json::Map::new(),
+            translation_shift_deg: serde_json::Map::new(),
+        };
+        let s = score("heading", &heading).unwrap();
+        assert_eq!(s.error, 1.5);
+        assert_eq!(s.missed.as_deref(), Some("over 1 degree; 3 readings N/A"));
+
+        let omnistereo = OmnistereoMetrics {
+            range_error_pct: RangeStats {
+                stats: stats(0.8, 3.5),
+                band_mm: [500.0, 3000.0],
+                nearest_ranged_mm: Some(600.0),
+            },
+            trilateration_error_mm: stats(50.0, 90.0),
+            compass_error_deg: stats(0.1, 0.2),
+            interframe_translation_error_mm: stats(5.0, 9.0),
+            frames: 10,
+        };
+        let s = score("ranges", &omnistereo).unwrap();
+        assert_eq!(s.error, 0.8);
+        assert_eq!(s.missed.as_deref(), Some("p95 3.50% over 3%"));
+        let s = score("trilateration", &omnistereo).unwrap();
+        assert_eq!(s.error, 50.0);
+        assert_eq!(s.missed.as_deref(), Some("median over 40 mm"));
+
+        let place = |place_cm: [f64; 2], error_cm: Option<f64>| resection::PlaceResult {
+            place_cm,
+            true_cm: place_cm,
+            estimate_cm: error_cm.map(|_| place_cm),
+            error_cm,
+            heading_error_deg: None,
+            pan_search_s: 10.0,
+            moved: false,
+            failure: None,
+        };
+        let located = [place([0.0, 0.0], Some(1.5)), place([50.0, 0.0], None)];
+        let s = score("resection", &ResectionMetrics::new("pan", &located)).unwrap();
+        assert_eq!(s.error, 1.5);
+        assert_eq!(s.missed.as_deref(), Some("1 of 2 places located"));
+
+        let at = |rms_position_mm| PlaceResult {
+            true_pose: [0.0, 0.0, 0.0],
+            rms_position_mm,
+            rms_heading_deg: 0.2,
+            ambiguity_errors: 0,
+            frames: 5,
+            not_localized: 0,
+        };
+        let places = PlacesMetrics {
+            places: vec![at(12.0), at(21.0)],
+            localization: PlacesMethod {
+                method: LocalizationMethod::Paper,
+                mode: "global".into(),
+            },
+        };
+        let s = score("floor_localization", &places).unwrap();
+        assert!(s.meets());
+        assert_eq!(s.error, 21.0);
+
+        let step = |kind: &str, commanded, truth, scanline_deg, lk_mm| MoveResult {
+            kind: kind.into(),
+            commanded,
+            truth,
+            scanline_deg,
+            lk_mm,
+            ncc_mm: lk_mm,
+            lk_gaps: 0,
+            ncc_gaps: 0,
+        };
+        let forward = ForwardMetrics {
+            moves: Some(vec![
+                step("forward", 600.0, 500.0, None, Some(550.0)),
+                step("turn", 90.0, 89.0, Some(92.0), None),
+            ]),
+            avoidance: None,
+        };
+        let s = score("odometry_turn", &forward).unwrap();
+        assert_eq!(s.error, 3.0);
+        assert_eq!(s.missed.as_deref(), Some("over 2 degrees"));
+        let s = score("odometry_legs", &forward).unwrap();
+        assert_eq!(s.error, 10.0);
+        assert_eq!(s.missed.as_deref(), Some("over 7.2%"));
+    }
+
+    #[test]
+    fn a_run_without_its_experiments_metrics_gives_no_score() {
+        let none = summary_with(MetricKeys::new());
+        for name in [
+            "floor_localization",
+            "heading",
+            "ranges",
+            "trilateration",
+            "resection",
+            "odometry_turn",
+            "odometry_legs",
+        ] {
+            assert_eq!((estimator(name).unwrap().score)(&none), None, "{name}");
+        }
+    }
 }

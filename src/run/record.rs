@@ -162,7 +162,8 @@ pub struct Summary {
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub robots: Option<Vec<RobotSummary>>,
     /// The experiment's own metrics (`turn_onset_mm`, `overshoot_mm` of E1, `places` of E2,
-    /// ...), written as keys of the summary beside the others.
+    /// ...), written as keys of the summary beside the others: each experiment's typed
+    /// metrics as keys, read back as the type with `Metrics::of` (`crate::experiments`).
     #[serde(flatten)]
     pub experiment: serde_json::Map<String, serde_json::Value>,
 }
@@ -254,13 +255,6 @@ pub struct TeamFigures {
     /// Total path of the robots with a goal over the total of their straight lines, each less
     /// its goal's tolerance (as the clutter benchmark's `path_ratio`).
     pub path_ratio: Option<f64>,
-}
-
-impl Summary {
-    /// The experiment metric `key` as a number, when it is one.
-    pub fn metric(&self, key: &str) -> Option<f64> {
-        self.experiment.get(key).and_then(serde_json::Value::as_f64)
-    }
 }
 
 /// A planar pose as written in `estimates.jsonl`.
