@@ -24,7 +24,7 @@ struct GapFollower {
 
 impl GapFollower {
     fn new(c: &RobotConfig) -> Result<Self, RobotError> {
-        let missing = |what: &str| RobotError::Config(format!("the gap follower needs {what}"));
+        let missing = |what: &str| RobotError::Missing(format!("the gap follower needs {what}"));
         let camera = c.vision_camera().ok_or_else(|| missing("a camera"))?;
         let cal = c.calibration(camera).ok_or_else(|| missing("a mirror"))?;
         let goal = c.goal.as_ref().ok_or_else(|| missing("a [goal]"))?.point();

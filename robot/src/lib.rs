@@ -73,10 +73,10 @@ pub enum RobotError {
     /// naming the field.
     #[error(transparent)]
     Field(#[from] omniloop_problem::Problem),
-    /// The configuration asks for what the robot does not have (a sensor, a calibration, a
-    /// map); a field that breaks a rule is a [`RobotError::Field`].
+    /// The robot lacks what its configuration asks for (a calibration, marks on its map, a
+    /// pan unit); a field that breaks a rule is a [`RobotError::Field`].
     #[error("{0}")]
-    Config(String),
+    Missing(String),
     /// A user's robot software failed, and why.
     #[error("{0}")]
     Software(Box<dyn std::error::Error + Send + Sync>),

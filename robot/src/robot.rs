@@ -11,15 +11,19 @@ use crate::mission::Mission;
 use crate::navigation::Unreachable;
 use crate::perception::{self, Belief, Perceived, Stage, StageEntry};
 use nalgebra::Isometry2;
+use omniloop_problem::Problem;
 
 /// The perception stages a configuration runs, in order: those its controller reads and those
 /// it asks for (its pose source, a goal's checkpoints, the visual odometry).
 pub fn stages_of(config: &RobotConfig) -> Result<Vec<&'static StageEntry>, RobotError> {
     let kind = &config.control.kind;
     let controller = controllers::find(kind).ok_or_else(|| {
-        RobotError::Config(format!(
-            "control.kind: no controller {kind:?} (there are: {})",
-            controllers::names()
+        RobotError::Field(Problem::new(
+            "control.kind",
+            format!(
+                "no controller {kind:?} (there are: {})",
+                controllers::names()
+            ),
         ))
     })?;
     Ok(perception::wanted(config, controller.stages))

@@ -123,9 +123,10 @@ impl Wander {
             && config.map.segments.is_empty()
             && config.map.boxes.is_empty()
         {
-            return Err(RobotError::Config(
-                "control.kind = \"wander\" needs a map: the world has no walls or pillars".into(),
-            ));
+            return Err(RobotError::Field(Problem::new(
+                "control.kind",
+                "\"wander\" needs a map: the world has no walls or pillars",
+            )));
         }
         let b = &config.body;
         let v = b.max_speed_mm_s;

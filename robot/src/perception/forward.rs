@@ -46,9 +46,12 @@ impl Percept for OdometryStep {}
 /// The forward camera the stages read, or the error saying vision's camera is not one.
 fn camera(c: &RobotConfig) -> Result<ForwardCamera, RobotError> {
     c.forward_camera.clone().ok_or_else(|| {
-        RobotError::Config(format!(
-            "controller {:?} and the visual odometry need a forward pinhole camera",
-            c.control.kind
+        RobotError::Field(Problem::new(
+            "control.kind",
+            format!(
+                "controller {:?} and the visual odometry need a forward pinhole camera",
+                c.control.kind
+            ),
         ))
     })
 }

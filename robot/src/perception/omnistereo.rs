@@ -65,7 +65,10 @@ pub const ENTRY: StageEntry = StageEntry {
     },
     build: |c| {
         let rig = c.stereo.ok_or_else(|| {
-            RobotError::Config("pose_source \"omnistereo\" needs the robot's two cones".into())
+            RobotError::Field(Problem::new(
+                "control.pose_source",
+                "\"omnistereo\" needs the robot's two cones",
+            ))
         })?;
         let config = vision_settings(c, "omnistereo")?;
         Ok(Box::new(OmnistereoStage::new(
@@ -165,7 +168,7 @@ impl OmnistereoStage {
     ) -> Result<Self, RobotError> {
         config.validate()?;
         if landmarks.is_empty() {
-            return Err(RobotError::Config(
+            return Err(RobotError::Missing(
                 "omnistereo needs a map with landmarks (the world's pillars)".into(),
             ));
         }

@@ -101,7 +101,7 @@ fn build(config: &RobotConfig) -> Result<ResectionStage, RobotError> {
         (Some(c), _) => View::Pan(c.clone()),
         (None, Some(c)) => View::Ring(c.clone()),
         (None, None) => {
-            return Err(RobotError::Config(format!(
+            return Err(RobotError::Missing(format!(
                 "no column or mirror calibration for camera {camera:?}"
             )));
         }
@@ -254,7 +254,7 @@ impl ResectionStage {
     ) -> Result<Self, RobotError> {
         config.validate()?;
         if marks.len() != 3 {
-            return Err(RobotError::Config(format!(
+            return Err(RobotError::Missing(format!(
                 "resection needs exactly three marks on the map (named boards), found {}",
                 marks.len()
             )));
@@ -297,7 +297,7 @@ impl ResectionStage {
                 _ => None,
             })
             .ok_or_else(|| {
-                RobotError::Config(format!(
+                RobotError::Missing(format!(
                     "resection pans camera {:?}, which is not on a pan unit",
                     self.camera
                 ))

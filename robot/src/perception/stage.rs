@@ -155,7 +155,7 @@ pub fn calibration<'a>(
     camera: &str,
 ) -> Result<&'a RadialCalibration, RobotError> {
     config.calibration(camera).ok_or_else(|| {
-        RobotError::Config(format!(
+        RobotError::Missing(format!(
             "no image-to-floor calibration for camera {camera:?}"
         ))
     })
@@ -164,9 +164,15 @@ pub fn calibration<'a>(
 /// Vision's camera (`vision.sensor`, else the robot's first), or the error naming `stage`.
 pub fn vision_camera<'a>(config: &'a RobotConfig, stage: &str) -> Result<&'a str, RobotError> {
     config.vision_camera().ok_or_else(|| {
-        RobotError::Config(match &config.vision.sensor {
-            Some(n) => format!("vision.sensor names a camera the robot does not have: {n:?}"),
-            None => format!("{stage} needs a camera and the robot has none"),
+        RobotError::Field(match &config.vision.sensor {
+            Some(n) => Problem::new(
+                "vision.sensor",
+                format!("names a camera the robot does not have: {n:?}"),
+            ),
+            None => Problem::new(
+                "robot.sensors",
+                format!("{stage} needs a camera and the robot has none"),
+            ),
         })
     })
 }
