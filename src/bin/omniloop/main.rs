@@ -12,7 +12,7 @@ use omniloop::report::output::{default_out_dir, write_run};
 use omniloop::run::observer::ObserverHandle;
 use omniloop::run::{RunOptions, render_snapshot, render_snapshot_truth, truth_files};
 use omniloop::scenario::calibrate::calibrate_sensor;
-use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
+use omniloop::camera_export::{CameraFormat, export_camera_model};
 use omniloop::sweep::Seeds;
 use omniloop::viewing::{FoxgloveLog, GifLog, LiveOptions, RealTime, RobotCameras, Sinks};
 use omniloop::{DEFAULT_SCENARIO, LoadError, Scenario, load_scenario, run_scenario};
