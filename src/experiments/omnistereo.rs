@@ -393,7 +393,34 @@ pub fn omnistereo_table(m: &Summary) -> String {
         .and_then(|v| v.get("band_mm"))
         .and_then(|b| serde_json::from_value::<[f64; 2]>(b.clone()).ok())
         .unwrap_or(default_band());
-    let rows = [
+    for (label, key, unit, digits, target) in omnistereo_rows(band) {
+        let _ = writeln!(
+            s,
+            "| {label} | {} | {} | {} | {target} |",
+            n(key),
+            f(get(key, "median"), unit, digits),
+            f(get(key, "p95"), unit, digits)
+        );
+    }
+    if let Some(near) = get("range_error_pct", "nearest_ranged_mm") {
+        let _ = writeln!(
+            s,
+            "\nNearest pillar ranged: {:.2} m. Nearer, a pillar's top is above the lower \
+             mirror's view: the common region of two cones (R = 30, d = 100, s = 150 mm) \
+             starts at s (d + R) / R - d = 550 mm for any feature, and later for the top of a \
+             600 mm pillar.",
+            near / 1000.0
+        );
+    }
+    s
+}
+
+/// The table's rows: label, the key of its statistics in the summary, unit, decimals and the
+/// target; the range error's over the pillars of `band` (mm).
+fn omnistereo_rows(
+    band: [f64; 2],
+) -> [(String, &'static str, &'static str, usize, &'static str); 4] {
+    [
         (
             format!(
                 "range error, pillars {:.1}-{:.1} m",
@@ -426,27 +453,7 @@ pub fn omnistereo_table(m: &Summary) -> String {
             1,
             "median <= 10 mm",
         ),
-    ];
-    for (label, key, unit, digits, target) in rows {
-        let _ = writeln!(
-            s,
-            "| {label} | {} | {} | {} | {target} |",
-            n(key),
-            f(get(key, "median"), unit, digits),
-            f(get(key, "p95"), unit, digits)
-        );
-    }
-    if let Some(near) = get("range_error_pct", "nearest_ranged_mm") {
-        let _ = writeln!(
-            s,
-            "\nNearest pillar ranged: {:.2} m. Nearer, a pillar's top is above the lower \
-             mirror's view: the common region of two cones (R = 30, d = 100, s = 150 mm) \
-             starts at s (d + R) / R - d = 550 mm for any feature, and later for the top of a \
-             600 mm pillar.",
-            near / 1000.0
-        );
-    }
-    s
+    ]
 }
 
 /// `omniloop replay omnistereo`.

@@ -358,39 +358,7 @@ pub fn resection_table(runs: &[&Summary]) -> String {
     }
     let _ = writeln!(s, "{head}\n{rule}");
     let results: Vec<Vec<PlaceResult>> = runs.iter().map(|m| place_results(m)).collect();
-    let n = results.iter().map(Vec::len).max().unwrap_or(0);
-    let pt = |p: [f64; 2]| format!("({:.0}, {:.0})", p[0], p[1]);
-    for k in 0..n {
-        let Some(place) = results.iter().find_map(|r| r.get(k)).map(|r| r.place_cm) else {
-            continue;
-        };
-        let (obs, err) = match paper_observed(place) {
-            Some(o) => (
-                pt(o),
-                format!("{:.1}", (o[0] - place[0]).hypot(o[1] - place[1])),
-            ),
-            None => ("-".into(), "-".into()),
-        };
-        let _ = write!(s, "| {} | {} | {obs} | {err} |", k + 1, pt(place));
-        for r in &results {
-            match r.get(k) {
-                Some(r) => {
-                    let ours = r.estimate_cm.map_or("not located".into(), |e| {
-                        format!(
-                            "({:.1}, {:.1}){}",
-                            e[0],
-                            e[1],
-                            if r.moved { " moved" } else { "" }
-                        )
-                    });
-                    let err = r.error_cm.map_or("-".into(), |e| format!("{e:.2}"));
-                    let _ = write!(s, " {ours} | {err} | {:.1} |", r.pan_search_s);
-                }
-                None => s.push_str(" - | - | - |"),
-            }
-        }
-        s.push('\n');
-    }
+    write_place_rows(&mut s, &results);
     s.push('\n');
     for m in runs {
         let max = m
@@ -411,6 +379,44 @@ pub fn resection_table(runs: &[&Summary]) -> String {
         );
     }
     s
+}
+
+/// The table's rows into `s`, a place a row: Table 1's true and observed position and error,
+/// then each run's estimate, error and search time (`results`: each run's places).
+fn write_place_rows(s: &mut String, results: &[Vec<PlaceResult>]) {
+    let n = results.iter().map(Vec::len).max().unwrap_or(0);
+    let pt = |p: [f64; 2]| format!("({:.0}, {:.0})", p[0], p[1]);
+    for k in 0..n {
+        let Some(place) = results.iter().find_map(|r| r.get(k)).map(|r| r.place_cm) else {
+            continue;
+        };
+        let (obs, err) = match paper_observed(place) {
+            Some(o) => (
+                pt(o),
+                format!("{:.1}", (o[0] - place[0]).hypot(o[1] - place[1])),
+            ),
+            None => ("-".into(), "-".into()),
+        };
+        let _ = write!(s, "| {} | {} | {obs} | {err} |", k + 1, pt(place));
+        for r in results {
+            match r.get(k) {
+                Some(r) => {
+                    let ours = r.estimate_cm.map_or("not located".into(), |e| {
+                        format!(
+                            "({:.1}, {:.1}){}",
+                            e[0],
+                            e[1],
+                            if r.moved { " moved" } else { "" }
+                        )
+                    });
+                    let err = r.error_cm.map_or("-".into(), |e| format!("{e:.2}"));
+                    let _ = write!(s, " {ours} | {err} | {:.1} |", r.pan_search_s);
+                }
+                None => s.push_str(" - | - | - |"),
+            }
+        }
+        s.push('\n');
+    }
 }
 
 /// `omniloop replay resection`.
