@@ -16,10 +16,10 @@
 //! robot clear of every solid and robot by its radius, heading uniform) or taken along the
 //! scenario's own run (`along-run`: every k-th cycle of the run).
 
+use crate::camera_export::{CameraFormat, ExportError, export_camera_model};
 use crate::run::{RunError, RunOptions, Simulation, truth_files};
 use crate::scenario::Scenario;
 use crate::scenario::calibrate::calibrate_sensor;
-use crate::scenario::camera_export::{CameraFormat, ExportError, export_camera_model};
 use image::RgbaImage;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_sim::render::TruthFrame;

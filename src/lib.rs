@@ -11,6 +11,8 @@
 //!   [`run_scenario`], [`Runner`] and [`load_scenario`];
 //! - [`sweep`]: many runs over a grid of values and seeds;
 //! - [`robustness`]: every estimator against each knob of realism, as one sweep;
+//! - [`camera_export`]: a mirror sensor as a standard camera model fitted to its traced rays
+//!   (OpenCV `omnidir`, Kalibr, OCamCalib);
 //! - [`dataset`]: frames of a camera with their truth (depth, labels, poses) for training;
 //! - [`replays`]: the registry of `omniloop replay`;
 //! - [`viewing`]: a run on Foxglove's channels, into an MCAP file.
@@ -18,6 +20,7 @@
 //! The robot's software is anything that implements [`robot::RobotSoftware`]; the world lives
 //! in `omniloop-sim`, image processing in [`vision`], motion and avoidance in [`control`].
 
+pub mod camera_export;
 pub mod dataset;
 pub mod experiments;
 pub mod replays;

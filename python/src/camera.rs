@@ -4,7 +4,7 @@
 //! where the model's frame sits on the robot.
 
 use crate::convert::json_to_py;
-use omniloop::scenario::camera_export::{CameraFormat, export_camera_model};
+use omniloop::camera_export::{CameraFormat, export_camera_model};
 use omniloop_sim::SensorSpec;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;

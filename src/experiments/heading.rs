@@ -450,8 +450,24 @@ fn heading_figure(
     h: &Heading,
     summary: &Summary,
 ) -> Result<Vec<u8>, crate::report::topview::FigureError> {
-    const COLOURS: [[u8; 3]; 4] = [[30, 80, 220], [220, 60, 30], [20, 150, 60], [150, 60, 180]];
-    let method = h.config.method;
+    charts_png(
+        "heading.png",
+        &[
+            polar_chart(h),
+            rotation_chart(h),
+            sweep_chart(h, summary),
+            translation_chart(h),
+        ],
+        2,
+        (640, 480),
+    )
+}
+
+/// The colours of the turns' and the translations' series, in order.
+const HEADING_COLOURS: [[u8; 3]; 4] = [[30, 80, 220], [220, 60, 30], [20, 150, 60], [150, 60, 180]];
+
+/// The reference circle as a polar plot: its grey level by direction, closed.
+fn polar_chart(h: &Heading) -> Chart {
     let n = h.reference.len().max(1);
     let polar: Vec<(f64, f64)> = h
         .reference
@@ -463,7 +479,7 @@ fn heading_figure(
             (l * a.cos(), l * a.sin())
         })
         .collect();
-    let polar_chart = Chart {
+    Chart {
         title: format!(
             "reference circle (R = {:.1} px): grey level by direction",
             h.radius_px
@@ -478,16 +494,21 @@ fn heading_figure(
             points: polar,
             style: Style::Line,
         }],
-    };
+    }
+}
+
+/// Each turn at the checkpoint: the accepted reading's error frame by frame.
+fn rotation_chart(h: &Heading) -> Chart {
+    let method = h.config.method;
     let frames = h.spec.frames_per_rotation as usize;
-    let rotation_series = h
+    let series = h
         .spec
         .rotations_deg
         .iter()
         .enumerate()
         .map(|(k, &t)| Series {
             label: format!("turn {t:+.0} deg"),
-            rgb: COLOURS[k % 4],
+            rgb: HEADING_COLOURS[k % 4],
             points: h
                 .rotations
                 .iter()
@@ -499,15 +520,21 @@ fn heading_figure(
             style: Style::Dots,
         })
         .collect();
-    let rotation_chart = Chart {
+    Chart {
         title: "turns at the checkpoint: reading - truth, frame by frame".into(),
         x_label: "frame".into(),
         y_label: "error (deg)".into(),
         x_range: (-0.5, frames as f64 - 0.5),
         y_range: (-3.0, 3.0),
-        series: rotation_series,
-    };
-    let sweep_chart = Chart {
+        series,
+    }
+}
+
+/// The sweep of turns: the accepted reading's error against the true turn, with the largest
+/// error and the N/A count in the title.
+fn sweep_chart(h: &Heading, summary: &Summary) -> Chart {
+    let method = h.config.method;
+    Chart {
         title: format!(
             "sweep: reading - truth (max {:.1} deg, {} N/A)",
             HeadingMetrics::of(summary)
@@ -532,8 +559,14 @@ fn heading_figure(
                 .collect(),
             style: Style::Dots,
         }],
-    };
-    let mut translation_series = Vec::new();
+    }
+}
+
+/// The translations: each direction's accepted readings against the distance, its N/A
+/// readings as crosses at the bottom.
+fn translation_chart(h: &Heading) -> Chart {
+    let method = h.config.method;
+    let mut series = Vec::new();
     for (k, (name, _)) in DIRECTIONS.iter().enumerate() {
         let rs: Vec<&Reading> = h
             .translations
@@ -542,18 +575,18 @@ fn heading_figure(
             .map(|t| &t.1)
             .collect();
         let cm = |r: &Reading| r.offset_mm[0].hypot(r.offset_mm[1]) / 10.0;
-        translation_series.push(Series {
+        series.push(Series {
             label: name.to_string(),
-            rgb: COLOURS[k],
+            rgb: HEADING_COLOURS[k],
             points: rs
                 .iter()
                 .filter_map(|r| Some((cm(r), r.accepted(method)?)))
                 .collect(),
             style: Style::Line,
         });
-        translation_series.push(Series {
+        series.push(Series {
             label: String::new(),
-            rgb: COLOURS[k],
+            rgb: HEADING_COLOURS[k],
             points: rs
                 .iter()
                 .filter(|r| r.accepted(method).is_none())
@@ -563,20 +596,14 @@ fn heading_figure(
         });
     }
     let max_cm = h.spec.translation_max_mm / 10.0;
-    let translation_chart = Chart {
+    Chart {
         title: "translations: reading (crosses at the bottom: N/A)".into(),
         x_label: "distance from the checkpoint (cm)".into(),
         y_label: "reading (deg)".into(),
         x_range: (-1.0, max_cm + 1.0),
         y_range: (-10.0, 10.0),
-        series: translation_series,
-    };
-    charts_png(
-        "heading.png",
-        &[polar_chart, rotation_chart, sweep_chart, translation_chart],
-        2,
-        (640, 480),
-    )
+        series,
+    }
 }
 
 /// E3 as a Markdown table beside the paper's figures.

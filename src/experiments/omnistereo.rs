@@ -422,8 +422,36 @@ pub fn omnistereo_table(m: &Summary) -> String {
     let f = |v: Option<f64>, unit: &str, digits: usize| {
         v.map_or("-".into(), |x| format!("{x:.digits$} {unit}"))
     };
+    let rows = omnistereo_rows(e);
+    for (label, stats, unit, digits, target) in rows {
+        let _ = writeln!(
+            s,
+            "| {label} | {} | {} | {} | {target} |",
+            stats.map_or(0, |x| x.n),
+            f(stats.and_then(|x| x.median), unit, digits),
+            f(stats.and_then(|x| x.p95), unit, digits)
+        );
+    }
+    if let Some(near) = e.and_then(|e| e.range_error_pct.nearest_ranged_mm) {
+        let _ = writeln!(
+            s,
+            "\nNearest pillar ranged: {:.2} m. Nearer, a pillar's top is above the lower \
+             mirror's view: the common region of two cones (R = 30, d = 100, s = 150 mm) \
+             starts at s (d + R) / R - d = 550 mm for any feature, and later for the top of a \
+             600 mm pillar.",
+            near / 1000.0
+        );
+    }
+    s
+}
+
+/// The table's rows: label, the statistics, unit, decimals and the target; the range error's
+/// over the pillars of the metrics' band.
+fn omnistereo_rows(
+    e: Option<OmnistereoMetrics>,
+) -> [(String, Option<Stats>, &'static str, usize, &'static str); 4] {
     let band = e.map_or(default_band(), |e| e.range_error_pct.band_mm);
-    let rows = [
+    [
         (
             format!(
                 "range error, pillars {:.1}-{:.1} m",
@@ -456,27 +484,7 @@ pub fn omnistereo_table(m: &Summary) -> String {
             1,
             "median <= 10 mm",
         ),
-    ];
-    for (label, stats, unit, digits, target) in rows {
-        let _ = writeln!(
-            s,
-            "| {label} | {} | {} | {} | {target} |",
-            stats.map_or(0, |x| x.n),
-            f(stats.and_then(|x| x.median), unit, digits),
-            f(stats.and_then(|x| x.p95), unit, digits)
-        );
-    }
-    if let Some(near) = e.and_then(|e| e.range_error_pct.nearest_ranged_mm) {
-        let _ = writeln!(
-            s,
-            "\nNearest pillar ranged: {:.2} m. Nearer, a pillar's top is above the lower \
-             mirror's view: the common region of two cones (R = 30, d = 100, s = 150 mm) \
-             starts at s (d + R) / R - d = 550 mm for any feature, and later for the top of a \
-             600 mm pillar.",
-            near / 1000.0
-        );
-    }
-    s
+    ]
 }
 
 /// `omniloop replay omnistereo`.

@@ -361,6 +361,28 @@ pub fn resection_table(runs: &[&Summary]) -> String {
     }
     let _ = writeln!(s, "{head}\n{rule}");
     let results: Vec<Vec<PlaceResult>> = runs.iter().map(|m| place_results(m)).collect();
+    write_place_rows(&mut s, &results);
+    s.push('\n');
+    for m in runs {
+        let r = ResectionMetrics::of(m);
+        let max = r
+            .as_ref()
+            .and_then(|r| r.max_error_cm)
+            .map_or("-".into(), |e| format!("{e:.2} cm"));
+        let located = r.as_ref().map_or(0, |r| r.located);
+        let _ = writeln!(
+            s,
+            "- {}: located at {located} of {} places, largest error {max}.",
+            camera(m),
+            place_results(m).len()
+        );
+    }
+    s
+}
+
+/// The table's rows into `s`, a place a row: Table 1's true and observed position and error,
+/// then each run's estimate, error and search time (`results`: each run's places).
+fn write_place_rows(s: &mut String, results: &[Vec<PlaceResult>]) {
     let n = results.iter().map(Vec::len).max().unwrap_or(0);
     let pt = |p: [f64; 2]| format!("({:.0}, {:.0})", p[0], p[1]);
     for k in 0..n {
@@ -375,7 +397,7 @@ pub fn resection_table(runs: &[&Summary]) -> String {
             None => ("-".into(), "-".into()),
         };
         let _ = write!(s, "| {} | {} | {obs} | {err} |", k + 1, pt(place));
-        for r in &results {
+        for r in results {
             match r.get(k) {
                 Some(r) => {
                     let ours = r.estimate_cm.map_or("not located".into(), |e| {
@@ -394,22 +416,6 @@ pub fn resection_table(runs: &[&Summary]) -> String {
         }
         s.push('\n');
     }
-    s.push('\n');
-    for m in runs {
-        let r = ResectionMetrics::of(m);
-        let max = r
-            .as_ref()
-            .and_then(|r| r.max_error_cm)
-            .map_or("-".into(), |e| format!("{e:.2} cm"));
-        let located = r.as_ref().map_or(0, |r| r.located);
-        let _ = writeln!(
-            s,
-            "- {}: located at {located} of {} places, largest error {max}.",
-            camera(m),
-            place_results(m).len()
-        );
-    }
-    s
 }
 
 /// `omniloop replay resection`.

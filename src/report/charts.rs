@@ -1,6 +1,6 @@
 //! Charts: x-y plots of lines and dots in a grid of panels, drawn with plotters into a PNG.
 
-use super::topview::{FigureError, png_bytes, register_font};
+use super::topview::{FigureError, PlotError, png_bytes, register_font};
 use plotters::prelude::*;
 
 /// The colours of the lines of a figure, in order (Matplotlib's ten, then navy and maroon):
@@ -70,47 +70,42 @@ pub fn charts_png(
     cell: (u32, u32),
 ) -> Result<Vec<u8>, FigureError> {
     register_font();
-    let fail = |message: String| FigureError::Draw {
-        file: name.to_string(),
-        message,
-    };
     let columns = columns.max(1);
     let rows = charts.len().div_ceil(columns).max(1);
     let (w, h) = (cell.0 * columns as u32, cell.1 * rows as u32);
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+        root.fill(&WHITE).map_err(FigureError::plot(name))?;
         let areas = root.split_evenly((rows, columns));
         for (area, chart) in areas.iter().zip(charts) {
-            draw_chart(area, chart).map_err(fail)?;
+            draw_chart(area, chart).map_err(FigureError::plot(name))?;
         }
-        root.present().map_err(|e| fail(e.to_string()))?;
+        root.present().map_err(FigureError::plot(name))?;
     }
-    let img = image::RgbImage::from_raw(w, h, buf)
-        .ok_or_else(|| fail("the drawing buffer does not match the image size".into()))?;
+    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| FigureError::Buffer {
+        file: name.to_string(),
+    })?;
     png_bytes(name, &img)
 }
 
+/// One chart into `area`: its axes, its series and, when any is labelled, their legend.
 fn draw_chart(
     area: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
     c: &Chart,
-) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| e.to_string();
+) -> Result<(), PlotError> {
     let mut chart = ChartBuilder::on(area)
         .caption(&c.title, ("sans-serif", 16))
         .margin(10)
         .x_label_area_size(36)
         .y_label_area_size(52)
-        .build_cartesian_2d(c.x_range.0..c.x_range.1, c.y_range.0..c.y_range.1)
-        .map_err(|e| err(&e))?;
+        .build_cartesian_2d(c.x_range.0..c.x_range.1, c.y_range.0..c.y_range.1)?;
     chart
         .configure_mesh()
         .x_desc(c.x_label.as_str())
         .y_desc(c.y_label.as_str())
         .label_style(("sans-serif", 12))
-        .draw()
-        .map_err(|e| err(&e))?;
+        .draw()?;
     let mut labelled = false;
     for s in &c.series {
         let colour = RGBColor(s.rgb[0], s.rgb[1], s.rgb[2]);
@@ -121,8 +116,7 @@ fn draw_chart(
             Style::Crosses => {
                 chart.draw_series(pts.map(|p| Cross::new(p, 4, colour.stroke_width(2))))
             }
-        }
-        .map_err(|e| err(&e))?;
+        }?;
         if !s.label.is_empty() {
             labelled = true;
             drawn.label(s.label.clone()).legend(move |(x, y)| {
@@ -136,8 +130,7 @@ fn draw_chart(
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(|e| err(&e))?;
+            .draw()?;
     }
     Ok(())
 }

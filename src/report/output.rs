@@ -102,17 +102,50 @@ pub fn run_topview_image(
         .iter()
         .filter_map(|r| Some(Point2::new(r.est_x_mm?, r.est_y_mm?)))
         .collect();
+    let plan: Vec<Point2<f64>> = out
+        .estimates
+        .iter()
+        .rev()
+        .find_map(|e| e.navigation.as_ref())
+        .map(|n| n.path_mm.clone())
+        .unwrap_or_default();
+    let title = match out.map {
+        Some(_) => format!(
+            "{}  (robot's map: green free, orange suspect, red blocked, clear unknown)",
+            scenario.name
+        ),
+        None => scenario.name.clone(),
+    };
+    let panel = Panel {
+        title,
+        layout: &scenario.world,
+        paths: run_paths(&truth, &estimate, &out.other_paths, &plan),
+        markers: run_markers(scenario),
+        spots: Vec::new(),
+        grid: out.map.as_ref(),
+    };
+    render_panels(name, &[panel], width)
+}
+
+/// A run's paths, in drawing order: the estimated one (dots, when there is one), the other
+/// robots', the last plan (when it has two points or more) and the true one on top.
+fn run_paths<'a>(
+    truth: &'a [Point2<f64>],
+    estimate: &'a [Point2<f64>],
+    others: &'a [Vec<Point2<f64>>],
+    plan: &'a [Point2<f64>],
+) -> Vec<PathLayer<'a>> {
     let mut layers = Vec::new();
     if !estimate.is_empty() {
         layers.push(PathLayer {
             label: "estimated".into(),
             rgb: [30, 80, 230],
-            points: &estimate,
+            points: estimate,
             dots: true,
             discs: None,
         });
     }
-    for (k, p) in out.other_paths.iter().enumerate() {
+    for (k, p) in others.iter().enumerate() {
         layers.push(PathLayer {
             label: format!("robot {}", k + 1),
             rgb: [200, 40, 160],
@@ -121,18 +154,11 @@ pub fn run_topview_image(
             discs: None,
         });
     }
-    let plan: Vec<Point2<f64>> = out
-        .estimates
-        .iter()
-        .rev()
-        .find_map(|e| e.navigation.as_ref())
-        .map(|n| n.path_mm.clone())
-        .unwrap_or_default();
     if plan.len() > 1 {
         layers.push(PathLayer {
             label: "last plan".into(),
             rgb: [20, 140, 60],
-            points: &plan,
+            points: plan,
             dots: false,
             discs: None,
         });
@@ -140,10 +166,16 @@ pub fn run_topview_image(
     layers.push(PathLayer {
         label: "true path".into(),
         rgb: [220, 30, 30],
-        points: &truth,
+        points: truth,
         dots: false,
         discs: None,
     });
+    layers
+}
+
+/// The robot's start (a circle of its size), and the goal's waypoints and the goal (circles of
+/// its tolerance).
+fn run_markers(scenario: &Scenario) -> Vec<Marker> {
     let mut markers = vec![Marker {
         at: scenario.start().point(),
         radius_mm: scenario.robot.radius_mm,
@@ -166,22 +198,7 @@ pub fn run_topview_image(
             label: "goal".into(),
         });
     }
-    let title = match out.map {
-        Some(_) => format!(
-            "{}  (robot's map: green free, orange suspect, red blocked, clear unknown)",
-            scenario.name
-        ),
-        None => scenario.name.clone(),
-    };
-    let panel = Panel {
-        title,
-        layout: &scenario.world,
-        paths: layers,
-        markers,
-        spots: Vec::new(),
-        grid: out.map.as_ref(),
-    };
-    render_panels(name, &[panel], width)
+    markers
 }
 
 /// The top view of a team's run: each robot's true path in its colour, from its start (a

@@ -4,6 +4,7 @@
 use nalgebra::Point2;
 use omniloop_robot::{CellState, MapSnapshot};
 use omniloop_sim::{Layout, Rgb, SolidShape};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::Path;
@@ -12,13 +13,19 @@ use std::sync::Once;
 /// Why a figure could not be drawn or written.
 #[derive(Debug, thiserror::Error)]
 pub enum FigureError {
-    /// Drawing failed.
-    #[error("drawing {file}: {message}")]
-    Draw {
+    /// The drawing's buffer does not make an image of the figure's size.
+    #[error("drawing {file}: the drawing buffer does not match the image size")]
+    Buffer {
         /// Target file.
         file: String,
-        /// What went wrong.
-        message: String,
+    },
+    /// A plotters call failed while drawing.
+    #[error("drawing {file}: {source}")]
+    Plot {
+        /// Target file.
+        file: String,
+        /// The cause.
+        source: PlotError,
     },
     /// Encoding or writing the PNG failed.
     #[error("writing {file}: {source}")]
@@ -28,6 +35,27 @@ pub enum FigureError {
         /// The cause.
         source: image::ImageError,
     },
+}
+
+/// A plotters call that failed while drawing into an image buffer.
+#[derive(Debug, thiserror::Error)]
+#[error(transparent)]
+pub struct PlotError(#[from] DrawingAreaErrorKind<BitMapError>);
+
+/// The bitmap backend's own error.
+type BitMapError = <BitMapBackend<'static> as DrawingBackend>::ErrorType;
+
+impl FigureError {
+    /// The error of the figure `file` for a plotters call that failed drawing it.
+    pub(crate) fn plot<E>(file: &str) -> impl Fn(E) -> FigureError + '_
+    where
+        PlotError: From<E>,
+    {
+        move |e| FigureError::Plot {
+            file: file.to_string(),
+            source: PlotError::from(e),
+        }
+    }
 }
 
 static FONT: Once = Once::new();
@@ -199,152 +227,43 @@ pub struct Panel<'a> {
 
 type Area<'b> = DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>;
 
+/// A panel's plotting area, in world mm.
+type Plot<'b> = DrawingArea<BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A panel's chart: its axes and the series with their legend.
+type PanelChart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// One panel into `area`, over `bounds` (x0, x1, y0, y1 in mm): axes, the floor, the robot's
+/// map, the solids, markers, paths and spots, and their legend.
 fn draw_panel(
     area: &Area<'_>,
     panel: &Panel<'_>,
     bounds: (f64, f64, f64, f64),
-) -> Result<(), String> {
-    let err = |e: &dyn std::fmt::Display| e.to_string();
+) -> Result<(), PlotError> {
     let (x0, x1, y0, y1) = bounds;
-    let layout = panel.layout;
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, ("sans-serif", 18))
         .margin_right(20)
         .x_label_area_size(50)
         .y_label_area_size(85)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(&e))?;
+        .build_cartesian_2d(x0..x1, y0..y1)?;
     chart
         .configure_mesh()
         .disable_mesh()
         .x_desc("x [mm]")
         .y_desc("y [mm]")
         .label_style(("sans-serif", 12))
-        .draw()
-        .map_err(|e| err(&e))?;
+        .draw()?;
     let plot = chart.plotting_area().clone();
-    plot.draw(&Rectangle::new(
-        [(x0, y0), (x1, y1)],
-        rgb(layout.outside_rgb).filled(),
-    ))
-    .map_err(|e| err(&e))?;
-    let rects = layout.all_floor_rects();
-    if rects.is_empty() {
-        plot.draw(&Rectangle::new(
-            [(x0, y0), (x1, y1)],
-            rgb(layout.floor_rgb).filled(),
-        ))
-        .map_err(|e| err(&e))?;
-    }
-    for r in rects {
-        let pts = rect_corners(
-            Point2::from(r.center_mm),
-            [r.size_mm[0] / 2.0, r.size_mm[1] / 2.0],
-            r.angle_deg.to_radians(),
-        );
-        plot.draw(&Polygon::new(pts, rgb(layout.floor_rgb).filled()))
-            .map_err(|e| err(&e))?;
-    }
-    if let Some(f) = &layout.field {
-        let line = rgb(layout.line_rgb).stroke_width(1);
-        let (a, b) = (f.half_length_mm, f.half_width_mm);
-        plot.draw(&PathElement::new(
-            vec![(-a, -b), (a, -b), (a, b), (-a, b), (-a, -b)],
-            line,
-        ))
-        .map_err(|e| err(&e))?;
-        plot.draw(&PathElement::new(vec![(0.0, -b), (0.0, b)], line))
-            .map_err(|e| err(&e))?;
-        plot.draw(&PathElement::new(
-            circle_points(Point2::origin(), f.centre_circle_radius_mm, 72),
-            line,
-        ))
-        .map_err(|e| err(&e))?;
-    }
+    draw_floor(&plot, panel.layout, bounds)?;
     if let Some(grid) = panel.grid {
         draw_grid(&plot, grid)?;
     }
-    for s in layout.solids() {
-        let fill = rgb(s.rgb).filled();
-        let edge = RGBColor(60, 60, 60).stroke_width(1);
-        let pts = outline(&s.shape);
-        plot.draw(&Polygon::new(pts.clone(), fill))
-            .map_err(|e| err(&e))?;
-        if !matches!(s.shape, SolidShape::Cylinder { .. }) {
-            let mut closed = pts;
-            closed.push(closed[0]);
-            plot.draw(&PathElement::new(closed, edge))
-                .map_err(|e| err(&e))?;
-        }
-    }
-    for m in &panel.markers {
-        plot.draw(&PathElement::new(
-            circle_points(m.at, m.radius_mm, 48),
-            color(m.rgb).stroke_width(2),
-        ))
-        .map_err(|e| err(&e))?;
-        if !m.label.is_empty() {
-            plot.draw(&Text::new(
-                m.label.clone(),
-                (m.at.x + m.radius_mm, m.at.y + m.radius_mm),
-                ("sans-serif", 13).into_font().color(&BLACK),
-            ))
-            .map_err(|e| err(&e))?;
-        }
-    }
-    for p in &panel.paths {
-        let c = color(p.rgb);
-        if let Some((every, radius)) = p.discs {
-            for q in p.points.iter().step_by(every.max(1)) {
-                chart
-                    .plotting_area()
-                    .draw(&PathElement::new(
-                        circle_points(*q, radius, 36),
-                        c.stroke_width(1),
-                    ))
-                    .map_err(|e| err(&e))?;
-            }
-        }
-        let pts: Vec<(f64, f64)> = p.points.iter().map(|q| (q.x, q.y)).collect();
-        let series = if p.dots {
-            chart
-                .draw_series(pts.iter().map(|&q| Circle::new(q, 1, c.filled())))
-                .map_err(|e| err(&e))?
-        } else {
-            chart
-                .draw_series(LineSeries::new(pts, c.stroke_width(2)))
-                .map_err(|e| err(&e))?
-        };
-        series
-            .label(p.label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
-    }
-    for spots in &panel.spots {
-        let c = color(spots.rgb);
-        let r = spots.size_px;
-        let pts = spots.points.iter().map(|q| (q.x, q.y));
-        let series = match spots.mark {
-            Mark::Disc => {
-                chart
-                    .draw_series(pts.clone().map(|q| Circle::new(q, r + 1, WHITE.filled())))
-                    .map_err(|e| err(&e))?;
-                chart
-                    .draw_series(pts.map(|q| Circle::new(q, r, c.filled())))
-                    .map_err(|e| err(&e))?
-            }
-            Mark::Cross => chart
-                .draw_series(pts.map(|q| Cross::new(q, r, c.stroke_width(2))))
-                .map_err(|e| err(&e))?,
-        };
-        let mark = spots.mark;
-        series.label(spots.label.clone()).legend(move |(x, y)| {
-            let at = (x + 9, y);
-            match mark {
-                Mark::Disc => EmptyElement::at(at) + Circle::new((0, 0), r, c.filled()),
-                Mark::Cross => EmptyElement::at(at) + Circle::new((0, 0), r, c.stroke_width(2)),
-            }
-        });
-    }
+    draw_solids(&plot, panel.layout)?;
+    draw_markers(&plot, &panel.markers)?;
+    draw_paths(&mut chart, &panel.paths)?;
+    draw_spots(&mut chart, &panel.spots)?;
     if !panel.paths.is_empty() || !panel.spots.is_empty() {
         // Spots cover the floor: their legend goes below it.
         let position = if panel.spots.is_empty() {
@@ -358,20 +277,147 @@ fn draw_panel(
             .border_style(BLACK)
             .label_font(("sans-serif", 13))
             .position(position)
-            .draw()
-            .map_err(|e| err(&e))?;
+            .draw()?;
+    }
+    Ok(())
+}
+
+/// The ground: the outside over `bounds`, the floor's rectangles (the whole panel when there
+/// are none) and a field's lines.
+fn draw_floor(
+    plot: &Plot<'_>,
+    layout: &Layout,
+    bounds: (f64, f64, f64, f64),
+) -> Result<(), PlotError> {
+    let (x0, x1, y0, y1) = bounds;
+    plot.draw(&Rectangle::new(
+        [(x0, y0), (x1, y1)],
+        rgb(layout.outside_rgb).filled(),
+    ))?;
+    let rects = layout.all_floor_rects();
+    if rects.is_empty() {
+        plot.draw(&Rectangle::new(
+            [(x0, y0), (x1, y1)],
+            rgb(layout.floor_rgb).filled(),
+        ))?;
+    }
+    for r in rects {
+        let pts = rect_corners(
+            Point2::from(r.center_mm),
+            [r.size_mm[0] / 2.0, r.size_mm[1] / 2.0],
+            r.angle_deg.to_radians(),
+        );
+        plot.draw(&Polygon::new(pts, rgb(layout.floor_rgb).filled()))?;
+    }
+    if let Some(f) = &layout.field {
+        let line = rgb(layout.line_rgb).stroke_width(1);
+        let (a, b) = (f.half_length_mm, f.half_width_mm);
+        plot.draw(&PathElement::new(
+            vec![(-a, -b), (a, -b), (a, b), (-a, b), (-a, -b)],
+            line,
+        ))?;
+        plot.draw(&PathElement::new(vec![(0.0, -b), (0.0, b)], line))?;
+        plot.draw(&PathElement::new(
+            circle_points(Point2::origin(), f.centre_circle_radius_mm, 72),
+            line,
+        ))?;
+    }
+    Ok(())
+}
+
+/// The world's solids, filled in their colour; all but cylinders edged in dark grey.
+fn draw_solids(plot: &Plot<'_>, layout: &Layout) -> Result<(), PlotError> {
+    for s in layout.solids() {
+        let fill = rgb(s.rgb).filled();
+        let edge = RGBColor(60, 60, 60).stroke_width(1);
+        let pts = outline(&s.shape);
+        plot.draw(&Polygon::new(pts.clone(), fill))?;
+        if !matches!(s.shape, SolidShape::Cylinder { .. }) {
+            let mut closed = pts;
+            closed.push(closed[0]);
+            plot.draw(&PathElement::new(closed, edge))?;
+        }
+    }
+    Ok(())
+}
+
+/// The markers: circles to scale, each with its label at its upper right.
+fn draw_markers(plot: &Plot<'_>, markers: &[Marker]) -> Result<(), PlotError> {
+    for m in markers {
+        plot.draw(&PathElement::new(
+            circle_points(m.at, m.radius_mm, 48),
+            color(m.rgb).stroke_width(2),
+        ))?;
+        if !m.label.is_empty() {
+            plot.draw(&Text::new(
+                m.label.clone(),
+                (m.at.x + m.radius_mm, m.at.y + m.radius_mm),
+                ("sans-serif", 13).into_font().color(&BLACK),
+            ))?;
+        }
+    }
+    Ok(())
+}
+
+/// The paths, as lines or dots (with the robot's outline along them when asked), each in the
+/// legend.
+fn draw_paths<'a, 'b: 'a>(
+    chart: &mut PanelChart<'a, 'b>,
+    paths: &[PathLayer<'_>],
+) -> Result<(), PlotError> {
+    for p in paths {
+        let c = color(p.rgb);
+        if let Some((every, radius)) = p.discs {
+            for q in p.points.iter().step_by(every.max(1)) {
+                chart.plotting_area().draw(&PathElement::new(
+                    circle_points(*q, radius, 36),
+                    c.stroke_width(1),
+                ))?;
+            }
+        }
+        let pts: Vec<(f64, f64)> = p.points.iter().map(|q| (q.x, q.y)).collect();
+        let series = if p.dots {
+            chart.draw_series(pts.iter().map(|&q| Circle::new(q, 1, c.filled())))?
+        } else {
+            chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))?
+        };
+        series
+            .label(p.label.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+    }
+    Ok(())
+}
+
+/// The spots, discs (white-rimmed) or crosses, each set in the legend.
+fn draw_spots<'a, 'b: 'a>(
+    chart: &mut PanelChart<'a, 'b>,
+    spots: &[Spots],
+) -> Result<(), PlotError> {
+    for spots in spots {
+        let c = color(spots.rgb);
+        let r = spots.size_px;
+        let pts = spots.points.iter().map(|q| (q.x, q.y));
+        let series = match spots.mark {
+            Mark::Disc => {
+                chart.draw_series(pts.clone().map(|q| Circle::new(q, r + 1, WHITE.filled())))?;
+                chart.draw_series(pts.map(|q| Circle::new(q, r, c.filled())))?
+            }
+            Mark::Cross => chart.draw_series(pts.map(|q| Cross::new(q, r, c.stroke_width(2))))?,
+        };
+        let mark = spots.mark;
+        series.label(spots.label.clone()).legend(move |(x, y)| {
+            let at = (x + 9, y);
+            match mark {
+                Mark::Disc => EmptyElement::at(at) + Circle::new((0, 0), r, c.filled()),
+                Mark::Cross => EmptyElement::at(at) + Circle::new((0, 0), r, c.stroke_width(2)),
+            }
+        });
     }
     Ok(())
 }
 
 /// The robot's map, a rectangle a run of like cells along each row.
-fn draw_grid(
-    plot: &DrawingArea<
-        BitMapBackend<'_>,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
-    grid: &MapSnapshot,
-) -> Result<(), String> {
+fn draw_grid(plot: &Plot<'_>, grid: &MapSnapshot) -> Result<(), PlotError> {
     let g = &grid.geometry;
     let (ox, oy, c) = (g.origin_mm.x, g.origin_mm.y, g.cell_mm);
     for y in 0..g.height {
@@ -391,8 +437,7 @@ fn draw_grid(
                 plot.draw(&Rectangle::new(
                     [(x0, y0), (x0 + run as f64 * c, y0 + c)],
                     style,
-                ))
-                .map_err(|e| e.to_string())?;
+                ))?;
             }
             x += run;
         }
@@ -444,10 +489,6 @@ pub fn render_panels(
     width: u32,
 ) -> Result<image::RgbImage, FigureError> {
     register_font();
-    let fail = |message: String| FigureError::Draw {
-        file: name.to_string(),
-        message,
-    };
     let mut b = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for p in panels {
         let (x0, x1, y0, y1) = bounds(p.layout, &p.paths, &p.markers, &p.spots);
@@ -462,15 +503,16 @@ pub fn render_panels(
     let mut buf = vec![255u8; (total_w * height * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (total_w, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+        root.fill(&WHITE).map_err(FigureError::plot(name))?;
         let areas = root.split_evenly((1, panels.len().max(1)));
         for (area, panel) in areas.iter().zip(panels) {
-            draw_panel(area, panel, b).map_err(fail)?;
+            draw_panel(area, panel, b).map_err(FigureError::plot(name))?;
         }
-        root.present().map_err(|e| fail(e.to_string()))?;
+        root.present().map_err(FigureError::plot(name))?;
     }
-    image::RgbImage::from_raw(total_w, height, buf)
-        .ok_or_else(|| fail("the drawing buffer does not match the image size".into()))
+    image::RgbImage::from_raw(total_w, height, buf).ok_or_else(|| FigureError::Buffer {
+        file: name.to_string(),
+    })
 }
 
 /// Draws one panel into a PNG `width` pixels wide.

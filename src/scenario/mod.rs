@@ -4,7 +4,6 @@
 //! It knows nothing of running: everything above imports it.
 
 pub mod calibrate;
-pub mod camera_export;
 pub mod check;
 pub mod parse;
 pub mod rules;

@@ -5,7 +5,8 @@ use super::plan::Plan;
 use super::report::{Aggregate, Row, aggregates};
 use super::set::value_text;
 use crate::report::charts::{Chart, Series, Style, charts_png};
-use crate::report::topview::{FigureError, png_bytes, register_font};
+use crate::report::topview::{FigureError, PlotError, png_bytes, register_font};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// The figure of `metric` (`success_rate` or a column of `sweep.csv`).
@@ -138,9 +139,67 @@ fn colour(t: f64) -> RGBColor {
 /// Two or more keys: a grid over the first two keys' values, each cell the metric's mean over
 /// the seeds (and over the further keys), its value written in it.
 fn heat_map(plan: &Plan, aggs: &[Aggregate], metric: &str) -> Result<Vec<u8>, FigureError> {
+    let cells = cell_means(plan, aggs, metric);
+    register_font();
+    let (w, h) = (820u32, 600u32);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        draw_heat_map(&root, plan, metric, &cells).map_err(FigureError::plot("sweep.png"))?;
+    }
+    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| FigureError::Buffer {
+        file: "sweep.png".into(),
+    })?;
+    png_bytes("sweep.png", &img)
+}
+
+/// The heat map of `cells` (from [`cell_means`]) into `root`: the title, the first two keys'
+/// values along the axes, a coloured cell for each pair.
+fn draw_heat_map(
+    root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    plan: &Plan,
+    metric: &str,
+    cells: &[Option<f64>],
+) -> Result<(), PlotError> {
     let (xs, ys) = (&plan.sets[0], &plan.sets[1]);
     let (nx, ny) = (xs.values.len(), ys.values.len());
-    let mut sum = vec![(0.0, 0usize); nx * ny];
+    let (lo, hi) = colour_range(metric, cells);
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(heat_title(plan, metric, lo, hi), ("sans-serif", 16))
+        .margin(14)
+        .x_label_area_size(46)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..nx as f64, 0.0..ny as f64)?;
+    let x_names: Vec<String> = xs.values.iter().map(value_text).collect();
+    let y_names: Vec<String> = ys.values.iter().map(value_text).collect();
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(xs.key.as_str())
+        .y_desc(ys.key.as_str())
+        .x_labels(nx * 2 + 1)
+        .y_labels(ny * 2 + 1)
+        .x_label_formatter(&|v| name_at(&x_names, *v))
+        .y_label_formatter(&|v| name_at(&y_names, *v))
+        .label_style(("sans-serif", 13))
+        .draw()?;
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let value = cells[iy * nx + ix].map(|v| ((v - lo) / (hi - lo), label(metric, v)));
+            draw_cell(&mut chart, (ix as f64, iy as f64), value)?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// Each cell's mean of `metric` over its combinations (`None`: no run has it), row by row of
+/// the second key's values, the first key's along each row.
+fn cell_means(plan: &Plan, aggs: &[Aggregate], metric: &str) -> Vec<Option<f64>> {
+    let (xs, ys) = (&plan.sets[0], &plan.sets[1]);
+    let nx = xs.values.len();
+    let mut sum = vec![(0.0, 0usize); nx * ys.values.len()];
     for a in aggs {
         let values = &plan.jobs[a.rows[0].run].values;
         let ix = xs.values.iter().position(|v| *v == values[0]);
@@ -150,23 +209,30 @@ fn heat_map(plan: &Plan, aggs: &[Aggregate], metric: &str) -> Result<Vec<u8>, Fi
             sum[iy * nx + ix].1 += 1;
         }
     }
-    let cells: Vec<Option<f64>> = sum
-        .iter()
+    sum.iter()
         .map(|&(s, n)| (n > 0).then(|| s / n as f64))
-        .collect();
-    let (lo, hi) = if metric == "success_rate" {
+        .collect()
+}
+
+/// The values at the ends of the colour scale: 0 to 1 for the success rate, else the cells'
+/// range.
+fn colour_range(metric: &str, cells: &[Option<f64>]) -> (f64, f64) {
+    if metric == "success_rate" {
+        return (0.0, 1.0);
+    }
+    let (lo, hi) = cells
+        .iter()
+        .flatten()
+        .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    if lo > hi {
         (0.0, 1.0)
     } else {
-        let (lo, hi) = cells
-            .iter()
-            .flatten()
-            .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-        if lo > hi {
-            (0.0, 1.0)
-        } else {
-            (lo, hi.max(lo + 1e-9))
-        }
-    };
+        (lo, hi.max(lo + 1e-9))
+    }
+}
+
+/// The heat map's title: the metric, the keys averaged over and the colour scale's ends.
+fn heat_title(plan: &Plan, metric: &str, lo: f64, hi: f64) -> String {
     let more = if plan.sets.len() > 2 {
         format!(
             ", averaged over {}",
@@ -179,85 +245,54 @@ fn heat_map(plan: &Plan, aggs: &[Aggregate], metric: &str) -> Result<Vec<u8>, Fi
     } else {
         String::new()
     };
-    let title = format!(
+    format!(
         "{}: {metric} (mean over seeds{more}; {} to {})",
         plan.name,
         label(metric, lo),
         label(metric, hi)
-    );
-    register_font();
-    let (w, h) = (820u32, 600u32);
-    let mut buf = vec![255u8; (w * h * 3) as usize];
-    let fail = |e: String| FigureError::Draw {
-        file: "sweep.png".into(),
-        message: e,
-    };
-    {
-        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(&title, ("sans-serif", 16))
-            .margin(14)
-            .x_label_area_size(46)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..nx as f64, 0.0..ny as f64)
-            .map_err(|e| fail(e.to_string()))?;
-        let x_names: Vec<String> = xs.values.iter().map(value_text).collect();
-        let y_names: Vec<String> = ys.values.iter().map(value_text).collect();
-        let name_of = |names: &[String], v: f64| -> String {
-            let k = (v - 0.5).round();
-            if (v - 0.5 - k).abs() < 1e-6 && k >= 0.0 {
-                names.get(k as usize).cloned().unwrap_or_default()
-            } else {
-                String::new()
-            }
-        };
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc(xs.key.as_str())
-            .y_desc(ys.key.as_str())
-            .x_labels(nx * 2 + 1)
-            .y_labels(ny * 2 + 1)
-            .x_label_formatter(&|v| name_of(&x_names, *v))
-            .y_label_formatter(&|v| name_of(&y_names, *v))
-            .label_style(("sans-serif", 13))
-            .draw()
-            .map_err(|e| fail(e.to_string()))?;
-        for iy in 0..ny {
-            for ix in 0..nx {
-                let (x0, y0) = (ix as f64, iy as f64);
-                let (fill, text) = match cells[iy * nx + ix] {
-                    Some(v) => (colour((v - lo) / (hi - lo)), label(metric, v)),
-                    None => (RGBColor(220, 220, 220), "-".to_string()),
-                };
-                let corners = [(x0, y0), (x0 + 1.0, y0 + 1.0)];
-                chart
-                    .draw_series([
-                        Rectangle::new(corners, fill.filled()),
-                        Rectangle::new(corners, WHITE.stroke_width(2)),
-                    ])
-                    .map_err(|e| fail(e.to_string()))?;
-                let dark = fill.0 as u32 + fill.1 as u32 + fill.2 as u32 > 380;
-                let ink = if dark { BLACK } else { WHITE };
-                let style = TextStyle::from(("sans-serif", 15).into_font())
-                    .color(&ink)
-                    .pos(plotters::style::text_anchor::Pos::new(
-                        plotters::style::text_anchor::HPos::Center,
-                        plotters::style::text_anchor::VPos::Center,
-                    ));
-                chart
-                    .draw_series(std::iter::once(Text::new(
-                        text,
-                        (x0 + 0.5, y0 + 0.5),
-                        style,
-                    )))
-                    .map_err(|e| fail(e.to_string()))?;
-            }
-        }
-        root.present().map_err(|e| fail(e.to_string()))?;
+    )
+}
+
+/// The name of the value whose cell is centred on axis position `v` (cells are a unit wide
+/// from 0), blank between cells.
+fn name_at(names: &[String], v: f64) -> String {
+    let k = (v - 0.5).round();
+    if (v - 0.5 - k).abs() < 1e-6 && k >= 0.0 {
+        names.get(k as usize).cloned().unwrap_or_default()
+    } else {
+        String::new()
     }
-    let img = image::RgbImage::from_raw(w, h, buf)
-        .ok_or_else(|| fail("the drawing buffer does not match the image size".into()))?;
-    png_bytes("sweep.png", &img)
+}
+
+/// The heat map's cell with lower corner `at`: coloured for its value's place on the scale
+/// (from 0 to 1) with the value's text in it, or grey with a dash when it has none.
+fn draw_cell(
+    chart: &mut ChartContext<'_, BitMapBackend<'_>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    at: (f64, f64),
+    value: Option<(f64, String)>,
+) -> Result<(), PlotError> {
+    let (x0, y0) = at;
+    let (fill, text) = match value {
+        Some((t, text)) => (colour(t), text),
+        None => (RGBColor(220, 220, 220), "-".to_string()),
+    };
+    let corners = [(x0, y0), (x0 + 1.0, y0 + 1.0)];
+    chart.draw_series([
+        Rectangle::new(corners, fill.filled()),
+        Rectangle::new(corners, WHITE.stroke_width(2)),
+    ])?;
+    let dark = fill.0 as u32 + fill.1 as u32 + fill.2 as u32 > 380;
+    let ink = if dark { BLACK } else { WHITE };
+    let style = TextStyle::from(("sans-serif", 15).into_font())
+        .color(&ink)
+        .pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Center,
+            plotters::style::text_anchor::VPos::Center,
+        ));
+    chart.draw_series(std::iter::once(Text::new(
+        text,
+        (x0 + 0.5, y0 + 0.5),
+        style,
+    )))?;
+    Ok(())
 }

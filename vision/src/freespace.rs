@@ -242,6 +242,146 @@ impl FreeSpace {
 
 const NONE: u16 = u16::MAX;
 
+/// The rings' edges in image pixels and on the floor (mm): as `config` gives them in mm or
+/// in pixels, else `rings` + 1 edges evenly spaced in the image or on the floor from
+/// `inner_mm` to `outer_mm`, each converted with the calibration.
+fn ring_edges(
+    config: &FreeSpaceConfig,
+    cal: &RadialCalibration,
+) -> Result<(Vec<f64>, Vec<f64>), VisionError> {
+    let i_n = config.rings;
+    let to_px = |mm: f64| {
+        cal.image_radius_px(mm)
+            .ok_or(VisionError::InvalidParameter {
+                name: "ring edge (mm)",
+                value: mm,
+                rule: "must lie on the floor the sensor sees (inside the calibration table)",
+            })
+    };
+    let to_mm = |px: f64| {
+        cal.floor_distance_mm(px)
+            .ok_or(VisionError::InvalidParameter {
+                name: "ring edge (px)",
+                value: px,
+                rule: "must lie below the floor horizon of the calibration table",
+            })
+    };
+    if !config.ring_edges_mm.is_empty() {
+        let px = config
+            .ring_edges_mm
+            .iter()
+            .map(|&m| to_px(m))
+            .collect::<Result<Vec<_>, _>>()?;
+        return Ok((px, config.ring_edges_mm.clone()));
+    }
+    if !config.ring_edges_px.is_empty() {
+        let mm = config
+            .ring_edges_px
+            .iter()
+            .map(|&p| to_mm(p))
+            .collect::<Result<Vec<_>, _>>()?;
+        return Ok((config.ring_edges_px.clone(), mm));
+    }
+    match config.spacing {
+        RingSpacing::Image => {
+            let (a, b) = (to_px(config.inner_mm)?, to_px(config.outer_mm)?);
+            let px: Vec<f64> = (0..=i_n)
+                .map(|k| a + (b - a) * k as f64 / i_n as f64)
+                .collect();
+            let mm = px
+                .iter()
+                .map(|&p| to_mm(p))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok((px, mm))
+        }
+        RingSpacing::Floor => {
+            let (a, b) = (config.inner_mm, config.outer_mm);
+            let mm: Vec<f64> = (0..=i_n)
+                .map(|k| a + (b - a) * k as f64 / i_n as f64)
+                .collect();
+            let px = mm
+                .iter()
+                .map(|&m| to_px(m))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok((px, mm))
+        }
+    }
+}
+
+/// Checks there are `rings` + 1 edges (pixels), non-negative and strictly increasing.
+fn check_ring_edges(edges_px: &[f64], rings: usize) -> Result<(), VisionError> {
+    if edges_px.len() != rings + 1 {
+        return Err(VisionError::InvalidParameter {
+            name: "ring edges",
+            value: edges_px.len() as f64,
+            rule: "need rings + 1 edges",
+        });
+    }
+    if edges_px.windows(2).any(|w| w[1] <= w[0]) || edges_px[0] < 0.0 {
+        return Err(VisionError::InvalidParameter {
+            name: "ring edges",
+            value: edges_px[0],
+            rule: "must be non-negative and strictly increasing",
+        });
+    }
+    Ok(())
+}
+
+/// The cell (ring i, direction j: `i * directions + j`) of each pixel of the bounding box
+/// `bbox` ([x0, y0, x1, y1)), `NONE` outside the rings.
+fn label_pixels(
+    cal: &RadialCalibration,
+    edges_px: &[f64],
+    directions: usize,
+    bbox: [usize; 4],
+) -> Vec<u16> {
+    let [x0, y0, x1, y1] = bbox;
+    let (bw, bh) = (x1 - x0, y1 - y0);
+    let r_out = edges_px[edges_px.len() - 1];
+    let dir_step = TAU / directions as f64;
+    let mut raw = vec![NONE; bw * bh];
+    for y in 0..bh {
+        for x in 0..bw {
+            let (px, py) = cal.image_coords((x + x0) as f64, (y + y0) as f64);
+            let r = px.hypot(py);
+            if r < edges_px[0] || r >= r_out {
+                continue;
+            }
+            let i = edges_px.partition_point(|&e| e <= r) - 1;
+            let phi = py.atan2(px);
+            let j = ((phi / dir_step).round() as i64).rem_euclid(directions as i64) as usize;
+            raw[y * bw + x] = (i * directions + j) as u16;
+        }
+    }
+    raw
+}
+
+/// One-pixel lines between cells: a pixel of `raw` (`bw` x `bh`) whose right or lower
+/// neighbour is in another cell (or outside) is left out.
+fn cell_lines(raw: &[u16], bw: usize, bh: usize) -> Vec<u16> {
+    let mut cells = raw.to_vec();
+    for y in 0..bh {
+        for x in 0..bw {
+            let c = raw[y * bw + x];
+            if c == NONE {
+                continue;
+            }
+            let differs = |xx: isize, yy: isize| {
+                if xx < 0 || yy < 0 || xx >= bw as isize || yy >= bh as isize {
+                    return true;
+                }
+                raw[yy as usize * bw + xx as usize] != c
+            };
+            let (xi, yi) = (x as isize, y as isize);
+            // Only the right/down neighbours mark a line, so lines are one pixel wide.
+            if differs(xi + 1, yi) || differs(xi, yi + 1) {
+                cells[y * bw + x] = NONE;
+            }
+        }
+    }
+    cells
+}
+
 /// The polar template laid on the image.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PolarTemplate {
@@ -269,76 +409,8 @@ impl PolarTemplate {
                 rule: "need rings >= 1, directions >= 4 and fewer than 65535 cells",
             });
         }
-        let to_px = |mm: f64| {
-            cal.image_radius_px(mm)
-                .ok_or(VisionError::InvalidParameter {
-                    name: "ring edge (mm)",
-                    value: mm,
-                    rule: "must lie on the floor the sensor sees (inside the calibration table)",
-                })
-        };
-        let to_mm = |px: f64| {
-            cal.floor_distance_mm(px)
-                .ok_or(VisionError::InvalidParameter {
-                    name: "ring edge (px)",
-                    value: px,
-                    rule: "must lie below the floor horizon of the calibration table",
-                })
-        };
-        let (edges_px, edges_mm): (Vec<f64>, Vec<f64>) = if !config.ring_edges_mm.is_empty() {
-            let px = config
-                .ring_edges_mm
-                .iter()
-                .map(|&m| to_px(m))
-                .collect::<Result<Vec<_>, _>>()?;
-            (px, config.ring_edges_mm.clone())
-        } else if !config.ring_edges_px.is_empty() {
-            let mm = config
-                .ring_edges_px
-                .iter()
-                .map(|&p| to_mm(p))
-                .collect::<Result<Vec<_>, _>>()?;
-            (config.ring_edges_px.clone(), mm)
-        } else {
-            match config.spacing {
-                RingSpacing::Image => {
-                    let (a, b) = (to_px(config.inner_mm)?, to_px(config.outer_mm)?);
-                    let px: Vec<f64> = (0..=i_n)
-                        .map(|k| a + (b - a) * k as f64 / i_n as f64)
-                        .collect();
-                    let mm = px
-                        .iter()
-                        .map(|&p| to_mm(p))
-                        .collect::<Result<Vec<_>, _>>()?;
-                    (px, mm)
-                }
-                RingSpacing::Floor => {
-                    let (a, b) = (config.inner_mm, config.outer_mm);
-                    let mm: Vec<f64> = (0..=i_n)
-                        .map(|k| a + (b - a) * k as f64 / i_n as f64)
-                        .collect();
-                    let px = mm
-                        .iter()
-                        .map(|&m| to_px(m))
-                        .collect::<Result<Vec<_>, _>>()?;
-                    (px, mm)
-                }
-            }
-        };
-        if edges_px.len() != i_n + 1 {
-            return Err(VisionError::InvalidParameter {
-                name: "ring edges",
-                value: edges_px.len() as f64,
-                rule: "need rings + 1 edges",
-            });
-        }
-        if edges_px.windows(2).any(|w| w[1] <= w[0]) || edges_px[0] < 0.0 {
-            return Err(VisionError::InvalidParameter {
-                name: "ring edges",
-                value: edges_px[0],
-                rule: "must be non-negative and strictly increasing",
-            });
-        }
+        let (edges_px, edges_mm) = ring_edges(config, cal)?;
+        check_ring_edges(&edges_px, i_n)?;
         let (w, h) = (cal.width_px as usize, cal.height_px as usize);
         let [cx, cy] = cal.principal_point_px;
         let r_out = edges_px[i_n];
@@ -346,44 +418,8 @@ impl PolarTemplate {
         let y0 = ((cy - r_out).floor().max(0.0)) as usize;
         let x1 = ((cx + r_out).ceil() as usize + 1).min(w);
         let y1 = ((cy + r_out).ceil() as usize + 1).min(h);
-        let (bw, bh) = (x1 - x0, y1 - y0);
-        let dir_step = TAU / j_n as f64;
-        let mut raw = vec![NONE; bw * bh];
-        for y in 0..bh {
-            for x in 0..bw {
-                let (px, py) = cal.image_coords((x + x0) as f64, (y + y0) as f64);
-                let r = px.hypot(py);
-                if r < edges_px[0] || r >= r_out {
-                    continue;
-                }
-                let i = edges_px.partition_point(|&e| e <= r) - 1;
-                let phi = py.atan2(px);
-                let j = ((phi / dir_step).round() as i64).rem_euclid(j_n as i64) as usize;
-                raw[y * bw + x] = (i * j_n + j) as u16;
-            }
-        }
-        // One-pixel lines between cells: a pixel whose 4-neighbour is in another cell (or
-        // outside) is left out.
-        let mut cells = raw.clone();
-        for y in 0..bh {
-            for x in 0..bw {
-                let c = raw[y * bw + x];
-                if c == NONE {
-                    continue;
-                }
-                let differs = |xx: isize, yy: isize| {
-                    if xx < 0 || yy < 0 || xx >= bw as isize || yy >= bh as isize {
-                        return true;
-                    }
-                    raw[yy as usize * bw + xx as usize] != c
-                };
-                let (xi, yi) = (x as isize, y as isize);
-                // Only the right/down neighbours mark a line, so lines are one pixel wide.
-                if differs(xi + 1, yi) || differs(xi, yi + 1) {
-                    cells[y * bw + x] = NONE;
-                }
-            }
-        }
+        let bbox = [x0, y0, x1, y1];
+        let cells = cell_lines(&label_pixels(cal, &edges_px, j_n, bbox), x1 - x0, y1 - y0);
         let mut area = vec![0u32; i_n * j_n];
         for &c in &cells {
             if c != NONE {
@@ -404,7 +440,7 @@ impl PolarTemplate {
             edges_px,
             edges_mm,
             mount_mm: cal.mount_mm,
-            bbox: [x0, y0, x1, y1],
+            bbox,
             cells,
             area,
         })

@@ -18,25 +18,70 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
-/// The command's arguments.
+/// `omniloop sweep`'s arguments.
+#[derive(clap::Args)]
 pub struct Args {
-    pub scenario: Option<PathBuf>,
-    pub sets: Vec<String>,
-    pub seeds: Seeds,
-    pub jobs: usize,
-    pub out: Option<PathBuf>,
-    pub renderer: RendererChoice,
-    pub plot: String,
-    pub keep_runs: bool,
-    pub quiet: bool,
-    /// Write the plan (into this file, or OUT/plan.jsonl) and run nothing.
-    pub plan: Option<Option<PathBuf>>,
-    /// Report on the runs of this sweep folder's plan.
-    pub collect: Option<PathBuf>,
-    /// Go on from the sweep folder's rows.jsonl.
-    pub resume: bool,
+    /// Scenario file.
+    #[arg(required_unless_present = "collect")]
+    scenario: Option<PathBuf>,
+    /// A dotted key of the scenario and its values: TOML literals, bare words for strings,
+    /// ranges A..B:STEP (ends included); array items as `name[2].key`. Repeat for a grid.
+    #[arg(long = "set", value_name = "KEY=V1,V2,...")]
+    sets: Vec<String>,
+    /// Seeds of each combination: N (the scenario's seed and the N - 1 after it) or A..B.
+    #[arg(long, default_value = "1")]
+    seeds: Seeds,
+    /// Runs at a time (default: one a core); the CPU renderer shares the cores among them.
+    #[arg(long, default_value_t = 0)]
+    jobs: usize,
+    /// Output folder (default: runs/<scenario name>_sweep).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Renderer for the sensors' images: auto, gpu or cpu.
+    #[arg(long, default_value = "auto")]
+    renderer: RendererChoice,
+    /// The metric of sweep.png: success_rate or a column of sweep.csv.
+    #[arg(long, default_value = "success_rate")]
+    plot: String,
+    /// Keep each run's own outputs in OUT/runs/.
+    #[arg(long)]
+    keep_runs: bool,
+    /// No progress bar.
+    #[arg(long, short)]
+    quiet: bool,
+    /// Write every job (its values, seed, output name, scenario) as JSON lines into FILE
+    /// (default OUT/plan.jsonl) and run nothing: run job N with `omniloop run --plan FILE
+    /// --job N`, then report with --collect.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, conflicts_with = "resume")]
+    plan: Option<Option<PathBuf>>,
+    /// Build sweep.csv, sweep.md and sweep.png of DIR/plan.jsonl (or of the plan file DIR,
+    /// beside it) from its runs' folders in DIR/runs/ (as `omniloop run --plan` leaves them).
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["plan", "resume"])]
+    collect: Option<PathBuf>,
+    /// Go on with the sweep in OUT: the jobs OUT/rows.jsonl has are not run again.
+    #[arg(long)]
+    resume: bool,
+    /// sweep.md's outcomes: goals reachable on the true world with at least this margin
+    /// (mm) count for success, the others for honesty (reached or reported unreachable).
+    #[arg(long, value_name = "MM", default_value_t = omniloop::sweep::DEFAULT_REACHABLE_MARGIN_MM, value_parser = margin_mm)]
+    reachable_margin_mm: f64,
+}
+
+impl Args {
     /// What sweep.md is asked for (the margin of goals counted for success).
-    pub report: ReportSettings,
+    fn report(&self) -> ReportSettings {
+        ReportSettings {
+            reachable_margin_mm: self.reachable_margin_mm,
+        }
+    }
+}
+
+/// A margin in mm: a finite number >= 0.
+fn margin_mm(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("`{text}` is not a margin (a number of mm >= 0)")),
+    }
 }
 
 /// Set by Ctrl-C: no new runs start.
@@ -77,9 +122,9 @@ fn checked_plan(scenario: &std::path::Path, sets: &[Set], seeds: &Seeds) -> anyh
 }
 
 /// Runs the sweep, writes its plan, or collects its runs.
-pub fn command(a: Args) -> anyhow::Result<()> {
+pub fn sweep_cmd(a: Args) -> anyhow::Result<()> {
     if let Some(dir) = &a.collect {
-        return collect(dir, &a.plot, &a.report);
+        return collect(dir, &a.plot, &a.report());
     }
     let Some(scenario) = &a.scenario else {
         anyhow::bail!("omniloop sweep needs a scenario file (or --collect DIR)");
@@ -175,7 +220,7 @@ fn run_sweep(a: &Args, plan: &Plan, dir: &std::path::Path) -> anyhow::Result<()>
         options.threads,
         ran as f64 / wall_s.max(1e-9),
     );
-    report(dir, plan, &outcomes, &a.plot, &header, &a.report)?;
+    report(dir, plan, &outcomes, &a.plot, &header, &a.report())?;
     if stopped {
         return Err(Exit(130).into());
     }

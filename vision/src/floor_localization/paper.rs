@@ -10,6 +10,16 @@ use crate::geometry::{Moments, convex_hull};
 use image::RgbaImage;
 use nalgebra::{Isometry2, Matrix3, Point2, Rotation2, Vector2, Vector3};
 
+/// Step 6's outcome: the field's frame, the last fit's RMS residual (mm), the points and lines
+/// it used, and the iterations run.
+struct PaperFit {
+    frame: FieldFrame,
+    rms_mm: f64,
+    points: usize,
+    lines: usize,
+    iterations: usize,
+}
+
 impl FloorLocalizer {
     /// Steps 2-7 on the prepared mask of `img`.
     pub(super) fn locate_paper(
@@ -25,21 +35,61 @@ impl FloorLocalizer {
                 points.len()
             ));
         }
-        // Step 3 (on the floor) and 5.
+        let fit = match self
+            .first_guess(&points)
+            .and_then(|guess| self.iterate_fit(&points, guess))
+        {
+            Ok(fit) => fit,
+            Err(why) => return Localization::NotLocalized(why),
+        };
+        let (chosen, other, by_goals) = self.choose(img, &fit.frame, hint);
+        Localization::Localized(PoseEstimate {
+            pose: chosen,
+            alternative: other,
+            quality: LocalizationQuality {
+                rms_residual_mm: fit.rms_mm,
+                points: fit.points,
+                lines: fit.lines,
+                points_per_line: Vec::new(),
+                boundary_points: points.len(),
+                inlier_fraction: fit.points as f64 / points.len() as f64,
+                sigma: [f64::NAN; 3],
+                hull_cut: false,
+                iterations: fit.iterations,
+                mode: LocalizationMode::Global,
+                resolved_by_goals: by_goals,
+            },
+        })
+    }
+
+    /// Steps 3 (on the floor) and 5: the field's frame guessed from the moments of the
+    /// boundary points' hull (its centroid and long axis); an error when the hull is too small
+    /// to be the field.
+    fn first_guess(&self, points: &[BoundaryPoint]) -> Result<FieldFrame, String> {
         let pts: Vec<Point2<f64>> = points.iter().map(|b| b.p).collect();
         let hull = convex_hull(&pts);
         let m = Moments::of_polygon(&hull);
         let f = &self.config.field;
         let field_area = 4.0 * f.a1_mm * f.b_mm;
         if hull.len() < 3 || m.m00 < 0.1 * field_area {
-            return Localization::NotLocalized(format!(
+            return Err(format!(
                 "floor region hull too small ({:.2} m^2)",
                 m.m00 * 1e-6
             ));
         }
-        let mut centre = m.centroid();
-        let mut psi = m.long_axis();
-        // Step 6.
+        Ok(FieldFrame {
+            centre: m.centroid(),
+            psi: m.long_axis(),
+        })
+    }
+
+    /// Step 6: from `guess`, the six lines fitted by eq. (15) and the frame moved by the fitted
+    /// offset and rotation, until both are below the thresholds or the iterations run out.
+    fn iterate_fit(&self, points: &[BoundaryPoint], guess: FieldFrame) -> Result<PaperFit, String> {
+        let FieldFrame {
+            mut centre,
+            mut psi,
+        } = guess;
         let mut iterations = 0;
         let mut fit = None;
         while iterations < self.config.max_iterations {
@@ -48,9 +98,9 @@ impl FloorLocalizer {
             } else {
                 self.config.gate_mm
             };
-            let Some((du, dv, zeta, rms, used, lines)) = self.fit_step(&points, centre, psi, gate)
+            let Some((du, dv, zeta, rms, used, lines)) = self.fit_step(points, centre, psi, gate)
             else {
-                return Localization::NotLocalized(
+                return Err(
                     "boundary points do not fix the field (need a goal line or back and a \
                      touchline)"
                         .into(),
@@ -68,29 +118,15 @@ impl FloorLocalizer {
                 break;
             }
         }
-        let Some((rms, used, lines)) = fit else {
-            return Localization::NotLocalized(
-                "no iteration of the fit ran (max_iterations is 0)".into(),
-            );
+        let Some((rms_mm, points, lines)) = fit else {
+            return Err("no iteration of the fit ran (max_iterations is 0)".into());
         };
-        let frame = FieldFrame { centre, psi };
-        let (chosen, other, by_goals) = self.choose(img, &frame, hint);
-        Localization::Localized(PoseEstimate {
-            pose: chosen,
-            alternative: other,
-            quality: LocalizationQuality {
-                rms_residual_mm: rms,
-                points: used,
-                lines,
-                points_per_line: Vec::new(),
-                boundary_points: points.len(),
-                inlier_fraction: used as f64 / points.len() as f64,
-                sigma: [f64::NAN; 3],
-                hull_cut: false,
-                iterations,
-                mode: LocalizationMode::Global,
-                resolved_by_goals: by_goals,
-            },
+        Ok(PaperFit {
+            frame: FieldFrame { centre, psi },
+            rms_mm,
+            points,
+            lines,
+            iterations,
         })
     }
 

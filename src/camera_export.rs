@@ -10,8 +10,9 @@
 //! single-viewpoint model is from the real camera.
 
 use nalgebra::{Matrix3, Vector3};
-use omniloop_sim::SensorSpec;
 use omniloop_sim::optics::Optics;
+use omniloop_sim::{Sensor, SensorSpec};
+use omniloop_vision::VisionError;
 use omniloop_vision::camera_model::{
     CameraFile, Correspondence, DoubleSphereModel, FitResidual, ModelPose, OcamModel, UnifiedModel,
     fit_unified, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml, parse_camera_file, refine,
@@ -154,6 +155,53 @@ pub fn export_camera_model(
         return Err(ExportError::NotAMirror(spec.name.clone()));
     }
     let sensor = spec.build();
+    let (rays, dark_radii) = traced_rays(&sensor);
+    let image_circle_px = image_circle(&sensor, &rays, &dark_radii);
+    let viewpoint = nearest_point(&rays);
+    let spread = rays
+        .iter()
+        .map(|(_, o, d)| distance_to_line(&viewpoint, o, d))
+        .fold(0.0, f64::max);
+    let correspondences = in_frame(&rays, &UNIFIED_FRAME);
+    // OCamCalib's frame is its own; its rays are turned into it once.
+    let (rotation, ocam_rays) = match format {
+        CameraFormat::Ocamcalib => (OCAM_FRAME, in_frame(&rays, &OCAM_FRAME)),
+        _ => (UNIFIED_FRAME, Vec::new()),
+    };
+    let fit_error = |reason| ExportError::Fit {
+        sensor: spec.name.clone(),
+        reason,
+    };
+    let (model, residual) =
+        fit_model(&sensor, format, &correspondences, &ocam_rays).map_err(fit_error)?;
+    let pose = ModelPose {
+        rotation,
+        translation_mm: viewpoint,
+    };
+    let header = file_header(spec, format, &residual, spread, image_circle_px);
+    let size = [sensor.width_px, sensor.height_px];
+    let text = model_file(&model, format, size, &pose, &spec.name, &header);
+    // The file must read back to the model that was fitted.
+    check_read_back(&text, format, &residual, &correspondences, &ocam_rays).map_err(fit_error)?;
+    let mut export = CameraExport {
+        model,
+        pose,
+        residual,
+        viewpoint_spread_mm: spread,
+        image_circle_px,
+        text,
+        json: serde_json::Value::Null,
+    };
+    export.json = export_json(&spec.name, format, size, &export);
+    Ok(export)
+}
+
+/// A traced ray: the pixel, the ray's origin and its unit direction (body frame, mm).
+type Ray = ([f64; 2], Vector3<f64>, Vector3<f64>);
+
+/// The ray of every pixel that sees the mirror, and the distance (px) from the principal
+/// point of every one that does not.
+fn traced_rays(sensor: &Sensor) -> (Vec<Ray>, Vec<f64>) {
     let mut rays = Vec::new();
     let mut dark_radii = Vec::new();
     for v in 0..sensor.height_px {
@@ -167,52 +215,57 @@ pub fn export_camera_model(
             }
         }
     }
-    let image_circle_px = image_circle(&sensor, &rays, &dark_radii);
-    let viewpoint = nearest_point(&rays);
-    let spread = rays
-        .iter()
-        .map(|(_, o, d)| distance_to_line(&viewpoint, o, d))
-        .fold(0.0, f64::max);
-    let in_frame = |rotation: &Matrix3<f64>| -> Vec<Correspondence> {
-        rays.iter()
-            .map(|(pixel, _, d)| Correspondence {
-                direction: rotation.transpose() * d,
-                pixel: *pixel,
-            })
-            .collect()
-    };
-    let correspondences = in_frame(&UNIFIED_FRAME);
-    // OCamCalib's frame is its own; its rays are turned into it once.
-    let (rotation, ocam_rays) = match format {
-        CameraFormat::Ocamcalib => (OCAM_FRAME, in_frame(&OCAM_FRAME)),
-        _ => (UNIFIED_FRAME, Vec::new()),
-    };
-    let fit_error = |reason| ExportError::Fit {
-        sensor: spec.name.clone(),
-        reason,
-    };
-    let (unified, unified_residual) = fit_unified(&correspondences).map_err(fit_error)?;
-    let (model, residual) = match format {
+    (rays, dark_radii)
+}
+
+/// `rays` as pixel-direction pairs in a model's frame, whose axes are `rotation`'s columns.
+fn in_frame(rays: &[Ray], rotation: &Matrix3<f64>) -> Vec<Correspondence> {
+    rays.iter()
+        .map(|(pixel, _, d)| Correspondence {
+            direction: rotation.transpose() * d,
+            pixel: *pixel,
+        })
+        .collect()
+}
+
+/// `format`'s model fitted to the rays, with its residual: the unified model (in its frame,
+/// `correspondences`) first, the start of the double sphere fit and OCamCalib's centre
+/// (`ocam_rays`: the rays in OCamCalib's frame).
+fn fit_model(
+    sensor: &Sensor,
+    format: CameraFormat,
+    correspondences: &[Correspondence],
+    ocam_rays: &[Correspondence],
+) -> Result<(FittedModel, FitResidual), VisionError> {
+    let (unified, unified_residual) = fit_unified(correspondences)?;
+    Ok(match format {
         CameraFormat::OpencvOmnidir | CameraFormat::KalibrOmni => {
             (FittedModel::Unified(unified), unified_residual)
         }
         CameraFormat::KalibrDs => {
-            let (m, r) = fit_double_sphere(&unified, &correspondences).map_err(fit_error)?;
+            let (m, r) = fit_double_sphere(&unified, correspondences)?;
             (FittedModel::DoubleSphere(m), r)
         }
         CameraFormat::Ocamcalib => {
             let [cx, cy] = unified.principal_px;
             let size_hw = [sensor.height_px, sensor.width_px];
-            let m = OcamModel::fit(&ocam_rays, [cy, cx], size_hw, 4).map_err(fit_error)?;
-            let r = m.residual(&ocam_rays);
+            let m = OcamModel::fit(ocam_rays, [cy, cx], size_hw, 4)?;
+            let r = m.residual(ocam_rays);
             (FittedModel::Ocam(m), r)
         }
-    };
-    let pose = ModelPose {
-        rotation,
-        translation_mm: viewpoint,
-    };
-    let header = format!(
+    })
+}
+
+/// The notes at the head of the file: the sensor, the model, the fit's residual, the rays'
+/// spread about the viewpoint and the mirror's image.
+fn file_header(
+    spec: &SensorSpec,
+    format: CameraFormat,
+    residual: &FitResidual,
+    spread: f64,
+    image_circle_px: Option<f64>,
+) -> String {
+    format!(
         "omniloop: sensor {:?} ({} mirror) as the {} model, fitted to {} traced rays:\n\
          reprojection RMS {:.4} px, worst {:.4} px; rays within {:.3} mm of the viewpoint.\n\
          The mirror's image: {}.",
@@ -226,48 +279,79 @@ pub fn export_camera_model(
         image_circle_px.map_or("the whole image".to_string(), |r| format!(
             "a circle of radius {r:.4} px about the principal point"
         ))
-    );
-    let size = [sensor.width_px, sensor.height_px];
-    let topic = format!("/camera/{}", spec.name);
-    let text = match &model {
+    )
+}
+
+/// The file of `model` in `format` for sensor `sensor` (images `size` px, topic
+/// `/camera/SENSOR` for Kalibr), `header` in its comments.
+fn model_file(
+    model: &FittedModel,
+    format: CameraFormat,
+    size: [u32; 2],
+    pose: &ModelPose,
+    sensor: &str,
+    header: &str,
+) -> String {
+    let topic = format!("/camera/{sensor}");
+    match model {
         FittedModel::Unified(m) if format == CameraFormat::KalibrOmni => {
-            kalibr_omni_yaml(m, size, &pose, &topic, &header)
+            kalibr_omni_yaml(m, size, pose, &topic, header)
         }
-        FittedModel::Unified(m) => opencv_omnidir_yaml(m, size, &pose, &header),
-        FittedModel::DoubleSphere(m) => kalibr_ds_yaml(m, size, &pose, &topic, &header),
+        FittedModel::Unified(m) => opencv_omnidir_yaml(m, size, pose, header),
+        FittedModel::DoubleSphere(m) => kalibr_ds_yaml(m, size, pose, &topic, header),
         // The toolbox reads its fields in a fixed order: the notes follow them.
         FittedModel::Ocam(m) => {
             let notes: String = header.lines().map(|l| format!("#{l}\n")).collect();
             format!("{}{notes}{}", m.calib_results_txt(), pose.comment_lines())
         }
-    };
-    // The file must read back to the model that was fitted.
-    let back = parse_camera_file(&text, format.name()).map_err(|e| {
-        fit_error(omniloop_vision::VisionError::Calibration(format!(
+    }
+}
+
+/// Checks that `text`, the file in `format`, reads back to a model with the fitted model's
+/// `residual` over the same rays.
+fn check_read_back(
+    text: &str,
+    format: CameraFormat,
+    residual: &FitResidual,
+    correspondences: &[Correspondence],
+    ocam_rays: &[Correspondence],
+) -> Result<(), VisionError> {
+    let back = parse_camera_file(text, format.name()).map_err(|e| {
+        VisionError::Calibration(format!(
             "the written {} file does not read back: {e}",
             format.name()
-        )))
+        ))
     })?;
     let back_residual = match &back {
-        CameraFile::Unified(m, _) => reprojection(m, &correspondences),
-        CameraFile::DoubleSphere(m, _) => reprojection(m, &correspondences),
-        CameraFile::Ocam(m) => m.residual(&ocam_rays),
+        CameraFile::Unified(m, _) => reprojection(m, correspondences),
+        CameraFile::DoubleSphere(m, _) => reprojection(m, correspondences),
+        CameraFile::Ocam(m) => m.residual(ocam_rays),
     };
     if (back_residual.rms_px - residual.rms_px).abs() > 1e-6 {
-        return Err(fit_error(omniloop_vision::VisionError::Calibration(
-            format!(
-                "the written {} file reads back to a model with RMS {} px, not {} px",
-                format.name(),
-                back_residual.rms_px,
-                residual.rms_px
-            ),
+        return Err(VisionError::Calibration(format!(
+            "the written {} file reads back to a model with RMS {} px, not {} px",
+            format.name(),
+            back_residual.rms_px,
+            residual.rms_px
         )));
     }
-    let json = serde_json::json!({
-        "sensor": spec.name,
+    Ok(())
+}
+
+/// The export as JSON (written beside the file): sensor, format, image size, intrinsics, the
+/// model's frame in the body, the residual, the viewpoint spread and the image circle.
+fn export_json(
+    sensor: &str,
+    format: CameraFormat,
+    size: [u32; 2],
+    e: &CameraExport,
+) -> serde_json::Value {
+    let (rotation, viewpoint) = (&e.pose.rotation, &e.pose.translation_mm);
+    serde_json::json!({
+        "sensor": sensor,
         "format": format.name(),
         "image_size_px": size,
-        "intrinsics": model.json(),
+        "intrinsics": e.model.json(),
         "model_frame_in_body": {
             "rotation": [
                 [rotation[(0, 0)], rotation[(0, 1)], rotation[(0, 2)]],
@@ -276,28 +360,19 @@ pub fn export_camera_model(
             ],
             "translation_mm": [viewpoint.x, viewpoint.y, viewpoint.z],
         },
-        "residual_px": { "rays": residual.count, "rms": residual.rms_px, "worst": residual.worst_px },
-        "viewpoint_spread_mm": spread,
-        "image_circle_px": image_circle_px,
-    });
-    Ok(CameraExport {
-        model,
-        pose,
-        residual,
-        viewpoint_spread_mm: spread,
-        image_circle_px,
-        text,
-        json,
+        "residual_px": {
+            "rays": e.residual.count,
+            "rms": e.residual.rms_px,
+            "worst": e.residual.worst_px
+        },
+        "viewpoint_spread_mm": e.viewpoint_spread_mm,
+        "image_circle_px": e.image_circle_px,
     })
 }
 
 /// The radius about the principal point halfway between the farthest pixel that sees the
 /// mirror and the nearest dark one beyond it, or `None` when none is dark beyond it.
-fn image_circle(
-    sensor: &omniloop_sim::Sensor,
-    rays: &[([f64; 2], Vector3<f64>, Vector3<f64>)],
-    dark_radii: &[f64],
-) -> Option<f64> {
+fn image_circle(sensor: &Sensor, rays: &[Ray], dark_radii: &[f64]) -> Option<f64> {
     let lit = rays
         .iter()
         .map(|(p, _, _)| {
@@ -319,7 +394,7 @@ fn image_circle(
 fn fit_double_sphere(
     unified: &UnifiedModel,
     rays: &[Correspondence],
-) -> Result<(DoubleSphereModel, FitResidual), omniloop_vision::VisionError> {
+) -> Result<(DoubleSphereModel, FitResidual), VisionError> {
     let mut best: Option<(DoubleSphereModel, FitResidual)> = None;
     for alpha in [0.0, 0.2, 0.4, 0.6] {
         let mut start = DoubleSphereModel {
@@ -336,9 +411,7 @@ fn fit_double_sphere(
         }
     }
     best.ok_or_else(|| {
-        omniloop_vision::VisionError::Calibration(
-            "no start of the double sphere model images every ray".into(),
-        )
+        VisionError::Calibration("no start of the double sphere model images every ray".into())
     })
 }
 
@@ -351,7 +424,7 @@ const UNIFIED_FRAME: Matrix3<f64> = Matrix3::new(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 
 const OCAM_FRAME: Matrix3<f64> = Matrix3::new(0.0, 1.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
 
 /// The point nearest (least squares) to the lines through `o` along unit `d`.
-fn nearest_point(rays: &[([f64; 2], Vector3<f64>, Vector3<f64>)]) -> Vector3<f64> {
+fn nearest_point(rays: &[Ray]) -> Vector3<f64> {
     let mut a = Matrix3::zeros();
     let mut b = Vector3::zeros();
     for (_, o, d) in rays {
