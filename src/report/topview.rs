@@ -20,20 +20,20 @@ pub enum FigureError {
         file: String,
     },
     /// A plotters call failed while drawing.
-    #[error("drawing {file}: {source}")]
+    #[error("drawing {file}: {reason}")]
     Plot {
         /// Target file.
         file: String,
-        /// The cause.
-        source: PlotError,
+        /// The cause (in the message, so not also a source: printed once).
+        reason: PlotError,
     },
     /// Encoding or writing the PNG failed.
-    #[error("writing {file}: {source}")]
+    #[error("writing {file}: {reason}")]
     Write {
         /// Target file.
         file: String,
-        /// The cause.
-        source: image::ImageError,
+        /// The cause (in the message, so not also a source: printed once).
+        reason: image::ImageError,
     },
 }
 
@@ -53,7 +53,7 @@ impl FigureError {
     {
         move |e| FigureError::Plot {
             file: file.to_string(),
-            source: PlotError::from(e),
+            reason: PlotError::from(e),
         }
     }
 }
@@ -460,7 +460,7 @@ pub fn draw_panels(file: &Path, panels: &[Panel<'_>], width: u32) -> Result<(), 
     let name = file.display().to_string();
     render_panels(&name, panels, width)?
         .save(file)
-        .map_err(|source| FigureError::Write { file: name, source })
+        .map_err(|reason| FigureError::Write { file: name, reason })
 }
 
 /// [`draw_panels`] into PNG bytes; `name` names the figure in errors.
@@ -475,9 +475,9 @@ pub(crate) fn png_bytes(name: &str, img: &image::RgbImage) -> Result<Vec<u8>, Fi
         &mut std::io::Cursor::new(&mut bytes),
         image::ImageFormat::Png,
     )
-    .map_err(|source| FigureError::Write {
+    .map_err(|reason| FigureError::Write {
         file: name.to_string(),
-        source,
+        reason,
     })?;
     Ok(bytes)
 }
