@@ -18,7 +18,7 @@ type SoftwareFactory<'a> =
 /// A run of a scenario, set up step by step: the robot's software (the built-in stack unless
 /// told otherwise), the renderer, the seed, a progress callback.
 ///
-/// ```no_run
+/// ```
 /// use omniloop::{Runner, load_scenario};
 /// use omniloop::robot::{BodyCommand, Estimates, Observation, OdometryReading, Outputs};
 /// use omniloop::robot::{RobotError, RobotSoftware};
@@ -43,7 +43,9 @@ type SoftwareFactory<'a> =
 /// # fn main() -> anyhow::Result<()> {
 /// let scenario = load_scenario("scenarios/corner55_velocity_aware.toml".as_ref())?;
 /// let output = Runner::new(&scenario).software(|_config| Ok(Straight)).run()?;
-/// println!("reached the goal: {}", output.summary.reached_goal);
+/// // Straight ahead from the corridor's start runs into its wall before the goal.
+/// assert!(!output.summary.reached_goal);
+/// assert!(output.summary.wall_contacts > 0);
 /// # Ok(())
 /// # }
 /// ```
@@ -219,6 +221,25 @@ pub fn run_dyn(
 
 /// Reads, parses and validates a scenario file, its experiment's section included (each
 /// problem located by file, line, column and field). Its name defaults to the file stem.
+///
+/// ```
+/// use omniloop::{LoadError, load_scenario, parse_scenario};
+///
+/// let scenario = load_scenario("scenarios/smoke.toml".as_ref())?;
+/// assert_eq!(scenario.name, "smoke");
+///
+/// // Every problem names its file, line, column and field.
+/// let text = "[world.field]\n[robot]\nstart = { x_mm = -1000.0, y_mm = 0.0 }\n\
+///             [goal]\nx_mm = 1000.0\ny_mm = -5000.0\n";
+/// match parse_scenario(text, "mine.toml".as_ref(), "mine") {
+///     Err(LoadError::Invalid { problems }) => assert_eq!(
+///         problems[0].to_string(),
+///         "mine.toml:5:1: field `goal.x_mm`: goal (1000, -5000) mm is outside the floor region"
+///     ),
+///     other => panic!("expected a problem, got {other:?}"),
+/// }
+/// # Ok::<(), LoadError>(())
+/// ```
 pub fn load_scenario(path: &Path) -> Result<Scenario, LoadError> {
     crate::scenario::load_scenario_with(path, registry::prepare, registry::check)
 }

@@ -19,6 +19,24 @@ pub fn default_out_dir(scenario: &Scenario) -> PathBuf {
 
 /// Writes `summary.json`, `trajectory.csv`, `estimates.jsonl`, `topview.png` and the
 /// experiment's own files into `dir` (created if needed).
+///
+/// ```
+/// use omniloop::report::write_run;
+/// use omniloop::{Runner, load_scenario};
+///
+/// # fn main() -> anyhow::Result<()> {
+/// let scenario = load_scenario("scenarios/smoke.toml".as_ref())?;
+/// let output = Runner::new(&scenario).run()?;
+/// let dir = std::env::temp_dir().join("omniloop-doc-write-run");
+/// write_run(&dir, &scenario, &output)?;
+/// for file in ["summary.json", "trajectory.csv", "estimates.jsonl", "topview.png"] {
+///     assert!(dir.join(file).is_file(), "{file}");
+/// }
+/// let lines = std::fs::read_to_string(dir.join("trajectory.csv"))?.lines().count();
+/// assert_eq!(lines, output.trajectory.len() + 1, "a header and a row a cycle");
+/// # Ok(())
+/// # }
+/// ```
 pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let summary_path = dir.join("summary.json");

@@ -4,6 +4,34 @@
 //! Every combination is built and validated before anything runs ([`plan`]); the runs are
 //! shared among workers ([`run_jobs`]), each run as deterministic as alone; the rows come back
 //! in the plan's order whatever finished first.
+//!
+//! The smoke scenario at two top speeds, two seeds each:
+//!
+//! ```
+//! use omniloop::sweep::{Seeds, Set, SweepOptions, plan, rows, run_jobs};
+//! use omniloop_sim::RendererChoice;
+//! use std::sync::atomic::AtomicBool;
+//!
+//! # fn main() -> anyhow::Result<()> {
+//! let sets = [Set::parse("robot.max_speed_mm_s=300,500")?];
+//! let plan = plan("scenarios/smoke.toml".as_ref(), &sets, &Seeds::Count(2))?;
+//! assert_eq!(plan.jobs.len(), 4, "two values, two seeds each");
+//! let options = SweepOptions {
+//!     workers: 2,
+//!     threads: 2,
+//!     renderer: RendererChoice::Cpu,
+//!     keep_runs: None,
+//!     shared_gpu: None,
+//!     truth: false,
+//! };
+//! let outcomes = run_jobs(&plan, &options, &AtomicBool::new(false), |_| {});
+//! let rows = rows(&plan, &outcomes);
+//! assert!(rows.iter().all(|r| r.error.is_none()));
+//! let fast: Vec<_> = rows.iter().filter(|r| r.combination == 1).collect();
+//! assert_eq!(fast.len(), 2);
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod files;
 pub mod journal;
