@@ -84,7 +84,9 @@ pub fn read_png_rgb(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyArray
 /// cannot give one, `OSError` for a file, `RuntimeError` otherwise.
 fn dataset_error(e: DatasetError) -> PyErr {
     match e {
-        DatasetError::Scenario { .. } => ScenarioError::new_err(e.to_string()),
+        DatasetError::Scenario { .. } | DatasetError::Sensor { .. } => {
+            ScenarioError::new_err(e.to_string())
+        }
         DatasetError::Run(run) => run_error(run),
         DatasetError::Io { path, source } => os_error(&path, &source),
         DatasetError::Image { path, source } => match source {
@@ -121,8 +123,8 @@ pub fn write_dataset<'py>(
         ));
     }
     let poses: PoseMode = poses
-        .parse()
-        .map_err(|e: String| PyValueError::new_err(format!("poses={poses:?}: {e}")))?;
+        .parse::<PoseMode>()
+        .map_err(|e| PyValueError::new_err(format!("poses={poses:?}: {e}")))?;
     let options = DatasetOptions {
         samples,
         poses,

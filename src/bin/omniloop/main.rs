@@ -270,7 +270,10 @@ fn live_addr(addr: &str) -> Result<String, String> {
         addr: addr.to_string(),
         ..LiveOptions::default()
     };
-    options.host_port().map(|_| options.addr)
+    options
+        .host_port()
+        .map(|_| options.addr)
+        .map_err(|e| e.to_string())
 }
 
 /// A margin in mm: a finite number >= 0.
