@@ -43,7 +43,7 @@ pub enum VisionError {
         /// The file.
         path: String,
         /// What is wrong, and where in it.
-        error: camera_model::CameraFileError,
+        error: Box<camera_model::CameraFileError>,
     },
     /// A parameter outside its range.
     #[error("{name} = {value}: {rule}")]

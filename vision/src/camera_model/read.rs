@@ -162,9 +162,9 @@ pub enum FieldProblem {
 
 /// Reads `path` as a camera model file of `format` (one of [`FORMATS`]).
 pub fn read_camera_file(path: &Path, format: &str) -> Result<CameraFile, VisionError> {
-    let in_file = |error| VisionError::CameraFile {
+    let in_file = |error: CameraFileError| VisionError::CameraFile {
         path: path.display().to_string(),
-        error,
+        error: Box::new(error),
     };
     let text = std::fs::read_to_string(path).map_err(|e| in_file(e.into()))?;
     parse_camera_file(&text, format).map_err(in_file)
