@@ -18,8 +18,8 @@
 
 use crate::camera_export::{CameraFormat, ExportError, export_camera_model};
 use crate::run::{RunError, RunOptions, Simulation, truth_files};
-use crate::scenario::Scenario;
 use crate::scenario::calibrate::calibrate_sensor;
+use crate::scenario::{Scenario, SensorLookupError};
 use image::RgbaImage;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_sim::render::TruthFrame;
@@ -52,13 +52,18 @@ impl PoseMode {
     }
 }
 
+/// A pose mode's name that is none of them.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown pose mode {0:?} (random, along-run)")]
+pub struct UnknownPoseMode(pub String);
+
 impl FromStr for PoseMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownPoseMode;
+    fn from_str(s: &str) -> Result<Self, UnknownPoseMode> {
         match s {
             "random" => Ok(Self::Random),
             "along-run" => Ok(Self::AlongRun),
-            other => Err(format!("unknown pose mode {other:?} (random, along-run)")),
+            other => Err(UnknownPoseMode(other.to_string())),
         }
     }
 }
@@ -97,6 +102,14 @@ pub enum DatasetError {
         scenario: String,
         /// Why.
         why: String,
+    },
+    /// The scenario's robot has no such camera.
+    #[error("scenario {scenario:?}: {error}")]
+    Sensor {
+        /// The scenario's name.
+        scenario: String,
+        /// Which camera, and which there are.
+        error: SensorLookupError,
     },
     /// The run or the renderer failed.
     #[error(transparent)]
@@ -180,15 +193,16 @@ pub fn write_dataset(
     out: &Path,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<DatasetInfo, DatasetError> {
-    let problem = |why: String| DatasetError::Scenario {
-        scenario: scenario.name.clone(),
-        why,
-    };
     let sensor_name = options
         .sensor
         .as_deref()
         .or(scenario.vision.sensor.as_deref());
-    let index = scenario.sensor_index(sensor_name).map_err(problem)?;
+    let index = scenario
+        .sensor_index(sensor_name)
+        .map_err(|error| DatasetError::Sensor {
+            scenario: scenario.name.clone(),
+            error,
+        })?;
     let spec = scenario.robot.sensors[index].clone();
     for dir in ["images", "depth", "labels"] {
         create_dir(&out.join(dir))?;

@@ -166,7 +166,6 @@ pub fn finite_numbers(what: &str, v: &Bound<'_, PyAny>, expected: &str) -> PyRes
 
 /// The renderer named in Python.
 pub fn renderer_choice(name: &str) -> PyResult<omniloop_sim::RendererChoice> {
-    name.parse().map_err(|e: String| {
-        pyo3::exceptions::PyValueError::new_err(format!("renderer={name:?}: {e}"))
-    })
+    name.parse::<omniloop_sim::RendererChoice>()
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("renderer={name:?}: {e}")))
 }

@@ -65,8 +65,8 @@ pub fn sweep_plan(
         .map(|a| Set::parse(a).map_err(|e| ScenarioError::new_err(e.to_string())))
         .collect::<PyResult<Vec<_>>>()?;
     let seeds: Seeds = seeds
-        .parse()
-        .map_err(|e: String| PyValueError::new_err(format!("seeds={seeds:?}: {e}")))?;
+        .parse::<Seeds>()
+        .map_err(|e| PyValueError::new_err(format!("seeds={seeds:?}: {e}")))?;
     let plan = omniloop::sweep::plan(&scenario, &parsed, &seeds).map_err(|e| match e {
         PlanError::Invalid(m) => ScenarioError::new_err(m.join("\n")),
         PlanError::Scenario(e) => ScenarioError::new_err(e.to_string()),
@@ -184,7 +184,8 @@ pub fn run_planned_job(
     threads: usize,
 ) -> PyResult<String> {
     let choice = renderer_choice(renderer)?;
-    let (planned, scenario) = scenario_of_lines(header, job).map_err(ScenarioError::new_err)?;
+    let (planned, scenario) =
+        scenario_of_lines(header, job).map_err(|e| ScenarioError::new_err(e.to_string()))?;
     let options = RunOptions {
         renderer: choice,
         ..RunOptions::default()

@@ -86,7 +86,9 @@ pub fn read_png_rgb(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyArray
 /// which it is taken, `RuntimeError` otherwise.
 fn dataset_error(e: DatasetError) -> PyErr {
     match e {
-        DatasetError::Scenario { .. } => ScenarioError::new_err(e.to_string()),
+        DatasetError::Scenario { .. } | DatasetError::Sensor { .. } => {
+            ScenarioError::new_err(e.to_string())
+        }
         DatasetError::Run(run) => run_error(run),
         DatasetError::Io { path, reason } => os_error(&path, &reason),
         DatasetError::Image { path, reason } => match reason {
@@ -123,8 +125,8 @@ pub fn write_dataset<'py>(
         ));
     }
     let poses: PoseMode = poses
-        .parse()
-        .map_err(|e: String| PyValueError::new_err(format!("poses={poses:?}: {e}")))?;
+        .parse::<PoseMode>()
+        .map_err(|e| PyValueError::new_err(format!("poses={poses:?}: {e}")))?;
     let options = DatasetOptions {
         samples,
         poses,

@@ -33,6 +33,40 @@ const GATE_RAD: f64 = 0.35;
 /// Position error the odometry adds per millimetre driven (one sigma).
 const ODOMETRY_DRIFT: f64 = 0.05;
 
+/// Why the estimator did not use a fix (its text is the `why` of a rejected fix in
+/// `estimates.jsonl`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Rejection {
+    /// The fix is farther from the prediction than the gate.
+    #[error(
+        "{distance_mm:.0} mm and {:.1} deg from the prediction (gate {} mm, {:.0} deg)",
+        .turn_rad.to_degrees(),
+        GATE_MM,
+        GATE_RAD.to_degrees()
+    )]
+    OutsideGate {
+        /// Distance from the prediction, mm.
+        distance_mm: f64,
+        /// Turn from the predicted heading, rad.
+        turn_rad: f64,
+    },
+    /// An ambiguous pose fix before any fix has set the estimate.
+    #[error("the image does not tell the two solutions apart and no fix has set the estimate yet")]
+    Ambiguous,
+    /// A heading fix while the position is unknown.
+    #[error("the position is unknown: a heading alone cannot set the pose")]
+    PositionUnknown,
+    /// A position fix while the heading is unknown.
+    #[error("the heading is unknown: a position alone cannot set the pose")]
+    HeadingUnknown,
+    /// A partial fix while the pose is unknown.
+    #[error("the pose is unknown: a partial fix cannot set it")]
+    PoseUnknown,
+    /// A motion fix without an earlier cycle of known pose.
+    #[error("no earlier cycle with a known pose to measure the motion from")]
+    NoEarlierCycle,
+}
+
 /// The pose the estimate was last set to, and the dead-reckoned pose at that moment (`None`:
 /// the origin of dead reckoning, i.e. the start).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -154,9 +188,7 @@ impl PoseEstimator {
                 let h = self.estimate().map(|p| p.rotation.angle());
                 match h {
                     Some(h) => self.fuse_pose_parts(Some(position.coords), h, 0.0),
-                    None => Err(
-                        "the heading is unknown: a position alone cannot set the pose".to_string(),
-                    ),
+                    None => Err(Rejection::HeadingUnknown),
                 }
             }
             Measurement::Motion { delta } => self.fuse_motion(delta),
@@ -166,7 +198,7 @@ impl PoseEstimator {
                 self.used += 1;
                 o
             }
-            Err(why) => FixOutcome::Rejected(why),
+            Err(why) => FixOutcome::Rejected(why.to_string()),
         }
     }
 
@@ -177,14 +209,13 @@ impl PoseEstimator {
         });
     }
 
-    fn gate(&mut self, d_mm: f64, dh_rad: f64) -> Result<(), String> {
+    fn gate(&mut self, d_mm: f64, dh_rad: f64) -> Result<(), Rejection> {
         if d_mm > GATE_MM || dh_rad.abs() > GATE_RAD {
             self.rejected += 1;
-            return Err(format!(
-                "{d_mm:.0} mm and {:.1} deg from the prediction (gate {GATE_MM} mm, {:.0} deg)",
-                dh_rad.to_degrees(),
-                GATE_RAD.to_degrees()
-            ));
+            return Err(Rejection::OutsideGate {
+                distance_mm: d_mm,
+                turn_rad: dh_rad,
+            });
         }
         Ok(())
     }
@@ -195,17 +226,13 @@ impl PoseEstimator {
         alternative: Option<Isometry2<f64>>,
         unambiguous: bool,
         expected_error_mm: Option<f64>,
-    ) -> Result<FixOutcome, String> {
+    ) -> Result<FixOutcome, Rejection> {
         let fix_var = expected_error_mm.map(|s| (s * s).max(1e-6));
         let predicted = match self.estimate() {
             Some(p) if self.anchored_by_fix => p,
             _ => {
                 if !unambiguous {
-                    return Err(
-                        "the image does not tell the two solutions apart and no fix has \
-                                set the estimate yet"
-                            .into(),
-                    );
+                    return Err(Rejection::Ambiguous);
                 }
                 self.set(pose);
                 self.anchored_by_fix = true;
@@ -239,9 +266,9 @@ impl PoseEstimator {
         Ok(FixOutcome::Used)
     }
 
-    fn fuse_heading(&mut self, heading_rad: f64) -> Result<FixOutcome, String> {
+    fn fuse_heading(&mut self, heading_rad: f64) -> Result<FixOutcome, Rejection> {
         let Some(p) = self.estimate() else {
-            return Err("the position is unknown: a heading alone cannot set the pose".into());
+            return Err(Rejection::PositionUnknown);
         };
         let dh = wrap_pi(heading_rad - p.rotation.angle());
         self.fuse_pose_parts(None, p.rotation.angle(), dh)
@@ -254,9 +281,9 @@ impl PoseEstimator {
         position: Option<Vector2<f64>>,
         h: f64,
         dh: f64,
-    ) -> Result<FixOutcome, String> {
+    ) -> Result<FixOutcome, Rejection> {
         let Some(p) = self.estimate() else {
-            return Err("the pose is unknown: a partial fix cannot set it".to_string());
+            return Err(Rejection::PoseUnknown);
         };
         let here = p.translation.vector;
         let target = position.unwrap_or(here);
@@ -268,9 +295,9 @@ impl PoseEstimator {
         Ok(FixOutcome::Used)
     }
 
-    fn fuse_motion(&mut self, delta: Isometry2<f64>) -> Result<FixOutcome, String> {
+    fn fuse_motion(&mut self, delta: Isometry2<f64>) -> Result<FixOutcome, Rejection> {
         let Some((before, odo_before)) = self.last_cycle else {
-            return Err("no earlier cycle with a known pose to measure the motion from".into());
+            return Err(Rejection::NoEarlierCycle);
         };
         let odo_delta = odo_before.inverse() * self.reckoning.pose();
         let dt = delta.translation.vector - odo_delta.translation.vector;
@@ -314,6 +341,22 @@ mod tests {
 
     fn x(e: &PoseEstimator) -> f64 {
         e.estimate().unwrap().translation.x
+    }
+
+    #[test]
+    fn a_rejection_says_why_as_estimates_jsonl_writes_it() {
+        let gate = Rejection::OutsideGate {
+            distance_mm: 512.4,
+            turn_rad: 0.1,
+        };
+        assert_eq!(
+            gate.to_string(),
+            "512 mm and 5.7 deg from the prediction (gate 400 mm, 20 deg)"
+        );
+        assert_eq!(
+            Rejection::Ambiguous.to_string(),
+            "the image does not tell the two solutions apart and no fix has set the estimate yet"
+        );
     }
 
     #[test]

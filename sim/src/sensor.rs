@@ -72,10 +72,33 @@ struct RawSensorSpec {
     calibrated: Option<CalibratedCamera>,
 }
 
-impl TryFrom<RawSensorSpec> for SensorSpec {
-    type Error = String;
+/// A sensor written without exactly one optics table.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "sensor {sensor:?}: a sensor needs exactly one of the tables hyperbolic, conical, spherical, \
+     pinhole, calibrated (found {})",
+    found(.given)
+)]
+pub struct OpticsCountError {
+    /// The sensor's name.
+    pub sensor: String,
+    /// The optics tables it has.
+    pub given: Vec<&'static str>,
+}
 
-    fn try_from(r: RawSensorSpec) -> Result<Self, String> {
+/// `none`, or the tables given.
+fn found(given: &[&str]) -> String {
+    if given.is_empty() {
+        "none".to_string()
+    } else {
+        given.join(", ")
+    }
+}
+
+impl TryFrom<RawSensorSpec> for SensorSpec {
+    type Error = OpticsCountError;
+
+    fn try_from(r: RawSensorSpec) -> Result<Self, OpticsCountError> {
         let mut given: Vec<Optics> = Vec::new();
         given.extend(r.hyperbolic.map(Optics::Hyperbolic));
         given.extend(r.conical.map(Optics::Conical));
@@ -85,17 +108,10 @@ impl TryFrom<RawSensorSpec> for SensorSpec {
         let optics = match given.len() {
             1 => given.remove(0),
             _ => {
-                let names: Vec<&str> = given.iter().map(Optics::kind).collect();
-                let found = if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                };
-                return Err(format!(
-                    "sensor {:?}: a sensor needs exactly one of the tables hyperbolic, conical, \
-                     spherical, pinhole, calibrated (found {found})",
-                    r.name
-                ));
+                return Err(OpticsCountError {
+                    sensor: r.name,
+                    given: given.iter().map(Optics::kind).collect(),
+                });
             }
         };
         Ok(Self {

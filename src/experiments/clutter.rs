@@ -79,9 +79,31 @@ pub struct ClutterLayout {
     pub goal: [f64; 2],
 }
 
+/// No layout of a clutter spec leaves a start and a goal for the robot.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "no layout of {cubes} cubes in {} draws leaves a start and a goal {min_distance_mm} mm \
+     apart{}: fewer cubes or a shorter min_distance_mm",
+    TRIES,
+    joined(.passage_mm)
+)]
+pub struct NoLayout {
+    /// The cubes asked for.
+    pub cubes: usize,
+    /// The distance asked between start and goal, mm.
+    pub min_distance_mm: f64,
+    /// The gap asked between them, when a passage is required, mm.
+    pub passage_mm: Option<f64>,
+}
+
+/// ` joined by gaps of W mm`, when a passage is required.
+fn joined(passage_mm: &Option<f64>) -> String {
+    passage_mm.map_or_else(String::new, |w| format!(" joined by gaps of {w} mm"))
+}
+
 impl ClutterSpec {
     /// The layout of this seed on `field` for a robot of `radius_mm`.
-    pub fn layout(&self, field: &FieldSpec, radius_mm: f64) -> Result<ClutterLayout, String> {
+    pub fn layout(&self, field: &FieldSpec, radius_mm: f64) -> Result<ClutterLayout, NoLayout> {
         let mut rng = StdRng::seed_from_u64(self.seed ^ 0x0043_4c55_5454_4552);
         for _ in 0..TRIES {
             let cubes = self.draw_cubes(&mut rng, field);
@@ -108,16 +130,11 @@ impl ClutterSpec {
                 goal: [goal.x, goal.y],
             });
         }
-        let joined = if self.require_passage {
-            format!(" joined by gaps of {} mm", self.passage_mm)
-        } else {
-            String::new()
-        };
-        Err(format!(
-            "no layout of {} cubes in {TRIES} draws leaves a start and a goal {} mm apart{joined}: \
-             fewer cubes or a shorter min_distance_mm",
-            self.cubes, self.min_distance_mm
-        ))
+        Err(NoLayout {
+            cubes: self.cubes,
+            min_distance_mm: self.min_distance_mm,
+            passage_mm: self.require_passage.then_some(self.passage_mm),
+        })
     }
 
     /// Cubes at random on the playing floor, none overlapping another.
@@ -219,7 +236,7 @@ impl ClutterSpec {
         if sane && self.cubes <= MAX_CUBES && positive.iter().all(|v| v.is_finite() && *v > 0.0) {
             let field = s.world.field.clone().unwrap_or_default();
             if let Err(why) = self.layout(&field, s.robot.radius_mm) {
-                c.fail(p, why);
+                c.fail(p, why.to_string());
             }
         }
     }

@@ -246,7 +246,7 @@ fn score(e: &Estimator, outcome: Option<&Option<crate::sweep::Outcome>>) -> Outc
             Some(s) => Outcome::Scored(s),
             None => Outcome::Failed(format!("the run gave no {}", e.error_label)),
         },
-        Some(Err(why)) => Outcome::Failed(why.clone()),
+        Some(Err(why)) => Outcome::Failed(why.to_string()),
         None => Outcome::Failed("the run did not finish".into()),
     }
 }

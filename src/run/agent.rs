@@ -559,7 +559,9 @@ fn calibrations(
     if !(scenario.needs_calibration() || takes_frames) {
         return Ok(Vec::new());
     }
-    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
+    let index = scenario
+        .vision_sensor_index()
+        .map_err(|e| SimError::Invalid(e.to_string()))?;
     let spec = &scenario.robot.sensors[index];
     let mut cal = match &scenario.vision.calibration_file {
         Some(path) => RadialCalibration::load(path)?,
@@ -576,7 +578,9 @@ fn columns(scenario: &Scenario) -> Result<Vec<ColumnCalibration>, RunError> {
     if !scenario.needs_columns() {
         return Ok(Vec::new());
     }
-    let index = scenario.vision_sensor_index().map_err(SimError::Invalid)?;
+    let index = scenario
+        .vision_sensor_index()
+        .map_err(|e| SimError::Invalid(e.to_string()))?;
     Ok(vec![calibrate_columns(
         &scenario.robot.sensors[index],
         scenario.seed,

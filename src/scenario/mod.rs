@@ -15,5 +15,5 @@ pub use parse::{LoadError, load_scenario_with, parse_scenario_with};
 pub use rules::validate;
 pub use schema::{
     DEFAULT_ROBOT_NAME, DifferentialSpec, OdometrySpec, OtherRobotSpec, PilotChoice, PoseSpec,
-    RobotSpec, RunSpec, Scenario, TeamMember, TimingSpec, member_seed,
+    RobotSpec, RunSpec, Scenario, SensorLookupError, TeamMember, TimingSpec, member_seed,
 };

@@ -18,6 +18,31 @@ use omniloop_vision::omnistereo::OmnistereoConfig;
 use omniloop_vision::resection::{ColumnCalibration, StripePattern};
 use serde::{Deserialize, Serialize};
 
+/// Why a scenario's robot has no sensor of a name ([`Scenario::sensor_index`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SensorLookupError {
+    /// No sensor has the name.
+    #[error("the robot has no sensor {name:?} (it has{})", it_has(.sensors))]
+    NoSuchSensor {
+        /// The name asked for.
+        name: String,
+        /// The robot's sensors' names.
+        sensors: Vec<String>,
+    },
+    /// The robot has no sensor at all.
+    #[error("the robot has no sensor (add a [[robot.sensors]] table)")]
+    NoSensor,
+}
+
+/// ` none` or `: NAME, NAME`: the sensors a robot has.
+fn it_has(sensors: &[String]) -> String {
+    if sensors.is_empty() {
+        " none".to_string()
+    } else {
+        format!(": {}", sensors.join(", "))
+    }
+}
+
 /// A complete scenario: the world, the robot, what it should do and for how long.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -483,34 +508,27 @@ impl Scenario {
 
     /// The index of the robot's sensor called `name`, or of its first sensor when `name` is
     /// `None`; the error says which sensors there are.
-    pub fn sensor_index(&self, name: Option<&str>) -> Result<usize, String> {
+    pub fn sensor_index(&self, name: Option<&str>) -> Result<usize, SensorLookupError> {
         let sensors = &self.robot.sensors;
         match name {
             Some(n) => sensors.iter().position(|s| s.name == n).ok_or_else(|| {
-                let names: Vec<&str> = sensors.iter().map(|s| s.name.as_str()).collect();
-                if names.is_empty() {
-                    format!("the robot has no sensor {n:?} (it has none)")
-                } else {
-                    format!(
-                        "the robot has no sensor {n:?} (it has: {})",
-                        names.join(", ")
-                    )
+                SensorLookupError::NoSuchSensor {
+                    name: n.to_string(),
+                    sensors: sensors.iter().map(|s| s.name.clone()).collect(),
                 }
             }),
-            None if sensors.is_empty() => {
-                Err("the robot has no sensor (add a [[robot.sensors]] table)".into())
-            }
+            None if sensors.is_empty() => Err(SensorLookupError::NoSensor),
             None => Ok(0),
         }
     }
 
     /// The sensor called `name`, or the first one when `name` is `None`.
-    pub fn sensor(&self, name: Option<&str>) -> Result<&SensorSpec, String> {
+    pub fn sensor(&self, name: Option<&str>) -> Result<&SensorSpec, SensorLookupError> {
         self.sensor_index(name).map(|i| &self.robot.sensors[i])
     }
 
     /// The index of the sensor vision uses (`vision.sensor`, else the first).
-    pub fn vision_sensor_index(&self) -> Result<usize, String> {
+    pub fn vision_sensor_index(&self) -> Result<usize, SensorLookupError> {
         self.sensor_index(self.vision.sensor.as_deref())
     }
 
@@ -752,5 +770,26 @@ impl Scenario {
     /// Number of control cycles the run lasts at most.
     pub fn max_cycles(&self) -> u64 {
         (self.run.duration_s / self.run.control_period_s).round() as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_sensor_names_the_ones_there_are() {
+        let missing = |sensors: &[&str]| SensorLookupError::NoSuchSensor {
+            name: "front".into(),
+            sensors: sensors.iter().map(|s| s.to_string()).collect(),
+        };
+        assert_eq!(
+            missing(&["omni", "down"]).to_string(),
+            "the robot has no sensor \"front\" (it has: omni, down)"
+        );
+        assert_eq!(
+            missing(&[]).to_string(),
+            "the robot has no sensor \"front\" (it has none)"
+        );
     }
 }

@@ -5,7 +5,7 @@
 
 use super::plan::Plan;
 use super::plan_file::PlanFileError;
-use super::workers::Outcome;
+use super::workers::{JobError, Outcome};
 use crate::run::Summary;
 use serde::{Deserialize, Serialize};
 use std::fs::{File, OpenOptions};
@@ -38,7 +38,7 @@ impl Record {
     pub fn new(outcome: &Outcome, name: &str, seed: u64) -> Self {
         let (summary, error) = match &outcome.result {
             Ok(s) => (Some(s.clone()), None),
-            Err(e) => (None, Some(e.clone())),
+            Err(e) => (None, Some(e.to_string())),
         };
         Self {
             index: outcome.job,
@@ -55,8 +55,8 @@ impl Record {
             job: self.index,
             result: match (self.summary, self.error) {
                 (Some(s), None) => Ok(s),
-                (_, Some(e)) => Err(e),
-                (None, None) => Err("recorded without a summary or an error".into()),
+                (_, Some(e)) => Err(JobError::Recorded(e)),
+                (None, None) => Err(JobError::Unrecorded),
             },
         }
     }
@@ -176,7 +176,7 @@ pub fn collect_runs(runs: &Path, plan: &Plan) -> Result<Vec<Option<Outcome>>, Pl
             })?))
         } else if error.exists() {
             let text = std::fs::read_to_string(&error).unwrap_or_default();
-            Some(Err(text.trim_end().to_string()))
+            Some(Err(JobError::Recorded(text.trim_end().to_string())))
         } else {
             None
         };
@@ -212,7 +212,7 @@ mod tests {
         assert!(previous.iter().all(Option::is_none));
         let failed = Outcome {
             job: 2,
-            result: Err("the renderer stopped".into()),
+            result: Err(JobError::Recorded("the renderer stopped".into())),
         };
         let job = &p.jobs[2];
         journal
@@ -223,9 +223,13 @@ mod tests {
         std::fs::write(dir.join(JOURNAL), text).unwrap();
         let (_, read) = Journal::open(&dir, &p, true).unwrap();
         assert_eq!(read.iter().flatten().count(), 1);
-        assert_eq!(
-            read[2].as_ref().unwrap().result,
-            Err("the renderer stopped".into())
+        assert!(
+            matches!(
+                &read[2].as_ref().unwrap().result,
+                Err(JobError::Recorded(why)) if why == "the renderer stopped"
+            ),
+            "{:?}",
+            read[2]
         );
     }
 

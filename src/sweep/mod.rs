@@ -46,8 +46,10 @@ pub use files::{
     known_metric, report as write_report, report_with as write_report_with, write_outputs,
 };
 pub use journal::{Journal, Record, collect_runs, read_journal};
-pub use plan::{Job, Plan, PlanError, Seeds, describe, plan, with_values};
-pub use plan_file::{PlanFileError, PlannedJob, planned_job, read_plan, write_plan};
+pub use plan::{Job, Plan, PlanError, Seeds, SeedsError, describe, plan, with_values};
+pub use plan_file::{
+    PlanFileError, PlannedJob, PlannedJobError, planned_job, read_plan, write_plan,
+};
 pub use report::{Aggregate, DEFAULT_REACHABLE_MARGIN_MM, ReportSettings, Row, row_json, rows};
-pub use set::{Set, SetError};
-pub use workers::{Outcome, SweepOptions, run_job, run_jobs, run_remaining, shared_gpu};
+pub use set::{Set, SetError, SetProblem};
+pub use workers::{JobError, Outcome, SweepOptions, run_job, run_jobs, run_remaining, shared_gpu};

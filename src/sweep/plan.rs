@@ -1,7 +1,7 @@
 //! The plan of a sweep: every combination of the `--set` values and seeds, each built into a
 //! scenario and validated before anything runs.
 
-use super::set::{self, Set, SetError};
+use super::set::{self, Set};
 use crate::experiments::{load_scenario, parse_scenario};
 use crate::scenario::LoadError;
 use crate::scenario::Scenario;
@@ -26,29 +26,46 @@ impl Default for Seeds {
     }
 }
 
-impl FromStr for Seeds {
-    type Err = String;
+/// Why a text is not `--seeds`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SeedsError {
+    /// A part that is not a whole number.
+    #[error("`{0}` is not a seed (a whole number >= 0)")]
+    NotASeed(String),
+    /// A range whose end is below its start.
+    #[error("`{0}`: the last seed is below the first")]
+    Reversed(String),
+    /// A count of 0.
+    #[error("at least one seed")]
+    None,
+    /// More seeds than a sweep takes.
+    #[error("`{0}`: too many")]
+    TooMany(String),
+}
 
-    fn from_str(s: &str) -> Result<Self, String> {
+impl FromStr for Seeds {
+    type Err = SeedsError;
+
+    fn from_str(s: &str) -> Result<Self, SeedsError> {
         let num = |t: &str| {
             t.trim()
                 .parse::<u64>()
-                .map_err(|_| format!("`{t}` is not a seed (a whole number >= 0)"))
+                .map_err(|_| SeedsError::NotASeed(t.to_string()))
         };
         let seeds = match s.split_once("..") {
             Some((a, b)) => {
                 let (a, b) = (num(a)?, num(b)?);
                 if b < a {
-                    return Err(format!("`{s}`: the last seed is below the first"));
+                    return Err(SeedsError::Reversed(s.to_string()));
                 }
                 Self::Range(a, b)
             }
             None => Self::Count(num(s)?),
         };
         match seeds {
-            Self::Count(0) => Err("at least one seed".into()),
-            Self::Count(n) if n > 100_000 => Err(format!("`{s}`: too many")),
-            Self::Range(a, b) if b - a >= 100_000 => Err(format!("`{s}`: too many")),
+            Self::Count(0) => Err(SeedsError::None),
+            Self::Count(n) if n > 100_000 => Err(SeedsError::TooMany(s.to_string())),
+            Self::Range(a, b) if b - a >= 100_000 => Err(SeedsError::TooMany(s.to_string())),
             ok => Ok(ok),
         }
     }
@@ -244,16 +261,7 @@ fn combination(
 ) -> Result<(Scenario, String), Vec<String>> {
     let mut doc = doc.clone();
     for (s, v) in sets.iter().zip(values) {
-        s.apply(&mut doc, v).map_err(|m| {
-            vec![
-                SetError {
-                    arg: s.arg.clone(),
-                    column: 1,
-                    message: m,
-                }
-                .to_string(),
-            ]
-        })?;
+        s.apply(&mut doc, v).map_err(|e| vec![e.to_string()])?;
     }
     let text = toml::to_string(&doc).map_err(|e| vec![format!("{}: {e}", file.display())])?;
     let stem = file
@@ -306,9 +314,15 @@ mod tests {
     fn seeds_read_as_a_count_or_a_range() {
         assert_eq!("3".parse::<Seeds>().unwrap().list(7), [7, 8, 9]);
         assert_eq!("2..4".parse::<Seeds>().unwrap().list(7), [2, 3, 4]);
-        assert!("0".parse::<Seeds>().is_err());
-        assert!("4..2".parse::<Seeds>().is_err());
-        assert!("x".parse::<Seeds>().is_err());
+        assert_eq!("0".parse::<Seeds>(), Err(SeedsError::None));
+        assert_eq!(
+            "4..2".parse::<Seeds>(),
+            Err(SeedsError::Reversed("4..2".into()))
+        );
+        assert_eq!(
+            "x".parse::<Seeds>().unwrap_err().to_string(),
+            "`x` is not a seed (a whole number >= 0)"
+        );
         for s in ["3", "2..4"] {
             assert_eq!(s.parse::<Seeds>().unwrap().to_string(), s);
         }

@@ -7,7 +7,7 @@
 use super::plan::{Job, Plan, Seeds, plan};
 use super::set::Set;
 use crate::experiments::parse_scenario;
-use crate::scenario::Scenario;
+use crate::scenario::{LoadError, Scenario};
 use serde::{Deserialize, Serialize};
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
@@ -69,6 +69,20 @@ pub enum PlanFileError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// Why a planned job given as its plan's lines ([`scenario_of_lines`]) cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum PlannedJobError {
+    /// The header line is not a plan's first line.
+    #[error("not a sweep plan's first line: {0}")]
+    Header(serde_json::Error),
+    /// The job's line is not a planned job.
+    #[error("not a planned job: {0}")]
+    Job(serde_json::Error),
+    /// The job's scenario is not valid.
+    #[error(transparent)]
+    Scenario(#[from] LoadError),
 }
 
 /// The planned jobs of `plan`.
@@ -185,7 +199,10 @@ pub fn read_plan(file: &Path) -> Result<(Plan, Vec<PlannedJob>), PlanFileError> 
         .iter()
         .map(|a| Set::parse(a).map_err(|e| bad(e.to_string())))
         .collect::<Result<Vec<_>, _>>()?;
-    let seeds: Seeds = header.seeds.parse().map_err(&bad)?;
+    let seeds = header
+        .seeds
+        .parse::<Seeds>()
+        .map_err(|e| bad(e.to_string()))?;
     let plan = plan(&header.scenario_file, &sets, &seeds).map_err(|e| bad(e.to_string()))?;
     let again = planned_jobs(&plan);
     if again != lines {
@@ -212,34 +229,35 @@ pub fn planned_job(file: &Path, index: usize) -> Result<(PlannedJob, Scenario), 
         });
     };
     let job = lines.swap_remove(pos);
-    let scenario = scenario_of(&header, &job).map_err(|message| PlanFileError::Line {
+    let scenario = scenario_of(&header, &job).map_err(|e| PlanFileError::Line {
         file: file.to_path_buf(),
         line: pos + 2,
-        message,
+        message: e.to_string(),
     })?;
     Ok((job, scenario))
 }
 
 /// The scenario of a planned job: its TOML as the plan holds it (files it names are read from
 /// the scenario file's folder), its seed.
-pub fn scenario_of(header: &PlanHeader, job: &PlannedJob) -> Result<Scenario, String> {
+pub fn scenario_of(header: &PlanHeader, job: &PlannedJob) -> Result<Scenario, LoadError> {
     let file = &header.scenario_file;
     let stem = file
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let mut scenario = parse_scenario(&job.scenario, file, &stem).map_err(|e| e.to_string())?;
+    let mut scenario = parse_scenario(&job.scenario, file, &stem)?;
     scenario.seed = job.seed;
     Ok(scenario)
 }
 
 /// The header and a job of a plan, each one JSON line of it (as a Ray task gets them): the
 /// job's scenario.
-pub fn scenario_of_lines(header: &str, job: &str) -> Result<(PlannedJob, Scenario), String> {
-    let header: PlanHeader =
-        serde_json::from_str(header).map_err(|e| format!("not a sweep plan's first line: {e}"))?;
-    let job: PlannedJob =
-        serde_json::from_str(job).map_err(|e| format!("not a planned job: {e}"))?;
+pub fn scenario_of_lines(
+    header: &str,
+    job: &str,
+) -> Result<(PlannedJob, Scenario), PlannedJobError> {
+    let header: PlanHeader = serde_json::from_str(header).map_err(PlannedJobError::Header)?;
+    let job: PlannedJob = serde_json::from_str(job).map_err(PlannedJobError::Job)?;
     let scenario = scenario_of(&header, &job)?;
     Ok((job, scenario))
 }

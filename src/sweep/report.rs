@@ -60,7 +60,7 @@ pub fn rows(plan: &Plan, outcomes: &[Option<Outcome>]) -> Vec<Row> {
                     flatten("", &json, &mut out);
                     (out, None)
                 }
-                Some(Err(e)) => (Vec::new(), Some(e.clone())),
+                Some(Err(e)) => (Vec::new(), Some(e.to_string())),
                 None => (
                     Vec::new(),
                     Some("not run (the sweep was stopped)".to_string()),
@@ -557,7 +557,9 @@ mod tests {
         let outcomes = vec![
             Some(Outcome {
                 job: 0,
-                result: Err("GPU device error: lost, badly".into()),
+                result: Err(crate::sweep::JobError::Recorded(
+                    "GPU device error: lost, badly".into(),
+                )),
             }),
             None,
         ];

@@ -6,27 +6,112 @@
 //! (`wander`: a letter or `_` first), or a range `A..B:STEP` (both ends included; STEP 1 when left out; integers when
 //! all three are).
 
-use std::fmt;
 use toml::{Table, Value};
 
-/// A `--set` that cannot be read, located in its argument like a file position.
-#[derive(Debug, Clone, PartialEq)]
+/// A `--set` that cannot be read or applied, located in its argument like a file position.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("--set {arg}:1:{column}: {problem}")]
 pub struct SetError {
     /// The argument as given.
     pub arg: String,
     /// 1-based column in the argument.
     pub column: usize,
     /// What is wrong.
-    pub message: String,
+    pub problem: SetProblem,
 }
 
-impl fmt::Display for SetError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "--set {}:1:{}: {}", self.arg, self.column, self.message)
-    }
+/// What is wrong with a `--set`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SetProblem {
+    /// No `=`.
+    #[error("expected KEY=VALUE[,VALUE...]")]
+    NoValue,
+    /// Nothing between two commas.
+    #[error("an empty value")]
+    EmptyValue,
+    /// More values than a sweep takes.
+    #[error("more than {} values", MAX_VALUES)]
+    TooManyValues,
+    /// Nothing before the `=`.
+    #[error("an empty key")]
+    EmptyKey,
+    /// A part of the key that is not `NAME` or `NAME[INDEX]`.
+    #[error("`{part}` in `{key}`: expected NAME or NAME[INDEX]")]
+    BadKeyPart {
+        /// The part.
+        part: String,
+        /// The key.
+        key: String,
+    },
+    /// A value that is neither a TOML literal, a bare word nor a range.
+    #[error("`{text}` is not a TOML value: {reason}")]
+    NotToml {
+        /// The value as written.
+        text: String,
+        /// What the TOML parser said.
+        reason: String,
+    },
+    /// A range whose end or step is not a number.
+    #[error("range `{range}`: `{part}` is not a number")]
+    RangeNotNumber {
+        /// The range as written.
+        range: String,
+        /// The part that is not a number.
+        part: String,
+    },
+    /// A range whose step is not positive.
+    #[error("range `{0}`: the step must be positive")]
+    RangeStep(String),
+    /// A range whose end is below its start.
+    #[error("range `{0}`: the end is below the start")]
+    RangeReversed(String),
+    /// A range of more values than a sweep takes.
+    #[error("range `{range}`: {count} values (most {})", MAX_VALUES)]
+    RangeTooLong {
+        /// The range as written.
+        range: String,
+        /// The values it has.
+        count: usize,
+    },
+    /// A key through a value where a table should be.
+    #[error("`{name}` in `{key}` is a value, not a table")]
+    NotATable {
+        /// The part of the key.
+        name: String,
+        /// The key.
+        key: String,
+    },
+    /// An item of something that is not an array.
+    #[error("`{name}` in `{key}` is not an array in the scenario")]
+    NotAnArray {
+        /// The part of the key.
+        name: String,
+        /// The key.
+        key: String,
+    },
+    /// An item past the array's end.
+    #[error("`{name}` in `{key}`: item {index} of {len} (counted from 0)")]
+    NoItem {
+        /// The array.
+        name: String,
+        /// The key.
+        key: String,
+        /// The item asked for.
+        index: usize,
+        /// The array's length.
+        len: usize,
+    },
+    /// A key through an array item that is a value, not a table.
+    #[error("`{name}` in `{key}`[{index}] is a value, not a table")]
+    ItemNotATable {
+        /// The array.
+        name: String,
+        /// The key.
+        key: String,
+        /// The item.
+        index: usize,
+    },
 }
-
-impl std::error::Error for SetError {}
 
 /// One step of a key path.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,13 +142,13 @@ const MAX_VALUES: usize = 10_000;
 impl Set {
     /// Parses `KEY=V1,V2,...`.
     pub fn parse(arg: &str) -> Result<Self, SetError> {
-        let fail = |column: usize, message: String| SetError {
+        let fail = |column: usize, problem: SetProblem| SetError {
             arg: arg.to_string(),
             column,
-            message,
+            problem,
         };
         let Some((key, values)) = arg.split_once('=') else {
-            return Err(fail(1, "expected KEY=VALUE[,VALUE...]".into()));
+            return Err(fail(1, SetProblem::NoValue));
         };
         let key = key.trim();
         let path = parse_path(key).map_err(|m| fail(1, m))?;
@@ -73,13 +158,13 @@ impl Set {
             let column = start + offset + (piece.len() - piece.trim_start().len());
             let piece = piece.trim();
             if piece.is_empty() {
-                return Err(fail(column, "an empty value".into()));
+                return Err(fail(column, SetProblem::EmptyValue));
             }
             let vals = parse_value(piece).map_err(|m| fail(column, m))?;
             columns.extend(std::iter::repeat_n(column, vals.len()));
             out.extend(vals);
             if out.len() > MAX_VALUES {
-                return Err(fail(column, format!("more than {MAX_VALUES} values")));
+                return Err(fail(column, SetProblem::TooManyValues));
             }
         }
         Ok(Self {
@@ -95,10 +180,10 @@ impl Set {
     /// way to set a value without writing it as text).
     pub fn single(key: &str, value: Value) -> Result<Self, SetError> {
         let arg = format!("{key}={value}");
-        let path = parse_path(key.trim()).map_err(|message| SetError {
+        let path = parse_path(key.trim()).map_err(|problem| SetError {
             arg: arg.clone(),
             column: 1,
-            message,
+            problem,
         })?;
         Ok(Self {
             arg,
@@ -109,12 +194,18 @@ impl Set {
         })
     }
 
-    /// Writes `value` at the key into `doc`, creating missing tables on the way.
-    pub fn apply(&self, doc: &mut Table, value: &Value) -> Result<(), String> {
+    /// Writes `value` at the key into `doc`, creating missing tables on the way; the error is
+    /// at the argument's first column.
+    pub fn apply(&self, doc: &mut Table, value: &Value) -> Result<(), SetError> {
+        let fail = |problem| SetError {
+            arg: self.arg.clone(),
+            column: 1,
+            problem,
+        };
         let mut table = doc;
         let last = self.path.len() - 1;
         for (i, seg) in self.path.iter().enumerate() {
-            let at = |name: &str| format!("`{name}` in `{}`", self.key);
+            let key = || self.key.clone();
             match seg {
                 Segment::Key(name) if i == last => {
                     table.insert(name.clone(), value.clone());
@@ -123,26 +214,43 @@ impl Set {
                     let next = table
                         .entry(name.clone())
                         .or_insert_with(|| Value::Table(Table::new()));
-                    table = next
-                        .as_table_mut()
-                        .ok_or_else(|| format!("{} is a value, not a table", at(name)))?;
+                    table = next.as_table_mut().ok_or_else(|| {
+                        fail(SetProblem::NotATable {
+                            name: name.clone(),
+                            key: key(),
+                        })
+                    })?;
                 }
                 Segment::Item(name, k) => {
                     let items = table
                         .get_mut(name)
                         .and_then(Value::as_array_mut)
-                        .ok_or_else(|| format!("{} is not an array in the scenario", at(name)))?;
+                        .ok_or_else(|| {
+                            fail(SetProblem::NotAnArray {
+                                name: name.clone(),
+                                key: key(),
+                            })
+                        })?;
                     let len = items.len();
                     let item = items.get_mut(*k).ok_or_else(|| {
-                        format!("{}: item {k} of {len} (counted from 0)", at(name))
+                        fail(SetProblem::NoItem {
+                            name: name.clone(),
+                            key: key(),
+                            index: *k,
+                            len,
+                        })
                     })?;
                     if i == last {
                         *item = value.clone();
                         return Ok(());
                     }
-                    table = item
-                        .as_table_mut()
-                        .ok_or_else(|| format!("{}[{k}] is a value, not a table", at(name)))?;
+                    table = item.as_table_mut().ok_or_else(|| {
+                        fail(SetProblem::ItemNotATable {
+                            name: name.clone(),
+                            key: key(),
+                            index: *k,
+                        })
+                    })?;
                 }
             }
         }
@@ -166,13 +274,16 @@ impl Set {
 }
 
 /// `a.b[2].c` as segments.
-fn parse_path(key: &str) -> Result<Vec<Segment>, String> {
+fn parse_path(key: &str) -> Result<Vec<Segment>, SetProblem> {
     if key.is_empty() {
-        return Err("an empty key".into());
+        return Err(SetProblem::EmptyKey);
     }
     key.split('.')
         .map(|part| {
-            let bad = || format!("`{part}` in `{key}`: expected NAME or NAME[INDEX]");
+            let bad = || SetProblem::BadKeyPart {
+                part: part.to_string(),
+                key: key.to_string(),
+            };
             let (name, item) = match part.split_once('[') {
                 Some((name, rest)) => {
                     let k = rest.strip_suffix(']').ok_or_else(bad)?;
@@ -218,7 +329,7 @@ fn split_values(text: &str) -> Vec<(usize, &str)> {
 }
 
 /// One value: a range, a TOML literal or a bare word.
-fn parse_value(text: &str) -> Result<Vec<Value>, String> {
+fn parse_value(text: &str) -> Result<Vec<Value>, SetProblem> {
     if let Some(range) = parse_range(text)? {
         return Ok(range);
     }
@@ -232,12 +343,15 @@ fn parse_value(text: &str) -> Result<Vec<Value>, String> {
         {
             Ok(vec![Value::String(text.to_string())])
         }
-        Err(e) => Err(format!("`{text}` is not a TOML value: {}", e.message())),
+        Err(e) => Err(SetProblem::NotToml {
+            text: text.to_string(),
+            reason: e.message().to_string(),
+        }),
     }
 }
 
 /// `A..B` or `A..B:STEP`, both ends included; `None` when `text` is not a range.
-fn parse_range(text: &str) -> Result<Option<Vec<Value>>, String> {
+fn parse_range(text: &str) -> Result<Option<Vec<Value>>, SetProblem> {
     let Some((a, rest)) = text.split_once("..") else {
         return Ok(None);
     };
@@ -245,26 +359,30 @@ fn parse_range(text: &str) -> Result<Option<Vec<Value>>, String> {
         Some((b, s)) => (b, Some(s)),
         None => (rest, None),
     };
-    let num = |s: &str| -> Result<f64, String> {
+    let num = |s: &str| -> Result<f64, SetProblem> {
         s.trim()
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("range `{text}`: `{s}` is not a number"))
+            .ok_or_else(|| SetProblem::RangeNotNumber {
+                range: text.to_string(),
+                part: s.to_string(),
+            })
     };
     let (lo, hi) = (num(a)?, num(b)?);
     let step_v = step.map(num).transpose()?.unwrap_or(1.0);
     if step_v <= 0.0 {
-        return Err(format!("range `{text}`: the step must be positive"));
+        return Err(SetProblem::RangeStep(text.to_string()));
     }
     if hi < lo {
-        return Err(format!("range `{text}`: the end is below the start"));
+        return Err(SetProblem::RangeReversed(text.to_string()));
     }
     let count = ((hi - lo) / step_v + 1e-9).floor() as usize + 1;
     if count > MAX_VALUES {
-        return Err(format!(
-            "range `{text}`: {count} values (most {MAX_VALUES})"
-        ));
+        return Err(SetProblem::RangeTooLong {
+            range: text.to_string(),
+            count,
+        });
     }
     let integer = |s: &str| s.trim().parse::<i64>().is_ok();
     let ints = integer(a) && integer(b) && step.is_none_or(integer);
@@ -318,8 +436,14 @@ mod tests {
                 .starts_with("--set robot.max_speed_mm_s=400,1e,1000:1:26:")
         );
         assert!(Set::parse("robot..x=1").is_err());
-        assert!(Set::parse("robot.x").is_err());
-        assert!(Set::parse("a=5..1").is_err());
+        assert_eq!(
+            Set::parse("robot.x").unwrap_err().problem,
+            SetProblem::NoValue
+        );
+        assert_eq!(
+            Set::parse("a=5..1").unwrap_err().problem,
+            SetProblem::RangeReversed("5..1".into())
+        );
         assert!(Set::parse("a=1..5:0").is_err());
         assert!(Set::parse("a[x].b=1").is_err());
     }
@@ -335,7 +459,23 @@ mod tests {
         assert!(text.contains("noise_sigma = 2.5"), "{text}");
         assert!(text.contains("directions = 36"), "{text}");
         let u = Set::parse("robot.sensors[3].x=1").unwrap();
-        assert!(u.apply(&mut doc, &u.values[0]).is_err());
+        let e = u.apply(&mut doc, &u.values[0]).unwrap_err();
+        assert!(
+            matches!(
+                e.problem,
+                SetProblem::NoItem {
+                    index: 3,
+                    len: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "--set robot.sensors[3].x=1:1:1: `sensors` in `robot.sensors[3].x`: item 3 of 1 \
+             (counted from 0)"
+        );
         assert!(t.covers("vision.freespace.directions"));
         assert!(s.covers("robot.sensors[0]"));
         assert!(!s.covers("robot.sensors[0].noise"));

@@ -6,14 +6,14 @@
 use super::plan::{Job, Plan};
 use crate::experiments::run_scenario;
 use crate::report::output::write_run;
-use crate::run::RunOptions;
 use crate::run::record::Summary;
+use crate::run::{RunError, RunOptions};
 use crate::scenario::Scenario;
 use omniloop_sim::render::{BatchHandle, BatchServer, GpuRenderer};
 use omniloop_sim::{RenderError, RendererChoice};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 /// How a sweep runs.
@@ -67,13 +67,30 @@ impl SweepOptions {
     }
 }
 
+/// Why a job of a sweep has no summary.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum JobError {
+    /// The run failed.
+    #[error("{0:#}")]
+    Run(Arc<RunError>),
+    /// The run's outputs could not be written.
+    #[error("{0:#}")]
+    Write(Arc<anyhow::Error>),
+    /// A failure as recorded in a journal or a run's `error.txt`: its text.
+    #[error("{0}")]
+    Recorded(String),
+    /// A journal's record with neither a summary nor an error.
+    #[error("recorded without a summary or an error")]
+    Unrecorded,
+}
+
 /// What became of one run.
 #[derive(Debug, Clone)]
 pub struct Outcome {
     /// The job's index in the plan.
     pub job: usize,
     /// Its summary, or the error that stopped it.
-    pub result: Result<Summary, String>,
+    pub result: Result<Summary, JobError>,
 }
 
 /// Runs the plan's jobs, calling `done` as each ends (in the order they end); stops taking new
@@ -138,7 +155,7 @@ pub fn run_remaining(
 }
 
 /// One run, its outputs written under `keep_runs` when kept.
-fn run_one(plan: &Plan, job: &Job, options: &SweepOptions) -> Result<Summary, String> {
+fn run_one(plan: &Plan, job: &Job, options: &SweepOptions) -> Result<Summary, JobError> {
     let run_options = RunOptions {
         renderer: options.renderer,
         shared_gpu: options.shared_gpu.clone(),
@@ -158,10 +175,11 @@ pub fn run_job(
     scenario: &Scenario,
     options: &RunOptions,
     keep: Option<&Path>,
-) -> Result<Summary, String> {
-    let out = run_scenario(scenario, options, |_| {}, |_, _| {}).map_err(|e| format!("{e:#}"))?;
+) -> Result<Summary, JobError> {
+    let out = run_scenario(scenario, options, |_| {}, |_, _| {})
+        .map_err(|e| JobError::Run(Arc::new(e)))?;
     if let Some(dir) = keep {
-        write_run(dir, scenario, &out).map_err(|e| format!("{e:#}"))?;
+        write_run(dir, scenario, &out).map_err(|e| JobError::Write(Arc::new(e)))?;
     }
     Ok(out.summary)
 }

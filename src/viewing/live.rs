@@ -36,19 +36,60 @@ impl Default for LiveOptions {
     }
 }
 
+/// Why a live address is not `HOST:PORT`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum AddressError {
+    /// No `:`.
+    #[error("live address {0:?}: expected HOST:PORT")]
+    NoPort(String),
+    /// A port that is not a number in `0..=65535`.
+    #[error("live address {addr:?}: port {port:?}: {reason}")]
+    BadPort {
+        /// The address.
+        addr: String,
+        /// The port as written.
+        port: String,
+        /// Why it is not one.
+        reason: std::num::ParseIntError,
+    },
+    /// Nothing before the `:`.
+    #[error("live address {0:?}: no host")]
+    NoHost(String),
+}
+
+/// Why a live server does not start.
+#[derive(Debug, thiserror::Error)]
+pub enum LiveError {
+    /// The address is not `HOST:PORT`.
+    #[error(transparent)]
+    Address(#[from] AddressError),
+    /// The server cannot listen there.
+    #[error("serving on {addr}: {reason}")]
+    Serve {
+        /// The address.
+        addr: String,
+        /// What the Foxglove SDK said.
+        reason: foxglove::FoxgloveError,
+    },
+}
+
 impl LiveOptions {
     /// The host and port of `addr`, or why it is not one.
-    pub fn host_port(&self) -> Result<(String, u16), String> {
+    pub fn host_port(&self) -> Result<(String, u16), AddressError> {
         let (host, port) = self
             .addr
             .rsplit_once(':')
-            .ok_or_else(|| format!("live address {:?}: expected HOST:PORT", self.addr))?;
+            .ok_or_else(|| AddressError::NoPort(self.addr.clone()))?;
         let port = port
             .parse::<u16>()
-            .map_err(|e| format!("live address {:?}: port {port:?}: {e}", self.addr))?;
+            .map_err(|reason| AddressError::BadPort {
+                addr: self.addr.clone(),
+                port: port.to_string(),
+                reason,
+            })?;
         let host = host.trim_start_matches('[').trim_end_matches(']');
         if host.is_empty() {
-            return Err(format!("live address {:?}: no host", self.addr));
+            return Err(AddressError::NoHost(self.addr.clone()));
         }
         Ok((host.to_string(), port))
     }
@@ -102,7 +143,7 @@ pub struct LiveServer {
 
 impl LiveServer {
     /// Starts serving `ctx`'s channels.
-    pub fn start(ctx: &Arc<Context>, options: &LiveOptions) -> Result<Self, String> {
+    pub fn start(ctx: &Arc<Context>, options: &LiveOptions) -> Result<Self, LiveError> {
         let (host, port) = options.host_port()?;
         let viewers = Arc::new(Viewers::default());
         let handle = WebSocketServer::new()
@@ -112,7 +153,10 @@ impl LiveServer {
             .message_backlog_size(BACKLOG)
             .listener(viewers.clone())
             .start_blocking()
-            .map_err(|e| format!("serving on {}: {e}", options.addr))?;
+            .map_err(|reason| LiveError::Serve {
+                addr: options.addr.clone(),
+                reason,
+            })?;
         Ok(Self {
             handle,
             viewers,
@@ -186,8 +230,12 @@ mod tests {
         };
         assert_eq!(at("127.0.0.1:8765"), Ok(("127.0.0.1".into(), 8765)));
         assert_eq!(at("[::1]:0"), Ok(("::1".into(), 0)));
-        assert!(at("localhost").unwrap_err().contains("HOST:PORT"));
-        assert!(at("localhost:http").unwrap_err().contains("port \"http\""));
-        assert!(at(":80").unwrap_err().contains("no host"));
+        let e = at("localhost").unwrap_err();
+        assert_eq!(e, AddressError::NoPort("localhost".into()));
+        assert!(e.to_string().contains("HOST:PORT"), "{e}");
+        let e = at("localhost:http").unwrap_err().to_string();
+        assert!(e.contains("port \"http\""), "{e}");
+        let e = at(":80").unwrap_err().to_string();
+        assert!(e.contains("no host"), "{e}");
     }
 }

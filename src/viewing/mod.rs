@@ -16,7 +16,7 @@ pub mod recorder;
 pub mod scene;
 
 pub use gif::GifLog;
-pub use live::{LiveOptions, LiveServer};
+pub use live::{AddressError, LiveError, LiveOptions, LiveServer};
 pub use pace::RealTime;
 pub use recorder::{Cycle, Recorder, RobotCameras};
 
@@ -66,6 +66,14 @@ pub enum ViewingError {
         file: PathBuf,
         /// Why.
         reason: std::io::Error,
+    },
+    /// The live server does not start.
+    #[error("{what}: {error}")]
+    Live {
+        /// The file and the live server's address.
+        what: String,
+        /// Why.
+        error: live::LiveError,
     },
     /// The Foxglove SDK refused (a channel, the writer).
     #[error("{what}: {message}")]
@@ -121,7 +129,14 @@ impl FoxgloveLog {
             None => None,
         };
         let live = match &sinks.live {
-            Some(options) => Some(LiveServer::start(&ctx, options).map_err(&fail)?),
+            Some(options) => {
+                Some(
+                    LiveServer::start(&ctx, options).map_err(|error| ViewingError::Live {
+                        what: what.clone(),
+                        error,
+                    })?,
+                )
+            }
             None => None,
         };
         let mut recorder = Recorder::new(&ctx, robots).map_err(|e| fail(e.to_string()))?;

@@ -37,6 +37,14 @@ pub enum VisionError {
         /// What went wrong.
         message: String,
     },
+    /// A camera model file that cannot be read or parsed.
+    #[error("calibration file {path}: {error}")]
+    CameraFile {
+        /// The file.
+        path: String,
+        /// What is wrong, and where in it.
+        error: Box<camera_model::CameraFileError>,
+    },
     /// A parameter outside its range.
     #[error("{name} = {value}: {rule}")]
     InvalidParameter {
@@ -46,6 +54,14 @@ pub enum VisionError {
         value: f64,
         /// The rule it breaks.
         rule: &'static str,
+    },
+    /// A profile whose contrast is too low to read marks in.
+    #[error("not found: contrast {contrast:.0} grey levels, need {needed:.0}")]
+    LowContrast {
+        /// Its contrast: brightest minus darkest, grey levels.
+        contrast: f64,
+        /// The contrast needed, grey levels.
+        needed: f64,
     },
     /// The image does not show what the method looks for (a degenerate or empty image).
     #[error("not found: {0}")]

@@ -11,6 +11,7 @@ use super::noise::FrameNoise;
 use super::scene::Scene;
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
+use std::sync::Arc;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::time::{Duration, Instant};
 
@@ -22,7 +23,7 @@ struct Pending {
     noise: Option<FrameNoise>,
     /// Whether the frame asks for its truth.
     truth: bool,
-    reply: Sender<Result<TracedFrame, String>>,
+    reply: Sender<Result<TracedFrame, Arc<RenderError>>>,
 }
 
 enum Message {
@@ -146,7 +147,7 @@ impl BatchClient {
         self.tx
             .send(Message::Frame(Box::new(frame)))
             .map_err(|_| gone())?;
-        rx.recv().map_err(|_| gone())?.map_err(RenderError::Device)
+        rx.recv().map_err(|_| gone())?.map_err(RenderError::Batch)
     }
 }
 
@@ -221,8 +222,9 @@ fn flush(gpu: &mut GpuRenderer, pending: &mut Vec<Pending>) {
             }
         }
         Err(e) => {
+            let e = Arc::new(e);
             for p in &frames {
-                let _ = p.reply.send(Err(e.to_string()));
+                let _ = p.reply.send(Err(e.clone()));
             }
         }
     }

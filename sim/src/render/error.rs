@@ -12,6 +12,9 @@ pub enum RenderError {
     /// The device failed.
     #[error("GPU device error: {0}")]
     Device(String),
+    /// The batch a frame was traced in failed (shared by every frame of the batch).
+    #[error("GPU device error: {0}")]
+    Batch(std::sync::Arc<RenderError>),
     /// The frame asked for cannot be made.
     #[error("cannot render: {0}")]
     Invalid(String),

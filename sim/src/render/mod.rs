@@ -42,14 +42,19 @@ pub enum RendererChoice {
     Cpu,
 }
 
+/// A renderer's name that is none of them.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown renderer {0:?} (auto, gpu, cpu)")]
+pub struct UnknownRenderer(pub String);
+
 impl FromStr for RendererChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownRenderer;
+    fn from_str(s: &str) -> Result<Self, UnknownRenderer> {
         match s {
             "auto" => Ok(Self::Auto),
             "gpu" => Ok(Self::Gpu),
             "cpu" => Ok(Self::Cpu),
-            other => Err(format!("unknown renderer {other:?} (auto, gpu, cpu)")),
+            other => Err(UnknownRenderer(other.to_string())),
         }
     }
 }

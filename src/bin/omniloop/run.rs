@@ -191,7 +191,7 @@ fn print_outcome(s: &Scenario, m: &omniloop::run::Summary, dir: &Path) {
 }
 
 /// A `--live` address, `HOST:PORT`, checked before the run.
-fn live_addr(addr: &str) -> Result<String, String> {
+fn live_addr(addr: &str) -> Result<String, omniloop::viewing::AddressError> {
     let options = LiveOptions {
         addr: addr.to_string(),
         ..LiveOptions::default()

@@ -13,6 +13,8 @@ pub mod unified;
 pub use double_sphere::DoubleSphereModel;
 pub use files::{ModelPose, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml};
 pub use fit::{Correspondence, FitResidual, Projection, fit_unified, refine, residual};
-pub use ocamcalib::OcamModel;
-pub use read::{CameraFile, FORMATS, parse_camera_file, read_camera_file};
+pub use ocamcalib::{OcamModel, PolynomialError};
+pub use read::{
+    CameraFile, CameraFileError, FORMATS, FieldProblem, parse_camera_file, read_camera_file,
+};
 pub use unified::UnifiedModel;

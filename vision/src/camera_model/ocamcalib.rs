@@ -15,6 +15,35 @@ use super::fit::{Correspondence, FitResidual, residual_of};
 use crate::VisionError;
 use nalgebra::{DMatrix, DVector, Vector3};
 
+/// Why a polynomial does not give every pixel of the image one ray
+/// ([`OcamModel::check_polynomial`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PolynomialError {
+    /// `a0` is 0.
+    #[error("a0 is 0: the image centre has no ray")]
+    NoCentreRay,
+    /// `f` overflows within the image.
+    #[error("f({rho_px:.1} px) is not a number")]
+    NotANumber {
+        /// Where, px from the centre.
+        rho_px: f64,
+    },
+    /// The ray's elevation is not monotonic within the image.
+    #[error(
+        "f(rho) - rho tan(theta) has no real root in the image for elevations beyond \
+         {beyond_deg:.2} deg: the ray's elevation turns back at rho = {rho_px:.1} px (the image \
+         reaches {rho_max_px:.1} px)"
+    )]
+    TurnsBack {
+        /// The last elevation reached before it turns, deg.
+        beyond_deg: f64,
+        /// Where it turns, px from the centre.
+        rho_px: f64,
+        /// The image's farthest corner, px from the centre.
+        rho_max_px: f64,
+    },
+}
+
 /// The OCamCalib model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OcamModel {
@@ -141,9 +170,9 @@ impl OcamModel {
     /// (`rho = 1`) to the farthest corner, so that `world2cam`'s equation `f(rho) = rho tan(theta)` (Scaramuzza et al. 2006,
     /// eq. (6) solved for `rho`) has exactly one real root in the image for each `theta` in its
     /// field of view. The error says what fails, and where.
-    pub fn check_polynomial(&self) -> Result<(), String> {
+    pub fn check_polynomial(&self) -> Result<(), PolynomialError> {
         if self.pol.first().is_none_or(|a0| *a0 == 0.0) {
-            return Err("a0 is 0: the image centre has no ray".into());
+            return Err(PolynomialError::NoCentreRay);
         }
         let [h, w] = self.size_hw.map(f64::from);
         let rho_max = [(0.0, 0.0), (h, 0.0), (0.0, w), (h, w)]
@@ -159,15 +188,14 @@ impl OcamModel {
             let t = theta(rho);
             let step = t - last;
             if !t.is_finite() {
-                return Err(format!("f({rho:.1} px) is not a number"));
+                return Err(PolynomialError::NotANumber { rho_px: rho });
             }
             if step == 0.0 || (sign != 0.0 && step.signum() != sign) {
-                return Err(format!(
-                    "f(rho) - rho tan(theta) has no real root in the image for elevations \
-                     beyond {:.2} deg: the ray's elevation turns back at rho = {rho:.1} px \
-                     (the image reaches {rho_max:.1} px)",
-                    last.to_degrees()
-                ));
+                return Err(PolynomialError::TurnsBack {
+                    beyond_deg: last.to_degrees(),
+                    rho_px: rho,
+                    rho_max_px: rho_max,
+                });
             }
             sign = step.signum();
             last = t;

@@ -3,11 +3,11 @@
 //! error naming the file, the line and the field.
 
 use super::double_sphere::DoubleSphereModel;
-use super::ocamcalib::OcamModel;
+use super::ocamcalib::{OcamModel, PolynomialError};
 use super::unified::UnifiedModel;
 use crate::VisionError;
 use std::path::Path;
-use yaml_rust2::{Yaml, YamlLoader};
+use yaml_rust2::{ScanError, Yaml, YamlLoader};
 
 /// A camera model read from a file, with its image size (width, height in px).
 #[derive(Debug, Clone, PartialEq)]
@@ -53,28 +53,132 @@ impl CameraFile {
 /// The formats [`read_camera_file`] takes, by name.
 pub const FORMATS: [&str; 4] = ["opencv-omnidir", "ocamcalib", "kalibr-omni", "kalibr-ds"];
 
+/// Why a camera model file cannot be read: where in the file, and what is wrong there.
+#[derive(Debug, thiserror::Error)]
+pub enum CameraFileError {
+    /// The file cannot be read at all.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// A format that is none of [`FORMATS`].
+    #[error("unknown camera model format {format:?} (one of: {})", FORMATS.join(", "))]
+    UnknownFormat {
+        /// The format asked for.
+        format: String,
+    },
+    /// The text is not YAML (the YAML formats).
+    #[error("line {line}: not YAML: {reason}")]
+    NotYaml {
+        /// 1-based line (the parser's).
+        line: usize,
+        /// What the parser said.
+        reason: ScanError,
+    },
+    /// The file holds no document.
+    #[error("line 1: the file is empty")]
+    Empty,
+    /// A Kalibr camchain read as an OpenCV `omnidir` file.
+    #[error("line 1: this is a Kalibr camchain, not an OpenCV omnidir file")]
+    KalibrCamchain,
+    /// A field that is missing or wrong.
+    #[error("line {line}, field `{field}`: {problem}")]
+    Field {
+        /// 1-based line of the field (1 when it is not in the file).
+        line: usize,
+        /// The field's name.
+        field: &'static str,
+        /// What is wrong with it.
+        problem: FieldProblem,
+    },
+}
+
+/// What is wrong with one field of a camera model file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FieldProblem {
+    /// Not in the file.
+    #[error("missing")]
+    Missing,
+    /// Not in the mapping it belongs to.
+    #[error("missing in `{0}`")]
+    MissingIn(&'static str),
+    /// A Kalibr camchain without its first camera.
+    #[error("missing (a Kalibr camchain names its cameras cam0, cam1, ...)")]
+    MissingCamera,
+    /// Not a list.
+    #[error("expected a list of {0} numbers")]
+    NotAList(usize),
+    /// A list of numbers of the wrong length.
+    #[error("expected {expected} numbers, found {found}")]
+    Count {
+        /// How many it must have.
+        expected: usize,
+        /// How many it has.
+        found: usize,
+    },
+    /// A list with something other than finite numbers in it.
+    #[error("expected {0} finite numbers")]
+    NotFinite(usize),
+    /// A matrix of the wrong shape.
+    #[error("a {rows}x{cols} matrix where {needed} values are needed")]
+    MatrixShape {
+        /// Its rows.
+        rows: i64,
+        /// Its columns.
+        cols: i64,
+        /// The values needed.
+        needed: usize,
+    },
+    /// Not a whole number of pixels in `1..=65536`.
+    #[error("expected a size in pixels")]
+    NotASize,
+    /// A focal length that is not positive.
+    #[error("the focal lengths must be positive")]
+    FocalLength,
+    /// A Kalibr camera of another model than the format.
+    #[error("{found:?} where format {format} needs {needed:?}")]
+    WrongModel {
+        /// The model the file names.
+        found: String,
+        /// The format asked for.
+        format: String,
+        /// The model that format needs.
+        needed: &'static str,
+    },
+    /// A line of a `calib_results.txt` that is not numbers.
+    #[error("expected numbers, found {0:?}")]
+    NotNumbers(String),
+    /// A polynomial's line whose count does not match its coefficients.
+    #[error("a count and that many coefficients")]
+    NotCounted,
+    /// An image size that is not whole pixels.
+    #[error("height and width in pixels")]
+    NotPixelSize,
+    /// An affine map without an inverse.
+    #[error("c - d e is 0, the affine map has no inverse")]
+    NoAffineInverse,
+    /// A polynomial that does not give every pixel one ray.
+    #[error(transparent)]
+    Polynomial(#[from] PolynomialError),
+}
+
 /// Reads `path` as a camera model file of `format` (one of [`FORMATS`]).
 pub fn read_camera_file(path: &Path, format: &str) -> Result<CameraFile, VisionError> {
-    let text = std::fs::read_to_string(path).map_err(|e| VisionError::CalibrationFile {
+    let in_file = |error: CameraFileError| VisionError::CameraFile {
         path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
-    parse_camera_file(&text, format).map_err(|message| VisionError::CalibrationFile {
-        path: path.display().to_string(),
-        message,
-    })
+        error: Box::new(error),
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| in_file(e.into()))?;
+    parse_camera_file(&text, format).map_err(in_file)
 }
 
 /// Parses the text of a camera model file of `format`; the error says the line and field.
-pub fn parse_camera_file(text: &str, format: &str) -> Result<CameraFile, String> {
+pub fn parse_camera_file(text: &str, format: &str) -> Result<CameraFile, CameraFileError> {
     match format {
         "opencv-omnidir" => parse_opencv(text),
         "ocamcalib" => parse_ocamcalib(text),
         "kalibr-omni" | "kalibr-ds" => parse_kalibr(text, format),
-        other => Err(format!(
-            "unknown camera model format {other:?} (one of: {})",
-            FORMATS.join(", ")
-        )),
+        other => Err(CameraFileError::UnknownFormat {
+            format: other.to_string(),
+        }),
     }
 }
 
@@ -89,18 +193,27 @@ fn line_of(text: &str, key: &str) -> usize {
         .map_or(1, |i| i + 1)
 }
 
+/// `problem` with the field `key`, at its line in `text`.
+fn at_key(text: &str, key: &'static str, problem: FieldProblem) -> CameraFileError {
+    CameraFileError::Field {
+        line: line_of(text, key),
+        field: key,
+        problem,
+    }
+}
+
 /// A YAML document; OpenCV's `%YAML:1.0` first line is read as a comment (it is not standard
 /// YAML), so that line numbers stay the file's.
-fn load_yaml(text: &str) -> Result<Yaml, String> {
+fn load_yaml(text: &str) -> Result<Yaml, CameraFileError> {
     let text = match text.strip_prefix("%YAML:1.0") {
         Some(rest) => format!("#{rest}"),
         None => text.to_string(),
     };
-    let docs = YamlLoader::load_from_str(&text)
-        .map_err(|e| format!("line {}: not YAML: {e}", e.marker().line()))?;
-    docs.into_iter()
-        .next()
-        .ok_or_else(|| "line 1: the file is empty".to_string())
+    let docs = YamlLoader::load_from_str(&text).map_err(|reason| CameraFileError::NotYaml {
+        line: reason.marker().line(),
+        reason,
+    })?;
+    docs.into_iter().next().ok_or(CameraFileError::Empty)
 }
 
 /// A number of a YAML value.
@@ -113,76 +226,84 @@ fn number(y: &Yaml) -> Option<f64> {
 }
 
 /// `n` numbers of a YAML list at `key` (its line for errors).
-fn numbers(y: &Yaml, text: &str, key: &str, n: usize) -> Result<Vec<f64>, String> {
-    let line = line_of(text, key);
+fn numbers(y: &Yaml, text: &str, key: &'static str, n: usize) -> Result<Vec<f64>, CameraFileError> {
     let list = y
         .as_vec()
-        .ok_or_else(|| format!("line {line}, field `{key}`: expected a list of {n} numbers"))?;
+        .ok_or_else(|| at_key(text, key, FieldProblem::NotAList(n)))?;
     let values: Option<Vec<f64>> = list.iter().map(number).collect();
     match values {
         Some(v) if v.len() == n && v.iter().all(|x| x.is_finite()) => Ok(v),
-        Some(v) if v.len() != n => Err(format!(
-            "line {line}, field `{key}`: expected {n} numbers, found {}",
-            v.len()
+        Some(v) if v.len() != n => Err(at_key(
+            text,
+            key,
+            FieldProblem::Count {
+                expected: n,
+                found: v.len(),
+            },
         )),
-        _ => Err(format!(
-            "line {line}, field `{key}`: expected {n} finite numbers"
-        )),
+        _ => Err(at_key(text, key, FieldProblem::NotFinite(n))),
     }
 }
 
-/// The field `key` of a mapping, or an error naming it.
-fn field<'a>(map: &'a Yaml, text: &str, key: &str, within: &str) -> Result<&'a Yaml, String> {
+/// The field `key` of a mapping, or an error naming it (`missing`: what it says).
+fn field<'a>(
+    map: &'a Yaml,
+    text: &str,
+    key: &'static str,
+    missing: FieldProblem,
+) -> Result<&'a Yaml, CameraFileError> {
     let v = &map[key];
     if v.is_badvalue() {
-        return Err(format!(
-            "line {}, field `{key}`: missing{within}",
-            line_of(text, key)
-        ));
+        return Err(at_key(text, key, missing));
     }
     Ok(v)
 }
 
 /// An OpenCV matrix (`!!opencv-matrix` with `rows`, `cols`, `data`) of `n` values, or a plain
 /// number for a 1x1 matrix.
-fn opencv_matrix(doc: &Yaml, text: &str, key: &str, n: usize) -> Result<Vec<f64>, String> {
-    let m = field(doc, text, key, "")?;
+fn opencv_matrix(
+    doc: &Yaml,
+    text: &str,
+    key: &'static str,
+    n: usize,
+) -> Result<Vec<f64>, CameraFileError> {
+    let m = field(doc, text, key, FieldProblem::Missing)?;
     if n == 1
         && let Some(v) = number(m)
     {
         return Ok(vec![v]);
     }
-    let data = field(m, text, "data", &format!(" in `{key}`"))?;
+    let data = field(m, text, "data", FieldProblem::MissingIn(key))?;
     let values = numbers(data, text, key, n)?;
     let (rows, cols) = (m["rows"].as_i64(), m["cols"].as_i64());
-    if let (Some(r), Some(c)) = (rows, cols)
-        && (r * c) as usize != n
+    if let (Some(rows), Some(cols)) = (rows, cols)
+        && (rows * cols) as usize != n
     {
-        return Err(format!(
-            "line {}, field `{key}`: a {r}x{c} matrix where {n} values are needed",
-            line_of(text, key)
+        return Err(at_key(
+            text,
+            key,
+            FieldProblem::MatrixShape {
+                rows,
+                cols,
+                needed: n,
+            },
         ));
     }
     Ok(values)
 }
 
-fn size_field(doc: &Yaml, text: &str, key: &str) -> Result<u32, String> {
-    let v = field(doc, text, key, "")?;
+fn size_field(doc: &Yaml, text: &str, key: &'static str) -> Result<u32, CameraFileError> {
+    let v = field(doc, text, key, FieldProblem::Missing)?;
     v.as_i64()
         .filter(|&n| n > 0 && n <= 1 << 16)
         .map(|n| n as u32)
-        .ok_or_else(|| {
-            format!(
-                "line {}, field `{key}`: expected a size in pixels",
-                line_of(text, key)
-            )
-        })
+        .ok_or_else(|| at_key(text, key, FieldProblem::NotASize))
 }
 
-fn parse_opencv(text: &str) -> Result<CameraFile, String> {
+fn parse_opencv(text: &str) -> Result<CameraFile, CameraFileError> {
     let doc = load_yaml(text)?;
     if doc["cam0"].as_hash().is_some() {
-        return Err("line 1: this is a Kalibr camchain, not an OpenCV omnidir file".into());
+        return Err(CameraFileError::KalibrCamchain);
     }
     let k = opencv_matrix(&doc, text, "K", 9)?;
     let xi = opencv_matrix(&doc, text, "xi", 1)?[0];
@@ -192,10 +313,7 @@ fn parse_opencv(text: &str) -> Result<CameraFile, String> {
         size_field(&doc, text, "image_height")?,
     ];
     if k[0] <= 0.0 || k[4] <= 0.0 {
-        return Err(format!(
-            "line {}, field `K`: the focal lengths must be positive",
-            line_of(text, "K")
-        ));
+        return Err(at_key(text, "K", FieldProblem::FocalLength));
     }
     let model = UnifiedModel {
         focal_px: [k[0], k[4]],
@@ -207,26 +325,27 @@ fn parse_opencv(text: &str) -> Result<CameraFile, String> {
     Ok(CameraFile::Unified(model, size))
 }
 
-fn parse_kalibr(text: &str, format: &str) -> Result<CameraFile, String> {
+fn parse_kalibr(text: &str, format: &str) -> Result<CameraFile, CameraFileError> {
     let doc = load_yaml(text)?;
-    let cam = field(
-        &doc,
-        text,
-        "cam0",
-        " (a Kalibr camchain names its cameras cam0, cam1, ...)",
-    )?;
-    let model_name = field(cam, text, "camera_model", " in `cam0`")?
+    let cam = field(&doc, text, "cam0", FieldProblem::MissingCamera)?;
+    let in_cam = || FieldProblem::MissingIn("cam0");
+    let model_name = field(cam, text, "camera_model", in_cam())?
         .as_str()
         .unwrap_or_default();
     let want = if format == "kalibr-ds" { "ds" } else { "omni" };
     if model_name != want {
-        return Err(format!(
-            "line {}, field `camera_model`: {model_name:?} where format {format} needs {want:?}",
-            line_of(text, "camera_model")
+        return Err(at_key(
+            text,
+            "camera_model",
+            FieldProblem::WrongModel {
+                found: model_name.to_string(),
+                format: format.to_string(),
+                needed: want,
+            },
         ));
     }
     let res = numbers(
-        field(cam, text, "resolution", " in `cam0`")?,
+        field(cam, text, "resolution", in_cam())?,
         text,
         "resolution",
         2,
@@ -234,7 +353,7 @@ fn parse_kalibr(text: &str, format: &str) -> Result<CameraFile, String> {
     let size = [res[0] as u32, res[1] as u32];
     let (n, n_dist) = if want == "ds" { (6, 0) } else { (5, 4) };
     let p = numbers(
-        field(cam, text, "intrinsics", " in `cam0`")?,
+        field(cam, text, "intrinsics", in_cam())?,
         text,
         "intrinsics",
         n,
@@ -267,63 +386,85 @@ fn parse_kalibr(text: &str, format: &str) -> Result<CameraFile, String> {
     })
 }
 
+/// `problem` with the field `field` of a `calib_results.txt`, at `line`.
+fn at_line(line: usize, field: &'static str, problem: FieldProblem) -> CameraFileError {
+    CameraFileError::Field {
+        line,
+        field,
+        problem,
+    }
+}
+
+/// A `calib_results.txt` line of numbers and its 1-based line.
+type NumberLine = (usize, Vec<f64>);
+
+/// The `(count, coefficients...)` line of a polynomial: its coefficients.
+fn counted((line, v): NumberLine, field: &'static str) -> Result<Vec<f64>, CameraFileError> {
+    let n = v.first().copied().unwrap_or(0.0);
+    if n < 1.0 || n.fract() != 0.0 || v.len() != n as usize + 1 {
+        return Err(at_line(line, field, FieldProblem::NotCounted));
+    }
+    Ok(v[1..].to_vec())
+}
+
+/// A line of exactly `n` numbers.
+fn exact(
+    (line, v): NumberLine,
+    field: &'static str,
+    n: usize,
+) -> Result<Vec<f64>, CameraFileError> {
+    if v.len() == n {
+        Ok(v)
+    } else {
+        Err(at_line(
+            line,
+            field,
+            FieldProblem::Count {
+                expected: n,
+                found: v.len(),
+            },
+        ))
+    }
+}
+
 /// OCamCalib's `calib_results.txt`: its fields in order, each on the first line with numbers
 /// after its comment line.
-fn parse_ocamcalib(text: &str) -> Result<CameraFile, String> {
+fn parse_ocamcalib(text: &str) -> Result<CameraFile, CameraFileError> {
     let mut lines = text
         .lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let mut next = |field: &str| -> Result<(usize, Vec<f64>), String> {
+    let mut next = |field: &'static str| -> Result<NumberLine, CameraFileError> {
         let (i, l) = lines
             .next()
-            .ok_or_else(|| format!("line {}, field `{field}`: missing", text.lines().count()))?;
+            .ok_or_else(|| at_line(text.lines().count(), field, FieldProblem::Missing))?;
         let values: Result<Vec<f64>, _> = l.split_whitespace().map(str::parse::<f64>).collect();
         match values {
             Ok(v) if v.iter().all(|x| x.is_finite()) => Ok((i + 1, v)),
-            _ => Err(format!(
-                "line {}, field `{field}`: expected numbers, found {l:?}",
-                i + 1
+            _ => Err(at_line(
+                i + 1,
+                field,
+                FieldProblem::NotNumbers(l.to_string()),
             )),
         }
-    };
-    let counted = |(line, v): (usize, Vec<f64>), field: &str| -> Result<Vec<f64>, String> {
-        let n = v.first().copied().unwrap_or(0.0);
-        if n < 1.0 || n.fract() != 0.0 || v.len() != n as usize + 1 {
-            return Err(format!(
-                "line {line}, field `{field}`: a count and that many coefficients"
-            ));
-        }
-        Ok(v[1..].to_vec())
     };
     let pol_at = next("pol")?;
     let pol_line = pol_at.0;
     let pol = counted(pol_at, "pol")?;
     let invpol = counted(next("invpol")?, "invpol")?;
-    let exact = |(line, v): (usize, Vec<f64>), field: &str, n: usize| {
-        if v.len() == n {
-            Ok(v)
-        } else {
-            Err(format!(
-                "line {line}, field `{field}`: expected {n} numbers, found {}",
-                v.len()
-            ))
-        }
-    };
     let center = exact(next("center")?, "center", 2)?;
     let affine = exact(next("affine")?, "affine", 3)?;
     let (size_line, size) = next("size")?;
     let size = exact((size_line, size), "size", 2)?;
     if size.iter().any(|s| *s < 1.0 || s.fract() != 0.0) {
-        return Err(format!(
-            "line {size_line}, field `size`: height and width in pixels"
-        ));
+        return Err(at_line(size_line, "size", FieldProblem::NotPixelSize));
     }
     let [c, d, e] = [affine[0], affine[1], affine[2]];
     if (c - d * e).abs() < 1e-12 {
-        return Err(format!(
-            "line {}, field `affine`: c - d e is 0, the affine map has no inverse",
-            line_of_values(text, 4)
+        return Err(at_line(
+            line_of_values(text, 4),
+            "affine",
+            FieldProblem::NoAffineInverse,
         ));
     }
     let model = OcamModel {
@@ -335,7 +476,7 @@ fn parse_ocamcalib(text: &str) -> Result<CameraFile, String> {
     };
     model
         .check_polynomial()
-        .map_err(|why| format!("line {pol_line}, field `pol`: {why}"))?;
+        .map_err(|why| at_line(pol_line, "pol", why.into()))?;
     Ok(CameraFile::Ocam(model))
 }
 
@@ -424,28 +565,50 @@ mod tests {
         // A missing field: named, with the line where it would be looked for.
         let no_xi = cv.replace("xi: !!opencv-matrix", "chi: !!opencv-matrix");
         let e = parse_camera_file(&no_xi, "opencv-omnidir").unwrap_err();
+        assert!(
+            matches!(
+                e,
+                CameraFileError::Field {
+                    field: "xi",
+                    problem: FieldProblem::Missing,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        let e = e.to_string();
         assert!(e.contains("field `xi`: missing"), "{e}");
         // A short matrix: its line.
         let short = cv.replace("data: [ 0.01, -0.002, 0.0003, -0.0004 ]", "data: [ 0.01 ]");
-        let e = parse_camera_file(&short, "opencv-omnidir").unwrap_err();
+        let e = parse_camera_file(&short, "opencv-omnidir")
+            .unwrap_err()
+            .to_string();
         let line = cv.lines().position(|l| l.starts_with("D:")).unwrap() + 1;
         assert!(e.starts_with(&format!("line {line}, field `D`")), "{e}");
         // The wrong format.
         let k = kalibr_omni_yaml(&unified(), [256, 220], &pose(), "/c", "");
-        let e = parse_camera_file(&k, "opencv-omnidir").unwrap_err();
+        let e = parse_camera_file(&k, "opencv-omnidir")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("Kalibr camchain"), "{e}");
-        let e = parse_camera_file(&k, "kalibr-ds").unwrap_err();
+        let e = parse_camera_file(&k, "kalibr-ds").unwrap_err().to_string();
         assert!(
             e.contains("field `camera_model`") && e.contains("\"omni\""),
             "{e}"
         );
         // Not YAML at all.
-        let e = parse_camera_file("K: [1, 2\n", "opencv-omnidir").unwrap_err();
+        let e = parse_camera_file("K: [1, 2\n", "opencv-omnidir")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("line 2: not YAML"), "{e}");
         // OCamCalib: a count that does not match its coefficients, a missing field.
-        let e = parse_camera_file("#pol\n5 1 2 3\n", "ocamcalib").unwrap_err();
+        let e = parse_camera_file("#pol\n5 1 2 3\n", "ocamcalib")
+            .unwrap_err()
+            .to_string();
         assert_eq!(e, "line 2, field `pol`: a count and that many coefficients");
-        let e = parse_camera_file("#pol\n2 1 2\n#inv\n1 5\n", "ocamcalib").unwrap_err();
+        let e = parse_camera_file("#pol\n2 1 2\n#inv\n1 5\n", "ocamcalib")
+            .unwrap_err()
+            .to_string();
         assert!(e.ends_with("field `center`: missing"), "{e}");
         // OCamCalib: a polynomial whose rays turn back inside the image.
         let mut bent = OcamModel {
@@ -458,7 +621,9 @@ mod tests {
         assert!(bent.check_polynomial().is_ok());
         bent.pol[4] = -3.0e-7;
         let text = bent.calib_results_txt();
-        let e = parse_camera_file(&text, "ocamcalib").unwrap_err();
+        let e = parse_camera_file(&text, "ocamcalib")
+            .unwrap_err()
+            .to_string();
         let line = text.lines().position(|l| l.starts_with("5 ")).unwrap() + 1;
         assert!(
             e.starts_with(&format!(
@@ -467,9 +632,11 @@ mod tests {
             "{e}"
         );
         bent.pol[0] = 0.0;
-        let e = parse_camera_file(&bent.calib_results_txt(), "ocamcalib").unwrap_err();
+        let e = parse_camera_file(&bent.calib_results_txt(), "ocamcalib")
+            .unwrap_err()
+            .to_string();
         assert!(e.ends_with("a0 is 0: the image centre has no ray"), "{e}");
-        let e = parse_camera_file("", "kalibr-dss").unwrap_err();
+        let e = parse_camera_file("", "kalibr-dss").unwrap_err().to_string();
         assert!(e.contains("unknown camera model format"), "{e}");
     }
 }

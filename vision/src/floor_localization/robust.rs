@@ -116,6 +116,40 @@ impl Directions {
     }
 }
 
+/// Why the robust fit found no pose (reported as [`Localization::NotLocalized`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(super) enum FitFailure {
+    /// Tracking: the fit from the best guess near the prior did not converge.
+    #[error("the fit near the prior did not converge")]
+    NearPrior,
+    /// Tracking: no guess came near the prior, and the fit from the prior did not converge.
+    #[error("the fit from the prior did not converge")]
+    FromPrior,
+    /// Global: no first guess converged.
+    #[error("no first guess converged to a field the boundary fits")]
+    NoGuess,
+    /// Global: the best first guess did not converge when finished.
+    #[error("the best first guess did not converge")]
+    BestGuess,
+    /// Global: another pose explains nearly as much of the boundary.
+    #[error(
+        "ambiguous: another pose ({x_mm:.0}, {y_mm:.0}, {heading_deg:.0} deg) explains \
+         {rival_percent:.0}% of the boundary against {best_percent:.0}%"
+    )]
+    Ambiguous {
+        /// The other pose's x, mm.
+        x_mm: f64,
+        /// The other pose's y, mm.
+        y_mm: f64,
+        /// The other pose's heading, deg.
+        heading_deg: f64,
+        /// The share of the boundary the other pose explains, %.
+        rival_percent: f64,
+        /// The share the best pose explains, %.
+        best_percent: f64,
+    },
+}
+
 impl FloorLocalizer {
     /// The robust method on the prepared mask: tracking from `prior` when given, else global;
     /// `hint` chooses between the two solutions when no goal is seen.
@@ -150,7 +184,7 @@ impl FloorLocalizer {
         };
         let (frame, step, iterations) = match found {
             Ok(f) => f,
-            Err(why) => return Localization::NotLocalized(why),
+            Err(why) => return Localization::NotLocalized(why.to_string()),
         };
         let quality = quality(&step, points.len(), hull_cut, iterations, mode);
         if let Some(why) = self.rejection(&quality) {
@@ -209,7 +243,7 @@ impl FloorLocalizer {
         model: &Model,
         prior: &Isometry2<f64>,
         hull_cut: bool,
-    ) -> Result<(FieldFrame, Step, usize), String> {
+    ) -> Result<(FieldFrame, Step, usize), FitFailure> {
         let start = FieldFrame::of_pose(prior);
         let direct = self.refine(points, model, start, self.config.max_iterations);
         if let Some(found @ (_, step, iterations)) = &direct {
@@ -239,8 +273,8 @@ impl FloorLocalizer {
         match best {
             Some((f, _)) => self
                 .refine(points, model, f, self.config.max_iterations)
-                .ok_or_else(|| "the fit near the prior did not converge".to_string()),
-            None => direct.ok_or_else(|| "the fit from the prior did not converge".to_string()),
+                .ok_or(FitFailure::NearPrior),
+            None => direct.ok_or(FitFailure::FromPrior),
         }
     }
 
@@ -569,7 +603,7 @@ impl FloorLocalizer {
         points: &[BoundaryPoint],
         model: &Model,
         rough_direction: Option<f64>,
-    ) -> Result<(FieldFrame, Step, usize), String> {
+    ) -> Result<(FieldFrame, Step, usize), FitFailure> {
         // The trials run on every fourth point: enough to tell the guesses apart. Each guess is
         // scored by what its first step explains on every sixth, and the best few are refined
         // further.
@@ -593,7 +627,7 @@ impl FloorLocalizer {
         trials.sort_by(|a, b| b.1.total_cmp(&a.1));
         let best_trial = trials.first().map_or(0.0, |t| t.1);
         let Some(&(best, _)) = trials.first() else {
-            return Err("no first guess converged to a field the boundary fits".into());
+            return Err(FitFailure::NoGuess);
         };
         let (frame, step, iterations) = self
             .refine_from(
@@ -603,7 +637,7 @@ impl FloorLocalizer {
                 self.config.max_iterations,
                 TRIAL_ITERATIONS,
             )
-            .ok_or_else(|| "the best first guess did not converge".to_string())?;
+            .ok_or(FitFailure::BestGuess)?;
         // Rivals: the other trials that came near the best, finished too.
         let rival = trials
             .iter()
@@ -617,15 +651,13 @@ impl FloorLocalizer {
             });
         if let Some((other, s, _)) = rival {
             let (a, _) = other.poses();
-            return Err(format!(
-                "ambiguous: another pose ({:.0}, {:.0}, {:.0} deg) explains {:.0}% of the \
-                 boundary against {:.0}%",
-                a.translation.x,
-                a.translation.y,
-                a.rotation.angle().to_degrees(),
-                100.0 * s.explained,
-                100.0 * step.explained
-            ));
+            return Err(FitFailure::Ambiguous {
+                x_mm: a.translation.x,
+                y_mm: a.translation.y,
+                heading_deg: a.rotation.angle().to_degrees(),
+                rival_percent: 100.0 * s.explained,
+                best_percent: 100.0 * step.explained,
+            });
         }
         Ok((frame, step, iterations))
     }

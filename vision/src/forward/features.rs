@@ -89,8 +89,32 @@ struct Key {
     ncc: Track,
 }
 
+/// Why a tracker gives no translation between two frames.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TrackingError {
+    /// The key frame has no corner on the floor in the lower window.
+    #[error("no corner in the lower window")]
+    NoCorner,
+    /// Every feature was lost.
+    #[error("no feature followed")]
+    NoneFollowed,
+    /// Too few features agree on the translation.
+    #[error("{inliers} of {features} features agree (need {needed})")]
+    TooFewAgree {
+        /// Features near the median translation.
+        inliers: usize,
+        /// Features followed.
+        features: usize,
+        /// Features that must agree.
+        needed: usize,
+    },
+}
+
 /// Both trackers' translations between two frames, or why there is none.
-pub type Translations = (Result<FeatureMotion, String>, Result<FeatureMotion, String>);
+pub type Translations = (
+    Result<FeatureMotion, TrackingError>,
+    Result<FeatureMotion, TrackingError>,
+);
 
 /// Feature tracks of one camera from key frame to key frame.
 #[derive(Debug, Clone)]
@@ -122,8 +146,7 @@ impl FeatureTracks {
             self.key = self.key_of(prev);
         }
         let Some(key) = self.key.as_mut() else {
-            let why = "no corner in the lower window".to_string();
-            return (Err(why.clone()), Err(why));
+            return (Err(TrackingError::NoCorner), Err(TrackingError::NoCorner));
         };
         key.rotation_rad += rotation_rad;
         key.frames += 1;
@@ -220,7 +243,7 @@ fn advance(
     track: &mut Track,
     ends: Vec<Option<(f64, f64)>>,
     r_now: &Rotation2<f64>,
-) -> Result<FeatureMotion, String> {
+) -> Result<FeatureMotion, TrackingError> {
     for (old, new) in track.ends.iter_mut().zip(ends) {
         *old = old.and(new);
     }
@@ -244,9 +267,9 @@ fn advance(
 }
 
 /// The mean of the translations within `inlier_mm` of their componentwise median.
-fn robust_mean(t: &[Vector2<f64>], config: &FeatureConfig) -> Result<FeatureMotion, String> {
+fn robust_mean(t: &[Vector2<f64>], config: &FeatureConfig) -> Result<FeatureMotion, TrackingError> {
     if t.is_empty() {
-        return Err("no feature followed".to_string());
+        return Err(TrackingError::NoneFollowed);
     }
     let m = Vector2::new(median(t.iter().map(|v| v.x)), median(t.iter().map(|v| v.y)));
     let inliers: Vec<&Vector2<f64>> = t
@@ -254,12 +277,11 @@ fn robust_mean(t: &[Vector2<f64>], config: &FeatureConfig) -> Result<FeatureMoti
         .filter(|v| (*v - m).norm() <= config.inlier_mm)
         .collect();
     if inliers.is_empty() || inliers.len() < config.min_features {
-        return Err(format!(
-            "{} of {} features agree (need {})",
-            inliers.len(),
-            t.len(),
-            config.min_features.max(1)
-        ));
+        return Err(TrackingError::TooFewAgree {
+            inliers: inliers.len(),
+            features: t.len(),
+            needed: config.min_features.max(1),
+        });
     }
     let sum: Vector2<f64> = inliers.iter().copied().sum();
     Ok(FeatureMotion {
@@ -304,7 +326,10 @@ mod tests {
         let m = robust_mean(&t, &FeatureConfig::default()).unwrap();
         assert_eq!((m.features, m.inliers), (4, 3));
         assert!((m.translation_mm.x - 6.0333).abs() < 1e-3, "{m:?}");
-        assert!(robust_mean(&[], &FeatureConfig::default()).is_err());
+        assert_eq!(
+            robust_mean(&[], &FeatureConfig::default()).unwrap_err(),
+            TrackingError::NoneFollowed
+        );
     }
 
     /// Driving 6 mm a frame straight ahead over dark squares, each tracker reads each frame's

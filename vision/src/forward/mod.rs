@@ -20,7 +20,7 @@ pub mod odometry;
 pub mod scanline;
 
 pub use camera::ForwardCamera;
-pub use features::{FeatureConfig, FeatureMotion, FeatureTracks};
+pub use features::{FeatureConfig, FeatureMotion, FeatureTracks, TrackingError};
 pub use flow::{FlowBalance, FlowConfig, FlowField, horn_schunck, reduce};
 pub use grey::{Grey, bilinear, grey};
 pub use ground::{GroundConfig, GroundSegmenter, GroundView};

@@ -6,7 +6,7 @@
 //! matcher's search.
 
 use super::camera::ForwardCamera;
-use super::features::{FeatureConfig, FeatureMotion, FeatureTracks};
+use super::features::{FeatureConfig, FeatureMotion, FeatureTracks, TrackingError};
 use super::grey::Grey;
 use super::lk::pyramid;
 use super::scanline::{ScanLine, ScanLineConfig};
@@ -70,9 +70,9 @@ pub struct OdometryStep {
     /// The scan line's rotation, rad (counter-clockwise positive).
     pub rotation_rad: f64,
     /// The translation by Lucas-Kanade, or why there is none.
-    pub lk: Result<FeatureMotion, String>,
+    pub lk: Result<FeatureMotion, TrackingError>,
     /// The translation by cross-correlation, or why there is none.
-    pub ncc: Result<FeatureMotion, String>,
+    pub ncc: Result<FeatureMotion, TrackingError>,
 }
 
 /// The previous frame, as the odometry keeps it.

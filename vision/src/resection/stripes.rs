@@ -162,15 +162,15 @@ struct Edge {
 
 /// Binarizes `profile` halfway between its extremes and returns the crossings (Fig. 6(b)), or
 /// why there are none worth reading.
-fn crossings(profile: &[f32], min_contrast: f64) -> Result<Vec<Edge>, String> {
+fn crossings(profile: &[f32], min_contrast: f64) -> Result<Vec<Edge>, VisionError> {
     let (lo, hi) = profile
         .iter()
         .fold((f32::MAX, f32::MIN), |(l, h), &v| (l.min(v), h.max(v)));
     if profile.len() < 2 || ((hi - lo) as f64) < min_contrast {
-        return Err(format!(
-            "contrast {:.0} grey levels, need {min_contrast:.0}",
-            (hi - lo).max(0.0)
-        ));
+        return Err(VisionError::LowContrast {
+            contrast: f64::from((hi - lo).max(0.0)),
+            needed: min_contrast,
+        });
     }
     let t = 0.5 * (lo + hi);
     let mut edges = Vec::new();
@@ -192,7 +192,7 @@ pub fn find_stripes(
     patterns: &[StripePattern],
     config: &StripeConfig,
 ) -> Result<Vec<StripeMatch>, VisionError> {
-    let edges = crossings(profile, config.min_contrast).map_err(VisionError::NotFound)?;
+    let edges = crossings(profile, config.min_contrast)?;
     let mut found = Vec::new();
     for start in 0..edges.len() {
         if !edges[start].falling {
@@ -406,6 +406,10 @@ mod tests {
             &StripeConfig::default(),
         )
         .unwrap_err();
+        assert!(
+            matches!(err, VisionError::LowContrast { contrast, .. } if contrast == 0.0),
+            "{err:?}"
+        );
         assert!(err.to_string().contains("contrast 0"), "{err}");
     }
 }
