@@ -20,6 +20,23 @@ struct PaperFit {
     iterations: usize,
 }
 
+/// Why steps 3-6 found no frame of the field.
+#[derive(Debug, thiserror::Error)]
+enum PaperFailure {
+    /// The boundary's hull is too small to be the field.
+    #[error("floor region hull too small ({area_m2:.2} m^2)")]
+    HullTooSmall {
+        /// The hull's area, m^2.
+        area_m2: f64,
+    },
+    /// The fit lost the lines that fix the field.
+    #[error("boundary points do not fix the field (need a goal line or back and a touchline)")]
+    Unfixed,
+    /// The settings allow no iteration.
+    #[error("no iteration of the fit ran (max_iterations is 0)")]
+    NoIteration,
+}
+
 impl FloorLocalizer {
     /// Steps 2-7 on the prepared mask of `img`.
     pub(super) fn locate_paper(
@@ -40,7 +57,7 @@ impl FloorLocalizer {
             .and_then(|guess| self.iterate_fit(&points, guess))
         {
             Ok(fit) => fit,
-            Err(why) => return Localization::NotLocalized(why),
+            Err(why) => return Localization::NotLocalized(why.to_string()),
         };
         let (chosen, other, by_goals) = self.choose(img, &fit.frame, hint);
         Localization::Localized(PoseEstimate {
@@ -65,17 +82,16 @@ impl FloorLocalizer {
     /// Steps 3 (on the floor) and 5: the field's frame guessed from the moments of the
     /// boundary points' hull (its centroid and long axis); an error when the hull is too small
     /// to be the field.
-    fn first_guess(&self, points: &[BoundaryPoint]) -> Result<FieldFrame, String> {
+    fn first_guess(&self, points: &[BoundaryPoint]) -> Result<FieldFrame, PaperFailure> {
         let pts: Vec<Point2<f64>> = points.iter().map(|b| b.p).collect();
         let hull = convex_hull(&pts);
         let m = Moments::of_polygon(&hull);
         let f = &self.config.field;
         let field_area = 4.0 * f.a1_mm * f.b_mm;
         if hull.len() < 3 || m.m00 < 0.1 * field_area {
-            return Err(format!(
-                "floor region hull too small ({:.2} m^2)",
-                m.m00 * 1e-6
-            ));
+            return Err(PaperFailure::HullTooSmall {
+                area_m2: m.m00 * 1e-6,
+            });
         }
         Ok(FieldFrame {
             centre: m.centroid(),
@@ -85,7 +101,11 @@ impl FloorLocalizer {
 
     /// Step 6: from `guess`, the six lines fitted by eq. (15) and the frame moved by the fitted
     /// offset and rotation, until both are below the thresholds or the iterations run out.
-    fn iterate_fit(&self, points: &[BoundaryPoint], guess: FieldFrame) -> Result<PaperFit, String> {
+    fn iterate_fit(
+        &self,
+        points: &[BoundaryPoint],
+        guess: FieldFrame,
+    ) -> Result<PaperFit, PaperFailure> {
         let FieldFrame {
             mut centre,
             mut psi,
@@ -100,11 +120,7 @@ impl FloorLocalizer {
             };
             let Some((du, dv, zeta, rms, used, lines)) = self.fit_step(points, centre, psi, gate)
             else {
-                return Err(
-                    "boundary points do not fix the field (need a goal line or back and a \
-                     touchline)"
-                        .into(),
-                );
+                return Err(PaperFailure::Unfixed);
             };
             iterations += 1;
             // Eqs. (16)-(18): move the estimate by the fitted offset and rotation.
@@ -119,7 +135,7 @@ impl FloorLocalizer {
             }
         }
         let Some((rms_mm, points, lines)) = fit else {
-            return Err("no iteration of the fit ran (max_iterations is 0)".into());
+            return Err(PaperFailure::NoIteration);
         };
         Ok(PaperFit {
             frame: FieldFrame { centre, psi },
