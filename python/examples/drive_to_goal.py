@@ -1,7 +1,9 @@
 import math, omniloop
 
 scenario = omniloop.Scenario.load("scenarios/smoke.toml")
-gx, gy = scenario.robot["goal"]["x_mm"], scenario.robot["goal"]["y_mm"]
+goal = scenario.robot["goal"]
+assert goal is not None                        # smoke.toml has one
+gx, gy = goal["x_mm"], goal["y_mm"]
 sim = omniloop.Simulation(scenario)            # your Python code is the robot's software
 obs = sim.reset(seed=1)
 while not obs.done:

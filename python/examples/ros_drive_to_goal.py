@@ -23,12 +23,12 @@ NS = "/omniloop"  # the robot's namespace: the scenario's robot name, or omniloo
 class DriveToGoal(Node):
     def __init__(self) -> None:
         super().__init__("drive_to_goal")
-        self.goal = None
+        self.goal: tuple[float, float] | None = None
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.create_subscription(PoseStamped, f"{NS}/goal_pose", self.on_goal, latched)
         self.create_subscription(Odometry, f"{NS}/odom", self.on_odom, 5)
         self.cmd = self.create_publisher(Twist, f"{NS}/cmd_vel", 5)
-        self.last_odom = None
+        self.last_odom: float | None = None
 
     def on_goal(self, msg: PoseStamped) -> None:
         self.goal = (msg.pose.position.x, msg.pose.position.y)
