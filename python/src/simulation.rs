@@ -477,6 +477,9 @@ pub struct Observation {
     /// Camera name -> pan angle, rad, for cameras on pan units.
     #[pyo3(get)]
     actuators: Py<PyDict>,
+    /// The dribbler's light barrier: whether it sees the ball (`None` without a kicker).
+    #[pyo3(get)]
+    ball_in_dribbler: Option<bool>,
     /// Whether the run is over (time up, or the goal reached where the run stops there).
     #[pyo3(get)]
     done: bool,
@@ -542,9 +545,15 @@ fn observation_of(py: Python<'_>, state: &State, k: usize) -> PyResult<Observati
         },
     };
     let actuators = PyDict::new(py);
-    for a in agent.actuator_state() {
-        let ActuatorState::Pan { sensor, pan_rad } = a;
-        actuators.set_item(sensor, pan_rad)?;
+    let mut ball_in_dribbler = None;
+    for a in agent.actuator_state(sim.world()) {
+        match a {
+            ActuatorState::Pan { sensor, pan_rad } => actuators.set_item(sensor, pan_rad)?,
+            ActuatorState::Kicker {
+                ball_in_dribbler: seen,
+                ..
+            } => ball_in_dribbler = Some(seen),
+        }
     }
     let record = match state.members[k].remote {
         Some(_) => None,
@@ -558,6 +567,7 @@ fn observation_of(py: Python<'_>, state: &State, k: usize) -> PyResult<Observati
         odometry: Py::new(py, odometry)?,
         odometry_pose: (p.translation.x, p.translation.y, p.rotation.angle()),
         actuators: actuators.unbind(),
+        ball_in_dribbler,
         done: state.done(),
         record,
     })

@@ -37,6 +37,13 @@ pub enum ActuatorState {
         /// Current pan angle, rad.
         pan_rad: f64,
     },
+    /// The kicker and dribbler on the robot's flat front.
+    Kicker {
+        /// The light barrier across the dribbler: whether it sees the ball.
+        ball_in_dribbler: bool,
+        /// Whether the kicker is charged.
+        ready: bool,
+    },
 }
 
 /// A command to an actuator.
@@ -56,6 +63,19 @@ pub enum ActuatorCommand {
         /// Pan rate, rad/s (counter-clockwise positive).
         rate_rad_s: f64,
     },
+    /// Arm the kicker: it fires once, as soon as the ball is at the dribbler and the kicker is
+    /// charged; a speed of 0 disarms it. At most the kicker's limit (the rules' 6.5 m/s).
+    Kick {
+        /// Speed of the ball off the kicker, mm/s.
+        speed_mm_s: f64,
+        /// Angle above the floor, rad: 0 a flat kick, above 0 a chip.
+        angle_rad: f64,
+    },
+    /// Spin the dribbler at this speed (0: off) until told otherwise.
+    Dribble {
+        /// Dribbler speed, rpm.
+        rpm: f64,
+    },
 }
 
 /// Everything the robot's sensors give it at the start of a control cycle (besides the wheel
@@ -71,6 +91,19 @@ pub struct Observation<'a> {
 }
 
 impl<'a> Observation<'a> {
+    /// Whether the dribbler's light barrier sees the ball (false without a kicker).
+    pub fn ball_in_dribbler(&self) -> bool {
+        self.actuators.iter().any(|a| {
+            matches!(
+                a,
+                ActuatorState::Kicker {
+                    ball_in_dribbler: true,
+                    ..
+                }
+            )
+        })
+    }
+
     /// The frame of the camera called `sensor`, if this cycle brought one.
     pub fn frame(&self, sensor: &str) -> Option<&Frame<'a>> {
         self.frames.iter().find(|f| f.sensor == sensor)

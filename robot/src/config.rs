@@ -168,6 +168,8 @@ pub struct BodySpec {
     pub accel_limit_mm_s2: f64,
     /// Rotational acceleration limit, rad/s^2.
     pub angular_accel_limit_rad_s2: f64,
+    /// Its kicker's fastest kick, mm/s, when it has a kicker.
+    pub max_kick_mm_s: Option<f64>,
 }
 
 /// A landmark of the robot's map: an upright cylinder of one colour.
@@ -277,6 +279,7 @@ impl RobotConfig {
                 max_speed_mm_s: 400.0,
                 accel_limit_mm_s2: 300.0,
                 angular_accel_limit_rad_s2: 10.0,
+                max_kick_mm_s: None,
             },
             control_period_s: 0.04,
             cameras: Vec::new(),

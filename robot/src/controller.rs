@@ -3,7 +3,7 @@
 //! [`crate::controllers`].
 
 use crate::RobotError;
-use crate::boundary::BodyCommand;
+use crate::boundary::{ActuatorCommand, ActuatorState, BodyCommand};
 use crate::config::{ControlSpec, RobotConfig};
 use crate::navigation::{MapSnapshot, NavigationReport};
 use crate::near_field::NearSpace;
@@ -31,6 +31,8 @@ pub struct Situation<'a> {
     pub odometry_pose: Isometry2<f64>,
     /// Time of the cycle, s.
     pub t_s: f64,
+    /// The state of the robot's actuators (pan units, the kicker's light barrier).
+    pub actuators: &'a [ActuatorState],
 }
 
 impl Situation<'_> {
@@ -45,6 +47,10 @@ impl Situation<'_> {
 pub trait Controller: Send {
     /// The command for this cycle.
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand;
+    /// Commands to the actuators (kicker, dribbler) after the cycle's decision; default none.
+    fn actuators(&mut self) -> Vec<ActuatorCommand> {
+        Vec::new()
+    }
     /// The move a scripted controller is at (after the cycle's decision), if it follows one.
     fn step(&self) -> Option<usize> {
         None

@@ -199,7 +199,10 @@ impl RobotSoftware for Robot {
             pose,
             odometry_pose: self.estimator.odometry_pose(),
             t_s: obs.t_s,
+            actuators: obs.actuators,
         });
+        let mut actuators = percepts.actuators;
+        actuators.extend(self.controller.actuators());
         self.estimator.end_cycle();
         let navigation = self.controller.navigation().cloned();
         let mut not_found = percepts.not_found;
@@ -210,7 +213,7 @@ impl RobotSoftware for Robot {
         }
         Ok(Outputs {
             command,
-            actuators: percepts.actuators,
+            actuators,
             estimates: Estimates {
                 t_s: obs.t_s,
                 pose,

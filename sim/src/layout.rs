@@ -2,6 +2,7 @@
 //! pillars. Scenario files embed these types directly; [`Layout::solids`] turns them into the
 //! one list of solid shapes that both the physics world and the renderer use.
 
+use crate::ball::BallSpec;
 use crate::color::Rgb;
 use crate::corridor::Corridor;
 use crate::floor_marks::{FloorMark, MarkScatter};
@@ -310,6 +311,8 @@ pub struct Layout {
     pub floor_marks: Vec<FloorMark>,
     /// Marks scattered at random over a rectangle of the floor.
     pub mark_scatter: Option<MarkScatter>,
+    /// The ball (`[world.ball]`), when there is one.
+    pub ball: Option<BallSpec>,
 }
 
 impl Default for Layout {
@@ -327,6 +330,7 @@ impl Default for Layout {
             boards: Vec::new(),
             floor_marks: Vec::new(),
             mark_scatter: None,
+            ball: None,
         }
     }
 }

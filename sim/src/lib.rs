@@ -2,11 +2,14 @@
 //! Small-Size field (or any floor of walls, cubes and pillars) and acceleration-limited
 //! omnidirectional robots.
 
+pub mod ball;
 pub mod calibration;
 pub mod color;
 pub mod corridor;
 pub mod floor_marks;
 pub mod floor_rect;
+pub mod game;
+pub mod kicker;
 pub mod labels;
 pub mod layout;
 pub mod optics;
@@ -16,10 +19,13 @@ pub mod sensor;
 pub mod shapes;
 pub mod world;
 
+pub use ball::{BallSpec, BallState};
 pub use color::Rgb;
 pub use corridor::Corridor;
 pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use floor_rect::FloorRect;
+pub use game::{BallEvent, BallFigures, GoalSide};
+pub use kicker::{BallCommand, Kick, KickerSpec};
 pub use layout::{Board, Cube, FieldSpec, Layout, Pillar, Wall};
 pub use reachability::{Reachability, Target, reachability};
 pub use render::{

@@ -9,8 +9,13 @@
 //! engine's collision events, confirmed by the contact manifold's distance (rapier also reports
 //! speculative contacts a few millimetres before touching).
 
+mod play;
+
 use crate::SimError;
+use crate::ball::{BallSpec, BallState};
 use crate::color::Rgb;
+use crate::game::{BallEvent, BallFigures, Referee};
+use crate::kicker::{BallCommand, KickerSpec};
 use crate::labels::{Class, ObjectId};
 use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
@@ -43,6 +48,8 @@ pub struct RobotBodySpec {
     /// Its drive when it is a differential-drive robot (then it takes the forward part of its
     /// commands and their rotation rate; the acceleration limits above are not used).
     pub differential: Option<DifferentialDrive>,
+    /// Its kicker and dribbler, on a flat front, when it has them.
+    pub kicker: Option<KickerSpec>,
 }
 
 /// The state of a robot as the physics engine has it.
@@ -103,6 +110,10 @@ struct Robot {
     stats: RobotStats,
     /// Colliders rapier says this robot is in contact with, and whether they actually touch.
     pairs: Vec<(ColliderHandle, bool)>,
+    /// What it commands its kicker and dribbler.
+    ball_command: BallCommand,
+    /// When its kicker is charged again.
+    kicker_ready_at_s: f64,
 }
 
 /// What a collider belongs to.
@@ -130,6 +141,8 @@ pub struct World {
     steps: u64,
     /// Touches between two robots (their indices, the lower first), each once.
     robot_touches: Vec<(usize, usize)>,
+    /// The ball, when there is one.
+    play: Option<play::Play>,
 }
 
 fn vec(v: Vector2<f64>) -> Vector {
@@ -207,6 +220,8 @@ impl World {
                 command: VelocityCommand::STOP,
                 stats: RobotStats::new(),
                 pairs: Vec::new(),
+                ball_command: BallCommand::default(),
+                kicker_ready_at_s: 0.0,
             });
         }
         let (ctx, crx) = channel();
@@ -226,6 +241,10 @@ impl World {
             physics_step_s,
             steps: 0,
             robot_touches: Vec::new(),
+            play: layout.ball.as_ref().map(|b| {
+                let referee = Referee::new(layout.field.clone(), robots.len());
+                play::Play::new(b, robots.len(), referee)
+            }),
         })
     }
 
@@ -479,6 +498,91 @@ impl World {
             }
         }
         self.confirm_contacts();
+        self.step_ball(dt);
+    }
+
+    /// The ball's physics step, the robots moved; a robot that kicked recharges.
+    fn step_ball(&mut self, dt: f64) {
+        if self.play.is_none() {
+            return;
+        }
+        let t = self.time_s();
+        let bodies = self.ball_bodies();
+        let kicked = match &mut self.play {
+            Some(play) => play.step(t, dt, &self.solids, &bodies),
+            None => Vec::new(),
+        };
+        for j in kicked {
+            let r = &mut self.robots[j];
+            r.ball_command.kick = None;
+            r.kicker_ready_at_s = t + r.spec.kicker.as_ref().map_or(0.0, |k| k.recharge_s);
+        }
+    }
+
+    /// Robot `i` commands its kicker and dribbler: the dribbler's speed from now on; a kick,
+    /// when given, armed until it fires (a kick of speed 0 disarms). A robot without a kicker
+    /// ignores it.
+    pub fn set_ball_command(&mut self, i: usize, command: BallCommand) {
+        let c = &mut self.robots[i].ball_command;
+        c.dribbler_rpm = command.dribbler_rpm;
+        if let Some(k) = command.kick {
+            c.kick = (k.speed_mm_s > 0.0).then_some(k);
+        }
+    }
+
+    /// What robot `i` commands its kicker and dribbler.
+    pub fn ball_command(&self, i: usize) -> BallCommand {
+        self.robots[i].ball_command
+    }
+
+    /// Whether robot `i`'s light barrier sees the ball now (false without a kicker or ball).
+    pub fn light_barrier(&self, i: usize) -> bool {
+        let Some(play) = &self.play else {
+            return false;
+        };
+        if play.holder() == Some(i) {
+            return true;
+        }
+        let (Some(k), s) = (&self.robots[i].spec.kicker, self.robot_state(i)) else {
+            return false;
+        };
+        let local = s.pose.inverse_transform_point(&play.state.position_mm);
+        k.barrier(local, play.spec.radius_mm, play.state.bottom_mm(&play.spec))
+    }
+
+    /// Whether robot `i`'s kicker is charged (false without one).
+    pub fn kicker_ready(&self, i: usize) -> bool {
+        let r = &self.robots[i];
+        r.spec.kicker.is_some() && self.time_s() >= r.kicker_ready_at_s
+    }
+
+    /// The ball's description and state, when there is a ball.
+    pub fn ball(&self) -> Option<(&BallSpec, BallState)> {
+        self.play.as_ref().map(|p| (&p.spec, p.state))
+    }
+
+    /// The robot whose dribbler holds the ball.
+    pub fn ball_holder(&self) -> Option<usize> {
+        self.play.as_ref().and_then(play::Play::holder)
+    }
+
+    /// Puts the ball at `position_mm` on the floor going at `velocity_mm_s` (an experimenter
+    /// placing it; a dribbler holding it lets go). Nothing without a ball.
+    pub fn place_ball(&mut self, position_mm: Point2<f64>, velocity_mm_s: Vector2<f64>) {
+        if let Some(p) = &mut self.play {
+            p.hold = None;
+            p.state = BallState::on_floor(&p.spec, position_mm, velocity_mm_s);
+        }
+    }
+
+    /// The game's events so far (kicks, touches, goals, ...), in order.
+    pub fn ball_events(&self) -> &[BallEvent] {
+        self.play.as_ref().map_or(&[], |p| p.referee.events())
+    }
+
+    /// The game's figures of the ball so far, when there is a ball.
+    pub fn ball_figures(&self) -> Option<&BallFigures> {
+        self.play.as_ref().map(|p| p.referee.figures())
     }
 
     /// Decides which pairs rapier reports truly touch (rapier keeps speculative contacts and
@@ -527,6 +631,7 @@ mod tests {
             rgb: Rgb([20, 20, 20]),
             marking_rgb: None,
             differential: None,
+            kicker: None,
         }
     }
 

@@ -384,6 +384,7 @@ mod tests {
             files: Vec::new(),
             map: None,
             robots: Vec::new(),
+            ball: None,
         }
     }
 

@@ -238,6 +238,8 @@ impl Forward {
                     lk_gaps: 0,
                     ncc_gaps: 0,
                 },
+                // The kicker's and dribbler's moves take no time and move nothing.
+                Move::DribbleRpm(_) | Move::Kick(_) => continue,
             });
         }
         results

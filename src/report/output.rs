@@ -4,6 +4,7 @@
 use super::charts::PALETTE;
 use super::topview::{FigureError, Marker, Panel, PathLayer, render_panels};
 use crate::run::RunOutput;
+use crate::run::ball_record::write_ball_csv;
 use crate::run::record::{write_estimates_jsonl, write_team_trajectory_csv, write_trajectory_csv};
 use crate::scenario::Scenario;
 use anyhow::Context;
@@ -48,12 +49,26 @@ pub fn write_run(dir: &Path, scenario: &Scenario, out: &RunOutput) -> anyhow::Re
     } else {
         write_team_records(dir, out)?;
     }
+    if let Some(ball) = &out.ball {
+        write_ball_records(dir, ball)?;
+    }
     draw_run_topview(&dir.join("topview.png"), scenario, out)?;
     for f in &out.files {
         let path = dir.join(&f.name);
         std::fs::write(&path, &f.bytes).with_context(|| format!("writing {}", path.display()))?;
     }
     Ok(())
+}
+
+/// Writes the ball's `ball.csv` and the game's `events.jsonl` into `dir`.
+fn write_ball_records(dir: &Path, ball: &crate::run::BallOutput) -> anyhow::Result<()> {
+    let path = dir.join("ball.csv");
+    let f = File::create(&path).with_context(|| format!("writing {}", path.display()))?;
+    write_ball_csv(&ball.rows, BufWriter::new(f))
+        .with_context(|| format!("writing {}", path.display()))?;
+    let path = dir.join("events.jsonl");
+    let text: String = (ball.events.iter()).map(|e| format!("{e}\n")).collect();
+    std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
 }
 
 /// Writes a robot's `trajectory.csv` and `estimates.jsonl` into `dir`.
@@ -134,15 +149,36 @@ pub fn run_topview_image(
         ),
         None => scenario.name.clone(),
     };
+    let ball = ball_path(out);
+    let mut paths = run_paths(&truth, &estimate, &out.other_paths, &plan);
+    paths.extend(ball_layer(&ball));
     let panel = Panel {
         title,
         layout: &scenario.world,
-        paths: run_paths(&truth, &estimate, &out.other_paths, &plan),
+        paths,
         markers: run_markers(scenario),
         spots: Vec::new(),
         grid: out.map.as_ref(),
     };
     render_panels(name, &[panel], width)
+}
+
+/// The ball's path over the run (empty without a ball).
+fn ball_path(out: &RunOutput) -> Vec<Point2<f64>> {
+    (out.ball.iter())
+        .flat_map(|b| b.rows.iter().map(crate::run::BallRow::point))
+        .collect()
+}
+
+/// The ball's path as a layer (orange), when it moved.
+fn ball_layer(points: &[Point2<f64>]) -> Option<PathLayer<'_>> {
+    (points.len() > 1).then(|| PathLayer {
+        label: "ball".into(),
+        rgb: [255, 120, 0],
+        points,
+        dots: false,
+        discs: None,
+    })
 }
 
 /// A run's paths, in drawing order: the estimated one (dots, when there is one), the other
@@ -238,7 +274,8 @@ fn team_topview_image(
                 .collect()
         })
         .collect();
-    let mut layers = Vec::new();
+    let ball = ball_path(out);
+    let mut layers: Vec<PathLayer<'_>> = ball_layer(&ball).into_iter().collect();
     for (k, p) in out.other_paths.iter().enumerate() {
         layers.push(PathLayer {
             label: format!("scripted {}", k + 1),

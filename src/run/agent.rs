@@ -15,13 +15,16 @@ use crate::scenario::calibrate::calibrate_sensor;
 use crate::scenario::{PilotChoice, Scenario};
 use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
 use omniloop_control::{AccelLimitedDrive, VelocityCommand};
+use omniloop_robot::ActuatorCommand;
 use omniloop_robot::perception::floor_localization;
 use omniloop_robot::{
     ActuatorState, Estimates, FixOutcome, Frame, NavigationReport, Observation, OdometryReading,
     Outputs, RobotConfig, RobotError, RobotSoftware,
 };
 use omniloop_sim::render::BatchHandle;
-use omniloop_sim::{Reachability, RendererChoice, RobotState, Scene, SimError, World};
+use omniloop_sim::{
+    BallCommand, Kick, Reachability, RendererChoice, RobotState, Scene, SimError, World,
+};
 use omniloop_vision::resection::ColumnCalibration;
 use omniloop_vision::{FreeSpace, RadialCalibration};
 use std::collections::VecDeque;
@@ -70,8 +73,11 @@ pub struct Agent {
     /// the free-space stage judged that cycle's frame.
     floor_scores: Vec<Option<FloorRegionScore>>,
     last_odometry: Option<OdometryReading>,
-    /// Commands on their way to the drive: when each is due, and the command.
-    commands: VecDeque<(f64, VelocityCommand)>,
+    /// Commands on their way to the drive, kicker and dribbler: when each is due, and the
+    /// commands.
+    commands: VecDeque<(f64, VelocityCommand, BallCommand)>,
+    /// The dribbler's speed its software last asked for, rpm.
+    dribbler_rpm: f64,
     /// The target it headed for in the cycle being applied (its software's word, or the
     /// pilot's), checked on the truth once the world moved on.
     heading_for: Option<usize>,
@@ -144,6 +150,7 @@ impl Agent {
             floor_scores: Vec::new(),
             last_odometry: None,
             commands: VecDeque::new(),
+            dribbler_rpm: 0.0,
             heading_for: None,
             route,
             progress: Vec::new(),
@@ -213,12 +220,13 @@ impl Agent {
         self.last_odometry
     }
 
-    /// The state of its pan units now.
-    pub fn actuator_state(&self) -> Vec<ActuatorState> {
-        self.cameras
-            .as_ref()
+    /// The state of its actuators in `world` now: its pan units, its kicker.
+    pub fn actuator_state(&self, world: &World) -> Vec<ActuatorState> {
+        let mut state = (self.cameras.as_ref())
             .map(|c| c.actuator_state())
-            .unwrap_or_default()
+            .unwrap_or_default();
+        state.extend(self.kicker_state(world));
+        state
     }
 
     /// Whether its goal is reached (on the truth).
@@ -252,11 +260,29 @@ impl Agent {
         Ok(())
     }
 
-    /// Its software decides on the frames of the last sense, at time `t_s`.
-    pub(crate) fn decide(&mut self, t_s: f64) -> Result<Outputs, RunError> {
+    /// Its kicker's state in `world` (its light barrier, its charge), when it has a kicker.
+    pub(crate) fn kicker_state(&self, world: &World) -> Option<ActuatorState> {
+        self.scenario
+            .robot
+            .kicker
+            .as_ref()
+            .map(|_| ActuatorState::Kicker {
+                ball_in_dribbler: world.light_barrier(self.body),
+                ready: world.kicker_ready(self.body),
+            })
+    }
+
+    /// Its software decides on the frames of the last sense and the actuators' state (its pan
+    /// units' and `kicker`), at time `t_s`.
+    pub(crate) fn decide(
+        &mut self,
+        t_s: f64,
+        kicker: Option<ActuatorState>,
+    ) -> Result<Outputs, RunError> {
         let cameras = self.cameras.as_ref();
         let frames = cameras.map(|c| c.frames()).unwrap_or_default();
-        let actuators = cameras.map(|c| c.actuator_state()).unwrap_or_default();
+        let mut actuators = cameras.map(|c| c.actuator_state()).unwrap_or_default();
+        actuators.extend(kicker);
         Ok(self.software.cycle(&Observation {
             t_s,
             frames: &frames,
@@ -289,7 +315,8 @@ impl Agent {
             ),
         };
         let latency = self.scenario.robot.timing.command_latency_s;
-        self.commands.push_back((t_s + latency, command));
+        let ball = self.ball_command(&out.actuators)?;
+        self.commands.push_back((t_s + latency, command, ball));
         if let Some(c) = &mut self.cameras {
             c.command(&out.actuators)?;
         }
@@ -316,6 +343,48 @@ impl Agent {
         Ok(())
     }
 
+    /// The kicker's and dribbler's part of the software's actuator commands, checked against
+    /// the robot's kicker: a kick without one, over its limit or negative is an error.
+    fn ball_command(&mut self, commands: &[ActuatorCommand]) -> Result<BallCommand, RunError> {
+        let mut ball = BallCommand::default();
+        for c in commands {
+            let (kick, rpm) = match *c {
+                ActuatorCommand::Kick {
+                    speed_mm_s,
+                    angle_rad,
+                } => (
+                    Some(Kick {
+                        speed_mm_s,
+                        angle_rad,
+                    }),
+                    None,
+                ),
+                ActuatorCommand::Dribble { rpm } => (None, Some(rpm)),
+                _ => continue,
+            };
+            let Some(spec) = &self.scenario.robot.kicker else {
+                return Err(RunError::Actuator(format!(
+                    "the robot commanded {c:?}, but it has no kicker and dribbler \
+                     ([robot.kicker])"
+                )));
+            };
+            if let Some(why) = kick.and_then(|k| k.problem(spec)) {
+                return Err(RunError::Actuator(why));
+            }
+            if let Some(rpm) = rpm {
+                if !(rpm.is_finite() && rpm >= 0.0) {
+                    return Err(RunError::Actuator(format!(
+                        "dribbler speed {rpm} rpm must be a finite number >= 0"
+                    )));
+                }
+                self.dribbler_rpm = rpm;
+            }
+            ball.kick = kick.or(ball.kick);
+        }
+        ball.dribbler_rpm = self.dribbler_rpm;
+        Ok(ball)
+    }
+
     /// The truth of the frame of vision's camera the software got this cycle, when kept.
     fn vision_truth(&self) -> Option<&omniloop_sim::render::TruthFrame> {
         let i = self.scenario.vision_sensor_index().ok()?;
@@ -338,16 +407,17 @@ impl Agent {
 
     /// When its next queued command is due, if one is.
     pub(crate) fn next_due_s(&self) -> Option<f64> {
-        self.commands.front().map(|&(due, _)| due)
+        self.commands.front().map(|&(due, _, _)| due)
     }
 
     /// Hands the drive every queued command due by `now_s` (within half a physics step).
     pub(crate) fn deliver_due(&mut self, world: &mut World, now_s: f64, half_step_s: f64) {
-        while let Some(&(due, command)) = self.commands.front() {
+        while let Some(&(due, command, ball)) = self.commands.front() {
             if due > now_s + half_step_s {
                 break;
             }
             world.set_command(self.body, command);
+            world.set_ball_command(self.body, ball);
             self.commands.pop_front();
         }
     }

@@ -341,11 +341,14 @@ impl Cameras {
             .collect()
     }
 
-    /// Passes the robot's actuator commands to the pan units.
+    /// Passes the robot's actuator commands to the pan units (the kicker's go to the world).
     pub fn command(&mut self, commands: &[ActuatorCommand]) -> Result<(), RunError> {
         for cmd in commands {
             let (ActuatorCommand::PanTo { sensor, .. } | ActuatorCommand::PanAt { sensor, .. }) =
-                cmd;
+                cmd
+            else {
+                continue;
+            };
             let unit = self
                 .cameras
                 .iter_mut()
@@ -360,6 +363,7 @@ impl Cameras {
             match *cmd {
                 ActuatorCommand::PanTo { pan_rad, .. } => unit.pan_to(pan_rad),
                 ActuatorCommand::PanAt { rate_rad_s, .. } => unit.pan_at(rate_rad_s),
+                _ => {}
             }
         }
         Ok(())

@@ -5,6 +5,7 @@
 //! experiment: an experiment drives it.
 
 pub mod agent;
+pub mod ball_record;
 pub mod cameras;
 pub mod column_calibration;
 pub mod error;
@@ -18,6 +19,7 @@ pub mod simulation;
 pub mod truth_files;
 
 pub use agent::{Agent, Truth};
+pub use ball_record::{BallOutput, BallRow, BallSummary};
 pub use error::RunError;
 pub use outcome::{GoalFigures, GoalOutcome};
 pub use record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};

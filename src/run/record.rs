@@ -161,6 +161,10 @@ pub struct Summary {
     /// A team's robots, a row each, in the scenario's order.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub robots: Option<Vec<RobotSummary>>,
+    /// With a ball: the game's figures (kicks, goals, outs, touches, possession, dribbles,
+    /// speeds), judged on the simulator's side.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub ball: Option<super::ball_record::BallSummary>,
     /// The experiment's own metrics (`turn_onset_mm`, `overshoot_mm` of E1, `places` of E2,
     /// ...), written as keys of the summary beside the others: each experiment's typed
     /// metrics as keys, read back as the type with `Metrics::of` (`crate::experiments`).

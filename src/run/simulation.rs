@@ -6,6 +6,7 @@
 //! and the same scenario and seed give the same run whatever the number of threads.
 
 use super::agent::{Agent, CameraSetup, SoftwareBuilder, Truth};
+use super::ball_record::{self, BallOutput, BallRow, BallSummary};
 use super::cameras::sensor_noise_seed;
 use super::error::RunError;
 use super::observer::{CycleView, ObserverHandle, RobotCycle};
@@ -69,6 +70,8 @@ pub struct RunOutput {
     /// A team's robots, each with its records (empty for a one-robot scenario, whose records
     /// are the fields above).
     pub robots: Vec<RobotOutput>,
+    /// With a ball: its state every cycle and the game's events.
+    pub ball: Option<BallOutput>,
 }
 
 /// What one robot of a team left behind.
@@ -103,6 +106,10 @@ pub struct Simulation {
     others: Vec<Pilot>,
     cycle: u64,
     other_paths: Vec<Vec<Point2<f64>>>,
+    /// With a ball: its state at the start of every cycle.
+    ball_rows: Vec<BallRow>,
+    /// Every robot body's name, in the world's order (scripted robots as `other_robots[k]`).
+    body_names: Vec<String>,
     options: RunOptions,
     /// A team's GPU, which traces every robot's frames of a cycle in one batch (dropped
     /// after the agents, which hold its clients).
@@ -189,9 +196,14 @@ impl Simulation {
         for o in &options.observers {
             o.with(|o| o.start(&world, &names));
         }
+        let body_names = (0..scenario.robot_bodies().len())
+            .map(|i| ball_record::robot_name(&names, i))
+            .collect();
         Ok(Self {
             scenario: scenario.clone(),
             world,
+            ball_rows: Vec::new(),
+            body_names,
             other_paths: vec![Vec::new(); others.len()],
             others,
             agents,
@@ -372,9 +384,9 @@ impl Simulation {
         self.first().last_odometry()
     }
 
-    /// The state of the robot's actuators (its pan units) now.
+    /// The state of the robot's actuators (its pan units, its kicker) now.
     pub fn actuator_state(&self) -> Vec<ActuatorState> {
-        self.first().actuator_state()
+        self.first().actuator_state(&self.world)
     }
 
     /// The second half of a control cycle: each robot's software decides on the frames of
@@ -383,10 +395,15 @@ impl Simulation {
     pub fn act(&mut self) -> Result<(), RunError> {
         let t = self.world.time_s();
         let team = self.agents.len();
+        let kickers: Vec<_> = (self.agents.iter())
+            .map(|a| a.kicker_state(&self.world))
+            .collect();
         let outputs: Vec<Result<Outputs, RunError>> = if team == 1 {
-            vec![self.agents[0].decide(t)]
+            vec![self.agents[0].decide(t, kickers[0].clone())]
         } else {
-            self.agents.par_iter_mut().map(|a| a.decide(t)).collect()
+            (self.agents.par_iter_mut().zip(kickers))
+                .map(|(a, k)| a.decide(t, k))
+                .collect()
         };
         for (a, out) in self.agents.iter_mut().zip(outputs) {
             let name = a.name().to_string();
@@ -394,6 +411,8 @@ impl Simulation {
                 .map_err(|e| in_robot(team, &name, e))?;
         }
         self.drive_others();
+        self.ball_rows
+            .extend(BallRow::of(&self.world, &self.body_names));
         self.observe();
 
         let dt = self.scenario.run.control_period_s;
@@ -474,6 +493,20 @@ impl Simulation {
         for a in &mut self.agents {
             a.record_final_state(&self.world);
         }
+        self.ball_rows
+            .extend(BallRow::of(&self.world, &self.body_names));
+    }
+
+    /// With a ball: its records so far.
+    fn ball_output(&self) -> Option<BallOutput> {
+        self.world.ball()?;
+        let names = &self.body_names;
+        Some(BallOutput {
+            rows: self.ball_rows.clone(),
+            events: (self.world.ball_events().iter())
+                .map(|e| ball_record::named_event(e, names))
+                .collect(),
+        })
     }
 
     /// The truth now: the robot's true pose and velocity, its contacts so far and whether
@@ -491,7 +524,9 @@ impl Simulation {
         }
         let summary = self.summary(wall_time_s);
         let team = self.scenario.is_team();
+        let ball = self.ball_output();
         let mut out = RunOutput {
+            ball,
             summary,
             map: None,
             trajectory: Vec::new(),
@@ -530,6 +565,7 @@ impl Simulation {
         let team = self.scenario.is_team();
         let first = self.first();
         RunOutput {
+            ball: self.ball_output(),
             summary: self.summary(wall_time_s),
             map: if team { None } else { first.software().map() },
             trajectory: if team {
@@ -606,6 +642,7 @@ impl Simulation {
             watchdog_fired: r.watchdog_fired,
             team: None,
             robots: None,
+            ball: BallSummary::of(&self.world, &self.body_names),
             experiment: serde_json::Map::new(),
         };
         if self.scenario.is_team() {

@@ -22,6 +22,7 @@ pub fn validate(s: &Scenario) -> Vec<Problem> {
     check_world(&mut c, &s.world);
     check_robot(&mut c, s);
     check_other_robots(&mut c, s);
+    check_ball(&mut c, s);
     check_goal(&mut c, s);
     check_software(&mut c, s);
     if let Some(g) = &s.goal {
@@ -162,12 +163,57 @@ fn check_robot(c: &mut Problems, s: &Scenario) {
             "missing: where the robot starts, e.g. start = { x_mm = 0.0, y_mm = 0.0 }",
         ),
     }
+    if let Some(k) = &rb.kicker {
+        let mut p = Problems::under("robot.kicker");
+        k.check(rb.radius_mm, &mut p);
+        c.extend(p);
+    }
     for (i, sensor) in rb.sensors.iter().enumerate() {
         check_sensor(c, &format!("robot.sensors[{i}]"), sensor);
         if rb.sensors[..i].iter().any(|o| o.name == sensor.name) {
             c.fail(
                 format!("robot.sensors[{i}].name"),
                 format!("sensor name {:?} is used twice", sensor.name),
+            );
+        }
+    }
+}
+
+/// `[world.ball]`: its figures; on the floor, clear of every solid and robot at the start.
+fn check_ball(c: &mut Problems, s: &Scenario) {
+    let Some(b) = &s.world.ball else {
+        return;
+    };
+    let mut p = Problems::under("world.ball");
+    b.check(&mut p);
+    c.extend(p);
+    let at = Point2::from(b.center_mm);
+    if !(at.x.is_finite() && at.y.is_finite() && b.radius_mm > 0.0) {
+        return;
+    }
+    let place = |what: &str| format!("({}, {}) mm is {what}", at.x, at.y);
+    if !in_floor(&s.world, at) {
+        c.fail("world.ball.center_mm", place("outside the floor region"));
+    }
+    if s.world
+        .solids()
+        .iter()
+        .any(|o| o.shape.distance_mm(at) < b.radius_mm)
+    {
+        c.fail(
+            "world.ball.center_mm",
+            place("inside a wall, cube, pillar or board"),
+        );
+    }
+    let names = s.robot_names();
+    for (i, body) in s.robot_bodies().iter().enumerate() {
+        let d = (at - Point2::from(body.start.translation.vector)).norm();
+        if d < body.radius_mm + b.radius_mm {
+            let name = names.get(i).cloned();
+            let name = name.unwrap_or_else(|| format!("other_robots[{}]", i - names.len()));
+            c.fail(
+                "world.ball.center_mm",
+                place(&format!("inside robot {name}")),
             );
         }
     }

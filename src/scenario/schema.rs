@@ -213,6 +213,9 @@ pub struct RobotSpec {
     /// When frames and commands arrive (`[robot.timing]`; default: at once, none lost).
     #[serde(default, skip_serializing_if = "TimingSpec::is_ideal")]
     pub timing: TimingSpec,
+    /// A kicker and a dribbler on a flat front (`[robot.kicker]`), to play the ball.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kicker: Option<omniloop_sim::KickerSpec>,
 }
 
 /// Latency and loss between the robot's software and its cameras and drive
@@ -273,6 +276,7 @@ impl Default for RobotSpec {
             sensors: Vec::new(),
             differential: None,
             timing: TimingSpec::default(),
+            kicker: None,
         }
     }
 }
@@ -419,6 +423,7 @@ impl Scenario {
                 rgb: o.rgb,
                 marking_rgb: None,
                 differential: None,
+                kicker: None,
             });
         }
         out
@@ -435,6 +440,7 @@ impl Scenario {
             rgb: self.robot.rgb,
             marking_rgb: self.robot.marking_rgb,
             differential: self.differential_drive(),
+            kicker: self.robot.kicker.clone(),
         }
     }
 
@@ -548,6 +554,7 @@ impl Scenario {
                 max_speed_mm_s: r.max_speed_mm_s,
                 accel_limit_mm_s2: r.accel_limit_mm_s2,
                 angular_accel_limit_rad_s2: r.angular_accel_limit_rad_s2,
+                max_kick_mm_s: r.kicker.as_ref().map(|k| k.max_kick_mm_s),
             },
             control_period_s: self.run.control_period_s,
             cameras: r.sensors.iter().map(|s| s.name.clone()).collect(),

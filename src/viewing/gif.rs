@@ -105,6 +105,10 @@ fn up_to(out: &RunOutput, n: usize) -> RunOutput {
                 map: None,
             })
             .collect(),
+        ball: out.ball.as_ref().map(|b| crate::run::BallOutput {
+            rows: b.rows[..n.min(b.rows.len())].to_vec(),
+            events: Vec::new(),
+        }),
     }
 }
 

@@ -1,11 +1,12 @@
 //! Scripted moves on dead reckoning: straight runs and turns on the spot, each ending at rest
-//! (`[control.script]`; E6's square of Fig. 8 and the tests of Fig. 10).
+//! (`[control.script]`; E6's square of Fig. 8 and the tests of Fig. 10), and the kicker's and
+//! dribbler's commands, so a scenario can play the ball before any robot can see it.
 
-use crate::boundary::BodyCommand;
-use crate::controller::{
-    ControlTable, Controller, ControllerEntry, Situation, no_problems, parses, settings,
-};
+use crate::boundary::{ActuatorCommand, BodyCommand};
+use crate::config::RobotConfig;
+use crate::controller::{ControlTable, Controller, ControllerEntry, Situation, parses, settings};
 use omniloop_control::wrap_pi;
+use omniloop_problem::{Problem, Problems};
 use serde::{Deserialize, Serialize};
 
 /// The registry's entry.
@@ -19,7 +20,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     }],
     needs_goal: false,
     stages: &[],
-    check_use: no_problems,
+    check_use: check_kicks,
     build: |c| {
         Ok(Box::new(Script {
             script: settings(c, "script")?,
@@ -28,9 +29,44 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
             period_s: c.control_period_s,
             index: 0,
             phase: None,
+            actuators: Vec::new(),
         }))
     },
 };
+
+/// Each kick of the script against the robot's kicker: it needs one, and a speed within its
+/// limit (not negative), an angle within 0 and 90 degrees.
+fn check_kicks(config: &RobotConfig) -> Vec<Problem> {
+    let Ok(script) = config.control.table::<ScriptConfig>("script") else {
+        return Vec::new();
+    };
+    let mut p = Problems::under("control.script");
+    for (i, m) in script.moves.iter().enumerate() {
+        let at = format!("moves[{i}]");
+        match (*m, config.body.max_kick_mm_s) {
+            (Move::Kick(_), None) => p.fail(at, "a kick needs a kicker: add [robot.kicker]"),
+            (Move::Kick(k), Some(limit)) => {
+                if !(k.speed_mm_s.is_finite() && (0.0..=limit).contains(&k.speed_mm_s)) {
+                    let why = format!("must be within 0 and the kicker's {limit} mm/s");
+                    p.fail(
+                        format!("{at}.kick.speed_mm_s"),
+                        format!("{why} (got {})", k.speed_mm_s),
+                    );
+                }
+                if !(k.angle_deg.is_finite() && (0.0..90.0).contains(&k.angle_deg)) {
+                    let why = format!("must be within 0 and 90 (got {})", k.angle_deg);
+                    p.fail(format!("{at}.kick.angle_deg"), why);
+                }
+            }
+            (Move::DribbleRpm(rpm), _) if !(rpm.is_finite() && rpm >= 0.0) => p.fail(
+                format!("{at}.dribble_rpm"),
+                format!("must be >= 0 (got {rpm})"),
+            ),
+            _ => {}
+        }
+    }
+    p.into_vec()
+}
 
 /// One move of a script.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -41,6 +77,22 @@ pub enum Move {
     /// Turn on the spot by this much (counter-clockwise positive), degrees:
     /// `{ turn_deg = -90.0 }`.
     TurnDeg(f64),
+    /// Spin the dribbler at this speed (0: off), at once: `{ dribble_rpm = 3000.0 }`.
+    DribbleRpm(f64),
+    /// Arm the kicker, at once (it fires when the ball is at the dribbler):
+    /// `{ kick = { speed_mm_s = 4000.0, angle_deg = 0.0 } }`.
+    Kick(KickMove),
+}
+
+/// A kick of a script.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KickMove {
+    /// Speed of the ball off the kicker, mm/s.
+    pub speed_mm_s: f64,
+    /// Angle above the floor, degrees (0: flat; above 0: a chip).
+    #[serde(default)]
+    pub angle_deg: f64,
 }
 
 /// A scripted drive (`[control.script]`), judged on dead reckoning.
@@ -87,9 +139,23 @@ pub struct Script {
     period_s: f64,
     index: usize,
     phase: Option<Phase>,
+    /// Actuator commands of the moves done this cycle.
+    actuators: Vec<ActuatorCommand>,
 }
 
 impl Script {
+    /// The actuator command of a move that is one, done at once.
+    fn actuator(m: Move) -> Option<ActuatorCommand> {
+        match m {
+            Move::DribbleRpm(rpm) => Some(ActuatorCommand::Dribble { rpm }),
+            Move::Kick(k) => Some(ActuatorCommand::Kick {
+                speed_mm_s: k.speed_mm_s,
+                angle_rad: k.angle_deg.to_radians(),
+            }),
+            Move::ForwardMm(_) | Move::TurnDeg(_) => None,
+        }
+    }
+
     /// The speed from which `accel` stops over `left` after one more period, capped at `top`.
     fn approach(left: f64, accel: f64, period_s: f64, top: f64) -> f64 {
         let at = accel * period_s;
@@ -105,6 +171,11 @@ impl Controller for Script {
             let Some(&m) = self.script.moves.get(self.index) else {
                 return BodyCommand::STOP;
             };
+            if let Some(a) = Self::actuator(m) {
+                self.actuators.push(a);
+                self.index += 1;
+                continue;
+            }
             match self.phase {
                 None => self.phase = Some(Phase::Moving(now)),
                 Some(Phase::Pausing(until)) => {
@@ -117,6 +188,7 @@ impl Controller for Script {
                 Some(Phase::Moving(start)) => {
                     let (left, top, accel, command): (f64, f64, f64, fn(f64) -> BodyCommand) =
                         match m {
+                            Move::DribbleRpm(_) | Move::Kick(_) => continue,
                             Move::ForwardMm(d) => {
                                 let (dx, dy) = (now[0] - start[0], now[1] - start[1]);
                                 let along = dx * start[2].cos() + dy * start[2].sin();
@@ -139,8 +211,8 @@ impl Controller for Script {
                             }
                         };
                     let done = match m {
-                        Move::ForwardMm(_) => left < 0.5,
                         Move::TurnDeg(_) => left < 0.05f64.to_radians(),
+                        _ => left < 0.5,
                     };
                     if done {
                         self.phase = Some(Phase::Pausing(s.t_s + self.script.pause_s));
@@ -148,11 +220,16 @@ impl Controller for Script {
                     }
                     let sign = match m {
                         Move::ForwardMm(d) | Move::TurnDeg(d) => d.signum(),
+                        _ => 1.0,
                     };
                     return command(sign * Self::approach(left, accel, self.period_s, top));
                 }
             }
         }
+    }
+
+    fn actuators(&mut self) -> Vec<ActuatorCommand> {
+        std::mem::take(&mut self.actuators)
     }
 
     fn step(&self) -> Option<usize> {

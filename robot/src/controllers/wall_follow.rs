@@ -237,6 +237,7 @@ mod tests {
             pose: None,
             odometry_pose: nalgebra::Isometry2::identity(),
             t_s: 0.0,
+            actuators: &[],
         })
     }
 
