@@ -9,6 +9,9 @@ use crate::kicker::{BallCommand, KickerSpec, body_distance};
 use crate::shapes::Solid;
 use nalgebra::{Isometry2, Point2, Vector2};
 
+/// A ball this close (mm) to a robot's body still touches it.
+const TOUCH_MM: f64 = 0.5;
+
 /// The ball and what the world knows of its play.
 pub(super) struct Play {
     pub(super) spec: BallSpec,
@@ -16,6 +19,9 @@ pub(super) struct Play {
     pub(super) hold: Option<Hold>,
     /// Per robot: until when its dribbler cannot catch the ball (after losing or kicking it).
     pub(super) no_catch_until_s: Vec<f64>,
+    /// Per robot: whether the ball touched its body at the last step (a touch is counted
+    /// when one begins).
+    touching: Vec<bool>,
     pub(super) referee: Referee,
 }
 
@@ -96,6 +102,7 @@ impl Play {
             spec: spec.clone(),
             hold: None,
             no_catch_until_s: vec![f64::NEG_INFINITY; robots],
+            touching: vec![false; robots],
             referee,
         }
     }
@@ -203,11 +210,12 @@ impl Play {
             let p = self.state.position_mm;
             let front = b.kicker.map(|k| k.front_mm);
             let (d, n_local) = body_distance(b.local(p), b.radius_mm, front);
+            let was = std::mem::replace(&mut self.touching[j], d < r + TOUCH_MM);
             if d >= r {
                 continue;
             }
             let n = b.pose.rotation * n_local;
-            if self.state.bounce(&self.spec, n, r - d, b.velocity_at(p)) {
+            if self.state.bounce(&self.spec, n, r - d, b.velocity_at(p)) && !was {
                 self.referee.event(BallEvent::Touch { t_s, robot: j });
             }
         }
