@@ -1,11 +1,16 @@
 //! The ball in the world against closed form: kicks from a robot's kicker, a chip's landing, a
 //! wall's bounce, the dribbler through a turn; and the shipped ball scenarios.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
+
+mod common;
+
+use common::{check_variant, cpu, omniloop, scenario, tmp};
 
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::VelocityCommand;
 use omniloop_sim::ball::GRAVITY_MM_S2;
 use omniloop_sim::{
-    BallCommand, BallEvent, BallSpec, Kick, KickerSpec, Layout, RobotBodySpec, Rgb, Wall, World,
+    BallCommand, BallEvent, BallSpec, Kick, KickerSpec, Layout, Rgb, RobotBodySpec, Wall, World,
 };
 
 const STEP_S: f64 = 0.002;
@@ -75,7 +80,10 @@ fn flat_kicks_from_a_kicker_rest_where_the_two_phase_model_says() {
         let d = (b.position_mm - start).norm();
         let took = t - t_kick.unwrap() + STEP_S;
         assert!((d - d0).abs() <= 0.02 * d0, "{v0}: {d} mm against {d0}");
-        assert!((took - t0).abs() <= 0.02 * t0, "{v0}: {took} s against {t0}");
+        assert!(
+            (took - t0).abs() <= 0.02 * t0,
+            "{v0}: {took} s against {t0}"
+        );
         let kicks: Vec<_> = (w.ball_events().iter())
             .filter(|e| matches!(e, BallEvent::Kick { .. }))
             .collect();
@@ -92,7 +100,10 @@ fn a_chip_lands_where_the_ballistic_flight_does_and_flies_over_a_robot() {
     let landing = speed * angle.cos() * 2.0 * speed * angle.sin() / GRAVITY_MM_S2;
     // A second robot 600 mm ahead, 150 mm tall: the ball is far above it by then.
     let layout = ball_at_front(Layout::default());
-    let robots = [striker(0.0, 0.0, 0.0), striker(700.0, 0.0, std::f64::consts::PI)];
+    let robots = [
+        striker(0.0, 0.0, 0.0),
+        striker(700.0, 0.0, std::f64::consts::PI),
+    ];
     let mut w = World::new(&layout, &robots, STEP_S).unwrap();
     let start = w.ball().unwrap().1.position_mm;
     kick(&mut w, speed, 45.0);
@@ -207,8 +218,7 @@ fn holds_through_a_turn(pull_mm_s2: f64) -> bool {
 }
 
 #[test]
-fn the_dribbler_keeps_the_ball_through_a_turn_at_one_metre_a_second_and_loses_it_above_its_pull()
-{
+fn the_dribbler_keeps_the_ball_through_a_turn_at_one_metre_a_second_and_loses_it_above_its_pull() {
     // 2 m/s^2 to the centre, plus omega^2 r = 4 * 96.5 mm back at the ball: 2.04 m/s^2.
     assert!(holds_through_a_turn(3000.0));
     assert!(!holds_through_a_turn(1500.0));
@@ -244,4 +254,98 @@ fn a_kicker_recharges_before_it_fires_again() {
         .filter(|e| matches!(e, BallEvent::Kick { .. }))
         .count();
     assert_eq!(kicks, 2);
+}
+
+#[test]
+fn ball_kick_scores_on_every_seed_and_its_events_name_the_kick_and_the_goal() {
+    for seed in 1..=10 {
+        let mut s = scenario("ball_kick.toml");
+        s.seed = seed;
+        let out = omniloop::run_scenario(&s, &cpu(), |_| {}, |_, _| {}).unwrap();
+        let ball = out.summary.ball.as_ref().expect("a ball table");
+        assert_eq!(ball.kicks, 1, "seed {seed}: {ball:?}");
+        assert_eq!(ball.goals.len(), 1, "seed {seed}: {ball:?}");
+        assert_eq!(ball.goals[0].goal, "+x");
+        assert_eq!(ball.goals[0].by.as_deref(), Some("robot"));
+        assert!(ball.longest_dribble_mm > 200.0 && ball.dribbled_too_far == 0);
+        let events = &out.ball.as_ref().unwrap().events;
+        let kinds: Vec<&str> = events.iter().filter_map(|e| e["event"].as_str()).collect();
+        let kick = kinds.iter().position(|k| *k == "kick").expect("a kick");
+        let goal = kinds.iter().position(|k| *k == "goal").expect("a goal");
+        assert!(kick < goal, "{kinds:?}");
+        assert_eq!(events[goal]["by"], "robot");
+    }
+}
+
+#[test]
+fn the_rollout_scenario_rests_where_the_closed_form_says_and_writes_its_files() {
+    let dir = tmp("ball_rollout");
+    omniloop([
+        "run",
+        common::scenario_path("ball_rollout.toml").to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--renderer",
+        "cpu",
+        "--quiet",
+    ]);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let end = summary["ball"]["final_mm"][0].as_f64().unwrap();
+    let (d0, _) = BallSpec::default().rest_after_kick(6500.0);
+    assert!((end - 96.5 - d0).abs() <= 0.02 * d0, "{end} against {d0}");
+    let csv = std::fs::read_to_string(dir.join("ball.csv")).unwrap();
+    assert!(csv.starts_with("t_s,x_mm,y_mm,z_mm,vx_mm_s,vy_mm_s,vz_mm_s,held_by\n"));
+    let events = std::fs::read_to_string(dir.join("events.jsonl")).unwrap();
+    assert!(events.contains("\"event\":\"kick\""), "{events}");
+    // 6.5 m/s is the limit, not over it.
+    assert_eq!(summary["ball"]["too_fast"], 0);
+}
+
+#[test]
+fn a_bad_ball_or_kick_is_named_with_its_place_in_the_file() {
+    let cases = [
+        (
+            "center_mm = [-300.0, -250.0]",
+            "center_mm = [-300.0, 2000.0]",
+            "world.ball.center_mm",
+            "outside the floor",
+        ),
+        (
+            "center_mm = [-300.0, -250.0]",
+            "center_mm = [-300.0, -380.0]",
+            "world.ball.center_mm",
+            "inside robot robot",
+        ),
+        (
+            "center_mm = [-300.0, -250.0]",
+            "center_mm = [-300.0, -250.0]\nrestitution = nan",
+            "world.ball.restitution",
+            "within 0 and 1",
+        ),
+        (
+            "speed_mm_s = 5000.0",
+            "speed_mm_s = 7000.0",
+            "control.script.moves[3].kick.speed_mm_s",
+            "6500",
+        ),
+        (
+            "speed_mm_s = 5000.0",
+            "speed_mm_s = -1.0",
+            "control.script.moves[3].kick.speed_mm_s",
+            "within 0",
+        ),
+        (
+            "front_mm = 75.0",
+            "front_mm = 95.0",
+            "robot.kicker.front_mm",
+            "radius",
+        ),
+    ];
+    for (k, (from, to, field, why)) in cases.into_iter().enumerate() {
+        let (code, err) = check_variant("ball_kick.toml", &format!("bad_ball_{k}"), from, to);
+        assert_eq!(code, Some(2), "{to}: {err}");
+        assert!(err.contains(field) && err.contains(why), "{to}: {err}");
+        assert!(err.contains("broken.toml:"), "{to}: no location in {err}");
+    }
 }

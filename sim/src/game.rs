@@ -22,6 +22,18 @@ pub enum GoalSide {
     NegX,
 }
 
+/// Why a dribbler let the ball go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Release {
+    /// The robot kicked it.
+    Kick,
+    /// Holding it asked for more pull than the dribbler has (turning or braking too hard).
+    Pull,
+    /// The dribbler stopped.
+    DribblerOff,
+}
+
 /// One event of the game. Robots are the world's robot indices.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(tag = "event", rename_all = "snake_case")]
@@ -51,14 +63,16 @@ pub enum BallEvent {
         /// Who.
         robot: usize,
     },
-    /// A robot's dribbler lost the ball (asked to pull harder than it can, or stopped).
-    Lost {
+    /// A robot's dribbler let the ball go.
+    Released {
         /// When, s.
         t_s: f64,
         /// Who.
         robot: usize,
-        /// How far it dribbled the ball, mm.
+        /// How far the robot carried the ball from where it caught it, mm.
         dribbled_mm: f64,
+        /// Why.
+        cause: Release,
     },
     /// A goal.
     Goal {
@@ -165,7 +179,7 @@ impl Referee {
                 self.touched(robot);
             }
             BallEvent::Captured { robot, .. } => self.touched(robot),
-            BallEvent::Lost { dribbled_mm, .. } => {
+            BallEvent::Released { dribbled_mm, .. } => {
                 self.figures.longest_dribble_mm = self.figures.longest_dribble_mm.max(dribbled_mm)
             }
             BallEvent::DribbledTooFar { .. } => self.figures.dribbled_too_far += 1,

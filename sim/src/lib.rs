@@ -24,7 +24,7 @@ pub use color::Rgb;
 pub use corridor::Corridor;
 pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use floor_rect::FloorRect;
-pub use game::{BallEvent, BallFigures, GoalSide};
+pub use game::{BallEvent, BallFigures, GoalSide, Release};
 pub use kicker::{BallCommand, Kick, KickerSpec};
 pub use layout::{Board, Cube, FieldSpec, Layout, Pillar, Wall};
 pub use reachability::{Reachability, Target, reachability};

@@ -207,8 +207,11 @@ fn check_ball(c: &mut Problems, s: &Scenario) {
     }
     let names = s.robot_names();
     for (i, body) in s.robot_bodies().iter().enumerate() {
-        let d = (at - Point2::from(body.start.translation.vector)).norm();
-        if d < body.radius_mm + b.radius_mm {
+        let local = body.start.inverse_transform_point(&at);
+        let front = body.kicker.map(|k| k.front_mm);
+        let (d, _) = omniloop_sim::kicker::body_distance(local, body.radius_mm, front);
+        // Touching (at its front, where a kicker plays it) is allowed; overlapping is not.
+        if d < b.radius_mm - 1e-6 {
             let name = names.get(i).cloned();
             let name = name.unwrap_or_else(|| format!("other_robots[{}]", i - names.len()));
             c.fail(

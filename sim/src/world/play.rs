@@ -4,7 +4,7 @@
 
 use super::World;
 use crate::ball::{BallSpec, BallState};
-use crate::game::{BallEvent, MAX_DRIBBLE_MM, Referee};
+use crate::game::{BallEvent, MAX_DRIBBLE_MM, Referee, Release};
 use crate::kicker::{BallCommand, KickerSpec, body_distance};
 use crate::shapes::Solid;
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -150,10 +150,15 @@ impl Play {
         let accel = b.pose.rotation.inverse() * ((v - h.front_velocity_mm_s) / dt_s);
         let robot = Point2::from(b.pose.translation.vector);
         let dribbled = (robot - h.caught_at).norm();
-        if !(b.command.dribbler_rpm > 0.0 && k.can_hold(b.command.dribbler_rpm, accel)) {
+        let rpm = b.command.dribbler_rpm;
+        if !(rpm > 0.0 && k.can_hold(rpm, accel)) {
             self.state.velocity_mm_s = h.front_velocity_mm_s;
             self.state.roll_below_mm_s = self.spec.roll_fraction * v.norm();
-            self.release(t_s, &k, dribbled);
+            let cause = match rpm > 0.0 {
+                true => Release::Pull,
+                false => Release::DribblerOff,
+            };
+            self.release(t_s, &k, dribbled, cause);
             return false;
         }
         self.state.position_mm = p;
@@ -171,14 +176,15 @@ impl Play {
         true
     }
 
-    /// The holder lets the ball go (lost or kicked): it cannot catch it again for a while.
-    fn release(&mut self, t_s: f64, k: &KickerSpec, dribbled_mm: f64) {
+    /// The holder lets the ball go: it cannot catch it again for a while.
+    fn release(&mut self, t_s: f64, k: &KickerSpec, dribbled_mm: f64, cause: Release) {
         if let Some(h) = self.hold.take() {
             self.no_catch_until_s[h.robot] = t_s + k.regrab_s;
-            (self.referee).event(BallEvent::Lost {
+            (self.referee).event(BallEvent::Released {
                 t_s,
                 robot: h.robot,
                 dribbled_mm,
+                cause,
             });
         }
     }
@@ -259,7 +265,7 @@ impl Play {
             let v = b.velocity_at(p) + heading * (speed * c);
             let robot = Point2::from(b.pose.translation.vector);
             let dribbled = self.hold.map_or(0.0, |h| (robot - h.caught_at).norm());
-            self.release(t_s, &k, dribbled);
+            self.release(t_s, &k, dribbled, Release::Kick);
             self.no_catch_until_s[j] = t_s + k.regrab_s;
             self.state.launch(&self.spec, v, speed * s);
             self.referee.event(BallEvent::Kick {
