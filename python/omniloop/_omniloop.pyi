@@ -17,14 +17,14 @@ import numpy as np
 import numpy.typing as npt
 from typing_extensions import Self, TypeAlias
 
-from .types import FreeSpace, PanAt, PanTo, RobotInfo, Truth, TruthFrame
+from .types import Dribble, FreeSpace, Kick, PanAt, PanTo, RobotInfo, Truth, TruthFrame
 
 _Path: TypeAlias = Union[str, os.PathLike[str]]
 # One robot's command: `(vx_mm_s, vy_mm_s, omega_rad_s)` or `(v_mm_s, omega_rad_s)`.
 _Command: TypeAlias = Union[Sequence[float], npt.NDArray[Any]]
 # One robot's pose estimate: `(x_mm, y_mm, theta_rad)`.
 _Estimate: TypeAlias = Union[Sequence[float], npt.NDArray[Any]]
-_Actuators: TypeAlias = Sequence[Union[PanTo, PanAt]]
+_Actuators: TypeAlias = Sequence[Union[PanTo, PanAt, Kick, Dribble]]
 _Columns: TypeAlias = dict[str, npt.NDArray[np.float64]]
 
 __all__ = [
@@ -212,6 +212,10 @@ class Observation:
         """Camera name -> pan angle, rad, for cameras on pan units."""
 
     @property
+    def ball_in_dribbler(self) -> bool | None:
+        """The dribbler's light barrier: whether it sees the ball (`None` without a kicker)."""
+
+    @property
     def done(self) -> bool:
         """Whether the run is over (time up, or the goal reached where the run stops there)."""
 
@@ -275,7 +279,10 @@ class Simulation:
         """One control cycle. The one robot driven by Python takes `command`: `(vx_mm_s,
         vy_mm_s, omega_rad_s)` in the body frame (x forward, y left; a differential robot takes
         `(v_mm_s, omega_rad_s)`), `actuators` an optional list of pan commands (`{"sensor":
-        NAME, "pan_rad": A}` or `{"sensor": NAME, "rate_rad_s": W}`), and `estimate` an
+        NAME, "pan_rad": A}` or `{"sensor": NAME, "rate_rad_s": W}`) and, for a robot with a
+        kicker, kicks (`{"kick_mm_s": S, "angle_rad": A}`: armed until the ball is at the
+        dribbler; at most the kicker's limit, `ValueError` above it or below 0) and the
+        dribbler's speed (`{"dribbler_rpm": R}`), and `estimate` an
         optional `(x_mm, y_mm, theta_rad)` recorded as the robot's own estimate; with
         `robot="builtin"` no command is given. A team takes each as a dict by robot name,
         holding every robot Python drives. Returns the next observation (a team's: a dict).
@@ -285,8 +292,16 @@ class Simulation:
     def truth(self) -> Truth | Any:
         """The truth now (the simulator's side, never part of an observation): `t_s`, `x_mm`,
         `y_mm`, `theta_rad`, `vx_mm_s`, `vy_mm_s` (world frame), `omega_rad_s`, `contacts` so
-        far, `reached_goal`, `targets_reached` (with waypoints); a team's: a dict of these by
-        robot name."""
+        far, `reached_goal`, `targets_reached` (with waypoints), and with a ball `ball` (`x_mm`,
+        `y_mm`, `z_mm`, `vx_mm_s`, `vy_mm_s`, `vz_mm_s`) and `ball_in_dribbler`; a team's: a dict
+        of these by robot name."""
+
+    def place_ball(
+        self, x_mm: float, y_mm: float, vx_mm_s: float = 0.0, vy_mm_s: float = 0.0
+    ) -> None:
+        """Puts the ball at `(x_mm, y_mm)` on the floor, going at `(vx_mm_s, vy_mm_s)` (an
+        experimenter placing or rolling it; a dribbler holding it lets go). Raises `ValueError`
+        without a ball, off the floor or with a number not finite."""
 
     def truth_frames(self, robot: str | None = None) -> dict[str, TruthFrame]:
         """The truth beside each frame `robot`'s software got in the last cycle (default: the

@@ -14,9 +14,12 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "Ball",
     "Differential",
+    "Dribble",
     "FreeSpace",
     "Goal",
+    "Kick",
     "LegendEntry",
     "OdometryErrors",
     "PanAt",
@@ -29,7 +32,26 @@ __all__ = [
 ]
 
 
-class Truth(TypedDict):
+class Ball(TypedDict):
+    """The ball now (``Simulation.truth()["ball"]``): the simulator's side."""
+
+    x_mm: float
+    y_mm: float
+    #: Height of its centre above the floor (its radius on the floor).
+    z_mm: float
+    vx_mm_s: float
+    vy_mm_s: float
+    vz_mm_s: float
+
+
+class _BallKeys(TypedDict, total=False):
+    #: With a ball: the ball.
+    ball: Ball
+    #: With a ball: whether it is at this robot's dribbler, where its light barrier sees it.
+    ball_in_dribbler: bool
+
+
+class Truth(_BallKeys):
     """The truth of one robot now (``Simulation.truth()``): the simulator's side."""
 
     t_s: float
@@ -159,3 +181,21 @@ class PanAt(TypedDict):
 
     sensor: str
     rate_rad_s: float
+
+
+class _KickAngle(TypedDict, total=False):
+    angle_rad: float
+
+
+class Kick(_KickAngle):
+    """A kick (``Simulation.step``): armed until the ball is at the dribbler, then fired once at
+    ``kick_mm_s`` (at most the kicker's limit; 0 disarms), ``angle_rad`` above the floor (0 a
+    flat kick, above 0 a chip)."""
+
+    kick_mm_s: float
+
+
+class Dribble(TypedDict):
+    """The dribbler's speed (``Simulation.step``), rpm (0: off), until told otherwise."""
+
+    dribbler_rpm: float

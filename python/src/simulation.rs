@@ -11,7 +11,7 @@ use crate::errors::{RunFinishedError, run_error};
 use crate::freespace::PyFreeSpaceDetector;
 use crate::scenario::PyScenario;
 use crate::truth::truth_frame_dict;
-use nalgebra::{Isometry2, Vector2};
+use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop::control::DeadReckoning;
 use omniloop::robot::perception::FreeSpaceStage;
 use omniloop::robot::{ActuatorCommand, ActuatorState, BodyCommand, Remote, RemoteHandle};
@@ -139,6 +139,8 @@ struct Member {
     differential: bool,
     pan_sensors: Vec<String>,
     sensors: Vec<String>,
+    /// Its kicker and dribbler, when it has them.
+    kicker: Option<omniloop_sim::KickerSpec>,
 }
 
 /// What a run traces beyond what the robots' software reads.
@@ -220,6 +222,7 @@ impl State {
                     .map(|s| s.name.clone())
                     .collect(),
                 sensors: m.robot.sensors.iter().map(|s| s.name.clone()).collect(),
+                kicker: m.robot.kicker,
             })
             .collect();
         Ok(Self {
@@ -275,6 +278,11 @@ impl State {
     /// The session.
     pub fn session(&self) -> &Session {
         &self.session
+    }
+
+    /// The session, to change the world between steps.
+    pub fn session_mut(&mut self) -> &mut Session {
+        &mut self.session
     }
 
     /// The seed of this run.
@@ -382,19 +390,26 @@ impl State {
     }
 
     /// Pan commands: a list of dicts `{"sensor": NAME, "pan_rad": A}` (pan toward A) or
-    /// `{"sensor": NAME, "rate_rad_s": W}` (pan at W until told otherwise).
+    /// `{"sensor": NAME, "rate_rad_s": W}` (pan at W until told otherwise); the kicker's and
+    /// dribbler's: `{"kick_mm_s": S, "angle_rad": A}` (a kick, armed until it fires; `angle_rad`
+    /// optional, 0 flat) and `{"dribbler_rpm": R}`.
     fn actuator_commands(
         &self,
         k: usize,
         list: &Bound<'_, PyAny>,
     ) -> PyResult<Vec<ActuatorCommand>> {
         let member = &self.members[k];
-        let shape = "actuators must be a list of dicts {\"sensor\": NAME, \"pan_rad\": A} or \
-                     {\"sensor\": NAME, \"rate_rad_s\": W}";
+        let shape = "actuators must be a list of dicts {\"sensor\": NAME, \"pan_rad\": A}, \
+                     {\"sensor\": NAME, \"rate_rad_s\": W}, {\"kick_mm_s\": S, \"angle_rad\": A} \
+                     or {\"dribbler_rpm\": R}";
         let items: Vec<Bound<'_, PyDict>> =
             list.extract().map_err(|_| PyValueError::new_err(shape))?;
         let mut out = Vec::with_capacity(items.len());
         for item in items {
+            if let Some(c) = ball_command(member, &item, shape)? {
+                out.push(c);
+                continue;
+            }
             let sensor: String = item
                 .get_item("sensor")?
                 .ok_or_else(|| PyValueError::new_err(shape))?
@@ -429,6 +444,49 @@ impl State {
         }
         Ok(out)
     }
+}
+
+/// A kicker's or dribbler's command of `item`, checked against the robot's kicker; `None` when
+/// `item` is no such command.
+fn ball_command(
+    member: &Member,
+    item: &Bound<'_, PyDict>,
+    shape: &str,
+) -> PyResult<Option<ActuatorCommand>> {
+    let number = |key: &str| -> PyResult<Option<f64>> {
+        item.get_item(key)?
+            .map(|v| v.extract::<f64>().map_err(|_| PyValueError::new_err(shape.to_string())))
+            .transpose()
+    };
+    let (kick, rpm) = (number("kick_mm_s")?, number("dribbler_rpm")?);
+    if kick.is_none() && rpm.is_none() {
+        return Ok(None);
+    }
+    let Some(spec) = &member.kicker else {
+        return Err(PyValueError::new_err(format!(
+            "actuators: robot {:?} has no kicker and dribbler ([robot.kicker])",
+            member.name
+        )));
+    };
+    if let Some(rpm) = rpm {
+        if !(rpm.is_finite() && rpm >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "actuators: dribbler_rpm is {rpm}: it must be a finite number >= 0"
+            )));
+        }
+        return Ok(Some(ActuatorCommand::Dribble { rpm }));
+    }
+    let kick = omniloop_sim::Kick {
+        speed_mm_s: kick.unwrap_or_default(),
+        angle_rad: number("angle_rad")?.unwrap_or(0.0),
+    };
+    if let Some(why) = kick.problem(spec) {
+        return Err(PyValueError::new_err(format!("actuators: {why}")));
+    }
+    Ok(Some(ActuatorCommand::Kick {
+        speed_mm_s: kick.speed_mm_s,
+        angle_rad: kick.angle_rad,
+    }))
 }
 
 /// What the wheel encoders measured over the last period, with the scenario's errors.
@@ -667,6 +725,17 @@ pub fn truth_dict<'py>(py: Python<'py>, t: &Truth) -> PyResult<Bound<'py, PyDict
     d.set_item("contacts", t.contacts)?;
     d.set_item("reached_goal", t.reached_goal)?;
     d.set_item("targets_reached", t.targets_reached)?;
+    if let Some(b) = &t.ball {
+        let ball = PyDict::new(py);
+        ball.set_item("x_mm", b.position_mm.x)?;
+        ball.set_item("y_mm", b.position_mm.y)?;
+        ball.set_item("z_mm", b.height_mm)?;
+        ball.set_item("vx_mm_s", b.velocity_mm_s.x)?;
+        ball.set_item("vy_mm_s", b.velocity_mm_s.y)?;
+        ball.set_item("vz_mm_s", b.vz_mm_s)?;
+        d.set_item("ball", ball)?;
+        d.set_item("ball_in_dribbler", t.ball_in_dribbler)?;
+    }
     Ok(d)
 }
 
@@ -900,10 +969,22 @@ impl PySimulation {
         observations(py, &self.lock())
     }
 
+    /// Puts the ball at `(x_mm, y_mm)` on the floor, going at `(vx_mm_s, vy_mm_s)` (an
+    /// experimenter placing or rolling it; a dribbler holding it lets go). Raises `ValueError`
+    /// without a ball, off the floor or with a number not finite.
+    #[pyo3(signature = (x_mm, y_mm, vx_mm_s = 0.0, vy_mm_s = 0.0))]
+    fn place_ball(&self, x_mm: f64, y_mm: f64, vx_mm_s: f64, vy_mm_s: f64) -> PyResult<()> {
+        let mut state = self.lock();
+        let sim = state.session_mut().simulation_mut();
+        sim.place_ball(Point2::new(x_mm, y_mm), Vector2::new(vx_mm_s, vy_mm_s))
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
     /// The truth now (the simulator's side, never part of an observation): `t_s`, `x_mm`,
     /// `y_mm`, `theta_rad`, `vx_mm_s`, `vy_mm_s` (world frame), `omega_rad_s`, `contacts` so
-    /// far, `reached_goal`, `targets_reached` (with waypoints); a team's: a dict of these by
-    /// robot name.
+    /// far, `reached_goal`, `targets_reached` (with waypoints), and with a ball `ball` (`x_mm`,
+    /// `y_mm`, `z_mm`, `vx_mm_s`, `vy_mm_s`, `vz_mm_s`) and `ball_in_dribbler`; a team's: a dict
+    /// of these by robot name.
     fn truth<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let state = self.lock();
         per_robot(py, &state, |k| {

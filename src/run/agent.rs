@@ -519,6 +519,8 @@ impl Agent {
             contacts: world.stats(self.body).contacts,
             reached_goal: self.reached_goal(),
             targets_reached: self.truth.targets_reached(),
+            ball: world.ball().map(|(_, b)| b),
+            ball_in_dribbler: world.light_barrier(self.body),
         }
     }
 
@@ -618,6 +620,10 @@ pub struct Truth {
     pub reached_goal: bool,
     /// How many of the goal's targets (waypoints, then the goal) it has reached.
     pub targets_reached: Option<usize>,
+    /// The ball, when there is one.
+    pub ball: Option<omniloop_sim::BallState>,
+    /// Whether the ball is at its dribbler, where its light barrier sees it.
+    pub ball_in_dribbler: bool,
 }
 
 /// The calibrations of the cameras the robot's vision uses: the scenario's file, or the

@@ -312,6 +312,30 @@ impl Simulation {
         }
     }
 
+    /// Puts the ball at `position_mm` on the floor going at `velocity_mm_s` (an experimenter
+    /// placing it; a dribbler holding it lets go): an error without a ball, or off the floor.
+    pub fn place_ball(
+        &mut self,
+        position_mm: Point2<f64>,
+        velocity_mm_s: Vector2<f64>,
+    ) -> Result<(), RunError> {
+        let finite = position_mm.iter().chain(velocity_mm_s.iter()).all(|v| v.is_finite());
+        let why = match self.world.ball() {
+            None => Some("the scenario has no ball ([world.ball])".to_string()),
+            Some(_) if !finite => Some("place and velocity must be finite".to_string()),
+            Some(_) if !self.world.layout().is_floor(position_mm) => Some(format!(
+                "({}, {}) mm is outside the floor region",
+                position_mm.x, position_mm.y
+            )),
+            Some(_) => None,
+        };
+        if let Some(why) = why {
+            return Err(RunError::Actuator(format!("placing the ball: {why}")));
+        }
+        self.world.place_ball(position_mm, velocity_mm_s);
+        Ok(())
+    }
+
     /// Puts the robot under test at `pose`, at rest (an experimenter carrying it there).
     pub fn place_robot(&mut self, pose: Isometry2<f64>) {
         self.world.place_robot(0, pose);

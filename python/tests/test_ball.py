@@ -1,0 +1,85 @@
+"""The ball from Python: a kick through `Simulation.step`'s actuators, the light barrier in the
+observation, the ball in the truth, placing it, refused kicks; the Gymnasium and PettingZoo
+checks on a scenario with a ball."""
+
+import math
+
+import pytest
+
+import omniloop
+from conftest import SCENARIOS
+
+
+@pytest.fixture(scope="module")
+def rollout() -> omniloop.Scenario:
+    """A robot with a kicker, the ball at its front, an open floor; no camera."""
+    return omniloop.Scenario.load(SCENARIOS / "ball_rollout.toml")
+
+
+def test_a_kick_from_python_sends_the_ball_off_at_its_speed(rollout):
+    sim = omniloop.Simulation(rollout)
+    obs = sim.reset(seed=1)
+    assert obs.ball_in_dribbler is True
+    truth = sim.truth()
+    assert truth["ball"]["vx_mm_s"] == 0.0 and truth["ball_in_dribbler"] is True
+    obs = sim.step((0.0, 0.0, 0.0), actuators=[{"kick_mm_s": 3000.0}])
+    ball = sim.truth()["ball"]
+    # One 40 ms cycle after the kick: sliding at 3.9 m/s^2 from 3 m/s.
+    assert ball["vx_mm_s"] == pytest.approx(3000.0 - 3900.0 * 0.04, abs=3900.0 * 0.0021)
+    assert abs(ball["vy_mm_s"]) < 1e-9
+    assert obs.ball_in_dribbler is False
+    sim.step((0.0, 0.0, 0.0))
+    assert sim.truth()["ball"]["x_mm"] > 96.5 + 100.0
+
+
+def test_a_chip_flies(rollout):
+    sim = omniloop.Simulation(rollout)
+    sim.reset(seed=1)
+    sim.step((0.0, 0.0, 0.0), actuators=[{"kick_mm_s": 4000.0, "angle_rad": math.radians(45)}])
+    ball = sim.truth()["ball"]
+    assert ball["z_mm"] > 21.5 + 50.0 and ball["vz_mm_s"] > 0.0
+
+
+def test_refused_kicks_and_places_raise_value_error(rollout):
+    sim = omniloop.Simulation(rollout)
+    sim.reset(seed=1)
+    with pytest.raises(ValueError, match="limit"):
+        sim.step((0.0, 0.0, 0.0), actuators=[{"kick_mm_s": 7000.0}])
+    with pytest.raises(ValueError, match="kick speed"):
+        sim.step((0.0, 0.0, 0.0), actuators=[{"kick_mm_s": -1.0}])
+    with pytest.raises(ValueError, match="dribbler_rpm"):
+        sim.step((0.0, 0.0, 0.0), actuators=[{"dribbler_rpm": float("nan")}])
+    with pytest.raises(ValueError, match="finite"):
+        sim.place_ball(float("nan"), 0.0)
+    sim.place_ball(500.0, 200.0, vx_mm_s=-100.0)
+    ball = sim.truth()["ball"]
+    assert (ball["x_mm"], ball["y_mm"], ball["vx_mm_s"]) == (500.0, 200.0, -100.0)
+
+
+def test_a_robot_without_a_kicker_cannot_kick(smoke):
+    sim = omniloop.Simulation(smoke)
+    obs = sim.reset(seed=1)
+    assert obs.ball_in_dribbler is None
+    with pytest.raises(ValueError, match="no kicker"):
+        sim.step((0.0, 0.0, 0.0), actuators=[{"kick_mm_s": 1000.0}])
+    with pytest.raises(ValueError, match="no ball"):
+        sim.place_ball(0.0, 0.0)
+
+
+def test_gymnasium_and_pettingzoo_checks_pass_with_a_ball():
+    gymnasium = pytest.importorskip("gymnasium")
+    from gymnasium.utils.env_checker import check_env
+
+    import omniloop.gym
+
+    scenario = omniloop.Scenario.load(SCENARIOS / "ball_kick.toml")
+    env = omniloop.gym.OmniloopEnv(scenario)
+    check_env(env, skip_render_check=True)
+    assert gymnasium is not None
+    pytest.importorskip("pettingzoo")
+    from pettingzoo.test import parallel_api_test
+
+    import omniloop.pettingzoo
+
+    teams = omniloop.Scenario.load(SCENARIOS / "ssl_teams_ball.toml")
+    parallel_api_test(omniloop.pettingzoo.parallel_env(teams), num_cycles=3)
