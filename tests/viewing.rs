@@ -279,3 +279,41 @@ fn e1_served_live_reaches_a_foxglove_client_a_pose_a_cycle() {
         );
     }
 }
+
+#[test]
+fn the_ball_and_the_scripted_robots_are_moving_entities_in_the_mcap() {
+    use foxglove::messages::SceneUpdate;
+    let dir = tmp("mcap_ball");
+    let file = scenario_path("ball_kick.toml").display().to_string();
+    let out = dir.display().to_string();
+    omniloop(["run", &file, "--out", &out, "--mcap", "-q"]);
+    let bytes = std::fs::read(dir.join("run.mcap")).unwrap();
+    let mut moving = Vec::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.topic == "/truth/moving" {
+            moving.push(SceneUpdate::decode(&m.data[..]).unwrap());
+        }
+    }
+    let csv = std::fs::read_to_string(dir.join("ball.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = (csv.lines().skip(1))
+        .map(|l| l.split(',').take(3).map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // A message a cycle (ball.csv has the final state besides), the ball where ball.csv has it.
+    assert_eq!(moving.len() + 1, rows.len());
+    for (k, update) in moving.iter().enumerate().step_by(25) {
+        let sphere = &update.entities[0].spheres[0];
+        let p = sphere.pose.as_ref().unwrap().position.as_ref().unwrap();
+        assert!((p.x * 1000.0 - rows[k][1]).abs() < 1e-6, "cycle {k}");
+        assert!((p.y * 1000.0 - rows[k][2]).abs() < 1e-6, "cycle {k}");
+        assert!((sphere.size.as_ref().unwrap().x - 0.043).abs() < 1e-9);
+    }
+    // E1 has neither: no such channel (its other files stay as they were).
+    let e1 = tmp("mcap_no_ball");
+    let e1_bytes = record(&e1);
+    let topics: Vec<String> = mcap::MessageStream::new(&e1_bytes)
+        .unwrap()
+        .map(|m| m.unwrap().channel.topic.clone())
+        .collect();
+    assert!(!topics.iter().any(|t| t == "/truth/moving"));
+}

@@ -455,7 +455,10 @@ fn ball_command(
 ) -> PyResult<Option<ActuatorCommand>> {
     let number = |key: &str| -> PyResult<Option<f64>> {
         item.get_item(key)?
-            .map(|v| v.extract::<f64>().map_err(|_| PyValueError::new_err(shape.to_string())))
+            .map(|v| {
+                v.extract::<f64>()
+                    .map_err(|_| PyValueError::new_err(shape.to_string()))
+            })
             .transpose()
     };
     let (kick, rpm) = (number("kick_mm_s")?, number("dribbler_rpm")?);

@@ -16,6 +16,10 @@ pub struct CycleView<'a> {
     pub cycle: u64,
     /// Every robot with software: the one robot, or a team's in the scenario's order.
     pub robots: &'a [RobotCycle<'a>],
+    /// The ball's true state and its description, when there is a ball.
+    pub ball: Option<(&'a super::BallRow, &'a omniloop_sim::BallSpec)>,
+    /// The scripted robots' (`[[other_robots]]`) bodies where they are.
+    pub others: &'a [omniloop_sim::Solid],
 }
 
 /// One robot's control cycle.

@@ -319,7 +319,10 @@ impl Simulation {
         position_mm: Point2<f64>,
         velocity_mm_s: Vector2<f64>,
     ) -> Result<(), RunError> {
-        let finite = position_mm.iter().chain(velocity_mm_s.iter()).all(|v| v.is_finite());
+        let finite = position_mm
+            .iter()
+            .chain(velocity_mm_s.iter())
+            .all(|v| v.is_finite());
         let why = match self.world.ball() {
             None => Some("the scenario has no ball ([world.ball])".to_string()),
             Some(_) if !finite => Some("place and velocity must be finite".to_string()),
@@ -503,9 +506,15 @@ impl Simulation {
                 floor: a.floor_scores().last().and_then(Option::as_ref),
             });
         }
+        let solids = self.world.robot_solids(None);
         let view = CycleView {
             cycle: self.cycle,
             robots: &robots,
+            ball: self
+                .ball_rows
+                .last()
+                .zip(self.world.ball().map(|(spec, _)| spec)),
+            others: &solids[self.agents.len().min(solids.len())..],
         };
         for o in &self.options.observers {
             o.with(|o| o.cycle(&view));

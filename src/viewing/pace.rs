@@ -60,6 +60,8 @@ mod tests {
             let view = CycleView {
                 cycle: cycle as u64,
                 robots: &robots,
+                ball: None,
+                others: &[],
             };
             pace.cycle(&view);
         }

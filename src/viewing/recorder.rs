@@ -2,7 +2,7 @@
 //! MCAP file, a live WebSocket server) on the same context gets them. Message times are the
 //! simulation's, from 0 at the run's start.
 
-use super::scene::{free_space, path, pose_in, stamp, transform, world_scene};
+use super::scene::{free_space, moving, path, pose_in, stamp, transform, world_scene};
 use crate::run::observer::CycleView;
 use foxglove::messages::{CompressedImage, FrameTransform, PoseInFrame, RawImage, SceneUpdate};
 use foxglove::{Channel, ChannelBuilder, Context, PartialMetadata, RawChannel};
@@ -20,11 +20,14 @@ use std::sync::Arc;
 /// `/truth/camera/NAME/depth` (16UC1, mm) and `/truth/camera/NAME/labels` (rgb8, the legend's
 /// colours) with the legend on `/truth/legend` (a team's robots each under its name:
 /// `/ROBOT/camera/NAME`, `/ROBOT/truth/pose`, ..., in frames `ROBOT/truth/base_link`,
-/// `ROBOT/estimate/base_link`); and `/world`, `/summary`.
+/// `ROBOT/estimate/base_link`); and `/world`, `/summary`, and where things move that have no
+/// software (the ball, the scripted robots) `/truth/moving`.
 pub struct Recorder {
     ctx: Arc<Context>,
     robots: Vec<RobotChannels>,
     world: Arc<Channel<SceneUpdate>>,
+    /// The ball and the scripted robots, made at their first cycle.
+    moving: Option<Channel<SceneUpdate>>,
     summary: Arc<RawChannel>,
     /// Why a message could not be made, the first time (a frame that did not encode).
     pub problem: Option<String>,
@@ -127,6 +130,7 @@ impl Recorder {
                 .map(|r| RobotChannels::new(ctx, r))
                 .collect::<Result<_, _>>()?,
             world: Arc::new(ChannelBuilder::new("/world").context(ctx).build()),
+            moving: None,
             summary: json(ctx, "/summary")?,
             problem: None,
         })
@@ -242,6 +246,14 @@ impl Recorder {
             }
             self.robots[k].log(robot);
         }
+        if c.ball.is_some() || !c.others.is_empty() {
+            let t = c.robots.first().map_or(0.0, |r| r.row.t_s);
+            let ctx = &self.ctx;
+            let channel = (self.moving)
+                .get_or_insert_with(|| ChannelBuilder::new("/truth/moving").context(ctx).build());
+            let ball = c.ball.as_ref().map(|(row, spec)| (row, spec));
+            channel.log_with_meta(&moving(t, ball, &c.others), at(t));
+        }
     }
 }
 
@@ -301,10 +313,15 @@ pub struct OwnedFrame {
     pub image: image::RgbaImage,
 }
 
-/// One cycle as the recorder keeps it (the loop goes on while it is written): every robot's.
+/// One cycle as the recorder keeps it (the loop goes on while it is written): every robot's,
+/// the ball's and the scripted robots'.
 pub struct Cycle {
     /// Each robot's part, in the robots' order.
     pub robots: Vec<RobotCycleOwned>,
+    /// The ball and its description, when there is one.
+    pub ball: Option<(crate::run::BallRow, omniloop_sim::BallSpec)>,
+    /// The scripted robots' bodies.
+    pub others: Vec<omniloop_sim::Solid>,
 }
 
 /// One robot's part of a cycle as the recorder keeps it.
@@ -351,7 +368,11 @@ impl Cycle {
                 record: crate::run::record::estimates_line(r.row, r.estimates, r.floor),
             })
             .collect();
-        Self { robots }
+        Self {
+            robots,
+            ball: v.ball.map(|(row, spec)| (row.clone(), spec.clone())),
+            others: v.others.to_vec(),
+        }
     }
 }
 

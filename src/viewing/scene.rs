@@ -3,7 +3,8 @@
 
 use foxglove::messages::{
     Color, CubePrimitive, CylinderPrimitive, FrameTransform, LinePrimitive, Point3, Pose,
-    PoseInFrame, Quaternion, SceneEntity, SceneUpdate, Timestamp, TriangleListPrimitive, Vector3,
+    PoseInFrame, Quaternion, SceneEntity, SceneUpdate, SpherePrimitive, Timestamp,
+    TriangleListPrimitive, Vector3,
 };
 use nalgebra::Isometry2;
 use omniloop_sim::shapes::{Solid, SolidShape};
@@ -138,6 +139,29 @@ pub fn world_scene(solids: &[Solid], floor: Option<([f64; 4], [u8; 3])>) -> Scen
         deletions: Vec::new(),
         entities: vec![entity],
     }
+}
+
+/// The things that move without software at `t_s`: the ball (a sphere) and the scripted
+/// robots (cylinders), in the world frame.
+pub fn moving(
+    t_s: f64,
+    ball: Option<(&crate::run::BallRow, &omniloop_sim::BallSpec)>,
+    others: &[Solid],
+) -> SceneUpdate {
+    let mut scene = world_scene(others, None);
+    for e in &mut scene.entities {
+        e.timestamp = Some(stamp(t_s));
+        e.id = "moving".into();
+    }
+    if let (Some((b, spec)), Some(e)) = (ball, scene.entities.first_mut()) {
+        let d = 2.0 * spec.radius_mm * M;
+        e.spheres.push(SpherePrimitive {
+            pose: Some(pose(&Isometry2::translation(b.x_mm, b.y_mm), b.z_mm)),
+            size: Some(Vector3 { x: d, y: d, z: d }),
+            color: Some(color(spec.rgb.0)),
+        });
+    }
+    scene
 }
 
 /// A prism over the quadrilateral `q` from `z0` to `z1` (mm) as triangles: its top and sides.
