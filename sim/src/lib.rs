@@ -14,6 +14,7 @@ pub mod reachability;
 pub mod render;
 pub mod sensor;
 pub mod shapes;
+pub mod sphere;
 pub mod world;
 
 pub use color::Rgb;
@@ -28,6 +29,7 @@ pub use render::{
 };
 pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};
+pub use sphere::Sphere;
 pub use world::{RobotBodySpec, RobotState, RobotStats, World};
 
 /// Errors of the simulator.
