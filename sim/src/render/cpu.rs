@@ -19,7 +19,7 @@
 
 mod packet;
 
-use super::scene::Scene;
+use super::scene::{BoxPrim, QuadPrim, Scene};
 use super::trace::{self, BLACK, FloorPaint, Hit, V3};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
@@ -562,124 +562,24 @@ impl Sectors {
     /// test first).
     fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32, body: Option<usize>) {
         self.prepare_faces(scene);
-        let pairs = &mut self.pairs;
-        pairs.clear();
-        let mut add = |prim: Prim,
-                       d_min: f32,
-                       d_max: f32,
-                       top: f32,
-                       (centre, half): (f32, f32),
-                       corners: Option<&[[f32; 2]; 4]>| {
-            let item = Item {
-                d_min,
-                reach: d_max + rho + CULL_MARGIN_MM,
-                top: top + CULL_MARGIN_MM,
-                prim,
-            };
-            if d_min <= 2.0 * rho + 1.0 || half >= std::f32::consts::PI {
-                pairs.extend((0..SECTORS).map(|k| (k as u16, item)));
-                return;
-            }
-            let spread = (rho / d_min).min(1.0).asin();
-            let spread_cs = ((spread as f64).cos(), (spread as f64).sin());
-            let half = half + spread;
-            let width = std::f32::consts::TAU / SECTORS as f32;
-            // One sector to spare on either side: rays find their sector from 32-bit turns.
-            let start = ((wrap(centre - half)) / width).floor() as i64 - 1;
-            let n = ((2.0 * half) / width).ceil() as i64 + 1;
-            for k in start..=start + n + 1 {
-                let sector = k.rem_euclid(SECTORS as i64) as u16;
-                let Some(corners) = corners else {
-                    pairs.push((sector, item));
-                    continue;
-                };
-                // A polygon's part that the sector's rays can reach: nearer and farther than
-                // the whole footprint, or none at all.
-                if let Some((near, far)) = wedge_extent(corners, sector, spread_cs) {
-                    let item = Item {
-                        d_min: near.max(d_min),
-                        reach: far.min(d_max) + rho + CULL_MARGIN_MM,
-                        ..item
-                    };
-                    pairs.push((sector, item));
-                }
-            }
+        self.pairs.clear();
+        let mut bins = Binning {
+            pairs: &mut self.pairs,
+            axis,
+            rho,
         };
         for (i, b) in scene.boxes.iter().enumerate() {
-            let [cx, cy, hx, hy] = b.geom;
-            let [c, s, _, top] = b.frame;
-            let rx = axis[0] - cx;
-            let ry = axis[1] - cy;
-            let lx = (c * rx + s * ry).abs() - hx;
-            let ly = (-s * rx + c * ry).abs() - hy;
-            let d_min = (lx.max(0.0).powi(2) + ly.max(0.0).powi(2)).sqrt();
-            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
-                [
-                    cx + c * sx * hx - s * sy * hy - axis[0],
-                    cy + s * sx * hx + c * sy * hy - axis[1],
-                ]
-            });
-            let d_max = farthest(&corners);
-            if lx <= 0.0 && ly <= 0.0 {
-                add(Prim::Box(i as u32), 0.0, d_max, top, AROUND, None);
-                continue;
-            }
-            let centre = (cy - axis[1]).atan2(cx - axis[0]);
-            let half = half_angle(&corners, centre);
-            add(
-                Prim::Box(i as u32),
-                d_min,
-                d_max,
-                top,
-                (centre, half),
-                Some(&corners),
-            );
+            bins.add_box(i as u32, b);
         }
         for (i, q) in scene.quads.iter().enumerate() {
-            let corners = [0, 1, 2, 3].map(|k| {
-                let c = q.corner(k);
-                [c[0] - axis[0], c[1] - axis[1]]
-            });
-            let (d_min, inside) = polygon_distance(&corners);
-            let (d_max, top) = (farthest(&corners), q.z[0]);
-            if inside {
-                add(Prim::Quad(i as u32), 0.0, d_max, top, AROUND, None);
-                continue;
-            }
-            let (sx, sy) = corners
-                .iter()
-                .fold((0.0, 0.0), |(x, y), c| (x + c[0], y + c[1]));
-            let centre = sy.atan2(sx);
-            let half = half_angle(&corners, centre);
-            add(
-                Prim::Quad(i as u32),
-                d_min,
-                d_max,
-                top,
-                (centre, half),
-                Some(&corners),
-            );
+            bins.add_quad(i as u32, q);
         }
         for (i, cyl) in scene.cylinders.iter().enumerate() {
             if Some(i) == body {
                 continue;
             }
             let [cx, cy, r, top] = cyl.geom;
-            let dx = cx - axis[0];
-            let dy = cy - axis[1];
-            let dc = (dx * dx + dy * dy).sqrt();
-            if dc <= r {
-                add(Prim::Cylinder(i as u32), 0.0, dc + r, top, AROUND, None);
-                continue;
-            }
-            add(
-                Prim::Cylinder(i as u32),
-                dc - r,
-                dc + r,
-                top,
-                (dy.atan2(dx), (r / dc).asin()),
-                None,
-            );
+            bins.add_disc(Prim::Cylinder(i as u32), [cx, cy, r], top);
         }
         // A stable sort keeps the scene's order among equal distances, so that exact ties
         // (coplanar faces) resolve as when every primitive is traced.
@@ -696,6 +596,126 @@ impl Sectors {
             }
             self.offsets.push(self.items.len() as u32);
         }
+    }
+}
+
+/// The (sector, item) pairs of a frame's primitives, as they are binned around the sensor axis
+/// at `axis` (world frame), whose rays start up to `rho` mm from it.
+struct Binning<'a> {
+    pairs: &'a mut Vec<(u16, Item)>,
+    axis: [f32; 2],
+    rho: f32,
+}
+
+impl Binning<'_> {
+    /// Puts `prim` in every sector whose rays may meet it: its footprint lies from `d_min` to
+    /// `d_max` from the axis, below `top`, within `half` (rad) of the azimuth `centre`; a
+    /// polygon's `corners` (relative to the axis) narrow its distances sector by sector.
+    fn add(
+        &mut self,
+        prim: Prim,
+        (d_min, d_max, top): (f32, f32, f32),
+        (centre, half): (f32, f32),
+        corners: Option<&[[f32; 2]; 4]>,
+    ) {
+        let rho = self.rho;
+        let item = Item {
+            d_min,
+            reach: d_max + rho + CULL_MARGIN_MM,
+            top: top + CULL_MARGIN_MM,
+            prim,
+        };
+        if d_min <= 2.0 * rho + 1.0 || half >= std::f32::consts::PI {
+            self.pairs.extend((0..SECTORS).map(|k| (k as u16, item)));
+            return;
+        }
+        let spread = (rho / d_min).min(1.0).asin();
+        let spread_cs = ((spread as f64).cos(), (spread as f64).sin());
+        let half = half + spread;
+        let width = std::f32::consts::TAU / SECTORS as f32;
+        // One sector to spare on either side: rays find their sector from 32-bit turns.
+        let start = ((wrap(centre - half)) / width).floor() as i64 - 1;
+        let n = ((2.0 * half) / width).ceil() as i64 + 1;
+        for k in start..=start + n + 1 {
+            let sector = k.rem_euclid(SECTORS as i64) as u16;
+            let Some(corners) = corners else {
+                self.pairs.push((sector, item));
+                continue;
+            };
+            // A polygon's part that the sector's rays can reach: nearer and farther than the
+            // whole footprint, or none at all.
+            if let Some((near, far)) = wedge_extent(corners, sector, spread_cs) {
+                let item = Item {
+                    d_min: near.max(d_min),
+                    reach: far.min(d_max) + rho + CULL_MARGIN_MM,
+                    ..item
+                };
+                self.pairs.push((sector, item));
+            }
+        }
+    }
+
+    /// Box `i`.
+    fn add_box(&mut self, i: u32, b: &BoxPrim) {
+        let axis = self.axis;
+        let [cx, cy, hx, hy] = b.geom;
+        let [c, s, _, top] = b.frame;
+        let rx = axis[0] - cx;
+        let ry = axis[1] - cy;
+        let lx = (c * rx + s * ry).abs() - hx;
+        let ly = (-s * rx + c * ry).abs() - hy;
+        let d_min = (lx.max(0.0).powi(2) + ly.max(0.0).powi(2)).sqrt();
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
+            [
+                cx + c * sx * hx - s * sy * hy - axis[0],
+                cy + s * sx * hx + c * sy * hy - axis[1],
+            ]
+        });
+        let d_max = farthest(&corners);
+        if lx <= 0.0 && ly <= 0.0 {
+            self.add(Prim::Box(i), (0.0, d_max, top), AROUND, None);
+            return;
+        }
+        let centre = (cy - axis[1]).atan2(cx - axis[0]);
+        let half = half_angle(&corners, centre);
+        let extent = (d_min, d_max, top);
+        self.add(Prim::Box(i), extent, (centre, half), Some(&corners));
+    }
+
+    /// Quad prism `i`.
+    fn add_quad(&mut self, i: u32, q: &QuadPrim) {
+        let axis = self.axis;
+        let corners = [0, 1, 2, 3].map(|k| {
+            let c = q.corner(k);
+            [c[0] - axis[0], c[1] - axis[1]]
+        });
+        let (d_min, inside) = polygon_distance(&corners);
+        let (d_max, top) = (farthest(&corners), q.z[0]);
+        if inside {
+            self.add(Prim::Quad(i), (0.0, d_max, top), AROUND, None);
+            return;
+        }
+        let (sx, sy) = corners
+            .iter()
+            .fold((0.0, 0.0), |(x, y), c| (x + c[0], y + c[1]));
+        let centre = sy.atan2(sx);
+        let half = half_angle(&corners, centre);
+        let extent = (d_min, d_max, top);
+        self.add(Prim::Quad(i), extent, (centre, half), Some(&corners));
+    }
+
+    /// A primitive standing over the disc of centre `(cx, cy)` and radius `r` of the floor, its
+    /// top at `top` (a cylinder).
+    fn add_disc(&mut self, prim: Prim, [cx, cy, r]: [f32; 3], top: f32) {
+        let dx = cx - self.axis[0];
+        let dy = cy - self.axis[1];
+        let dc = (dx * dx + dy * dy).sqrt();
+        if dc <= r {
+            self.add(prim, (0.0, dc + r, top), AROUND, None);
+            return;
+        }
+        let span = (dy.atan2(dx), (r / dc).asin());
+        self.add(prim, (dc - r, dc + r, top), span, None);
     }
 }
 
