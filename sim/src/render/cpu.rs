@@ -276,6 +276,7 @@ enum Prim {
     Box(u32),
     Quad(u32),
     Cylinder(u32),
+    Sphere(u32),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -332,8 +333,8 @@ struct Sectors {
     /// The highest top of any primitive plus [`CULL_MARGIN_MM`]: a ray from above it that does
     /// not go down meets nothing.
     top_mm: f32,
-    /// The number of boxes and of quads, for [`Sectors::rank`].
-    counts: [u32; 2],
+    /// The number of boxes, of quads and of cylinders, for [`Sectors::rank`].
+    counts: [u32; 3],
 }
 
 /// The shaded, packed colours of a primitive's six faces in the order of their `index`, and two
@@ -542,18 +543,24 @@ impl Sectors {
         self.sky = trace::pack([g.sky_rgb[0], g.sky_rgb[1], g.sky_rgb[2]]);
         let tops = (scene.boxes.iter().map(|b| b.frame[3]))
             .chain(scene.quads.iter().map(|q| q.z[0]))
-            .chain(scene.cylinders.iter().map(|c| c.geom[3]));
+            .chain(scene.cylinders.iter().map(|c| c.geom[3]))
+            .chain(scene.spheres.iter().map(|s| s.geom[2] + s.geom[3]));
         self.top_mm = tops.fold(f32::NEG_INFINITY, f32::max) + CULL_MARGIN_MM;
-        self.counts = [scene.boxes.len() as u32, scene.quads.len() as u32];
+        self.counts = [
+            scene.boxes.len() as u32,
+            scene.quads.len() as u32,
+            scene.cylinders.len() as u32,
+        ];
     }
 
     /// A primitive's place in the scene's order, from 1 (0 is the floor's).
     fn rank(&self, prim: Prim) -> u32 {
-        let [boxes, quads] = self.counts;
+        let [boxes, quads, cylinders] = self.counts;
         match prim {
             Prim::Box(i) => 1 + i,
             Prim::Quad(i) => 1 + boxes + i,
             Prim::Cylinder(i) => 1 + boxes + quads + i,
+            Prim::Sphere(i) => 1 + boxes + quads + cylinders + i,
         }
     }
 
@@ -580,6 +587,10 @@ impl Sectors {
             }
             let [cx, cy, r, top] = cyl.geom;
             bins.add_disc(Prim::Cylinder(i as u32), [cx, cy, r], top);
+        }
+        for (i, sp) in scene.spheres.iter().enumerate() {
+            let [cx, cy, cz, r] = sp.geom;
+            bins.add_disc(Prim::Sphere(i as u32), [cx, cy, r], cz + r);
         }
         // A stable sort keeps the scene's order among equal distances, so that exact ties
         // (coplanar faces) resolve as when every primitive is traced.
@@ -705,7 +716,7 @@ impl Binning<'_> {
     }
 
     /// A primitive standing over the disc of centre `(cx, cy)` and radius `r` of the floor, its
-    /// top at `top` (a cylinder).
+    /// top at `top` (a cylinder; a sphere, wherever its centre is above the floor).
     fn add_disc(&mut self, prim: Prim, [cx, cy, r]: [f32; 3], top: f32) {
         let dx = cx - self.axis[0];
         let dy = cy - self.axis[1];
@@ -986,5 +997,130 @@ mod tests {
             }
         }
         assert!(hits > 1000 && spared > 5000, "hits {hits}, spared {spared}");
+    }
+
+    /// A field with a cube and a pillar around the corner paper's robot at the origin, and
+    /// spheres: a ball on the floor, one 300 mm up, one half behind the pillar, one in the
+    /// cube's face, a large one cut by the floor under the robot (around the axis: in every
+    /// sector) and one just above the robot's body.
+    fn sphere_scene() -> Scene {
+        use crate::labels::{Class, ObjectId};
+        use crate::layout::{Cube, FieldSpec, Layout, Pillar};
+        use crate::sphere::Sphere;
+        let layout = Layout {
+            field: Some(FieldSpec::default()),
+            cubes: vec![Cube {
+                center_mm: [-500.0, 250.0],
+                size_mm: 130.0,
+                angle_deg: 20.0,
+                rgb: crate::Rgb([200, 40, 40]),
+            }],
+            pillars: vec![Pillar {
+                center_mm: [0.0, -600.0],
+                radius_mm: 60.0,
+                height_mm: 250.0,
+                rgb: crate::Rgb([90, 90, 200]),
+            }],
+            ..Layout::default()
+        };
+        let ball = |k: u32, [x, y, z]: [f64; 3], r: f64| Sphere {
+            center_mm: [x, y, z],
+            radius_mm: r,
+            rgb: crate::Rgb([255, 120, 0]),
+            object: ObjectId::new(Class::Ball, k),
+        };
+        Scene::new(&layout, &[]).with_spheres(&[
+            ball(0, [400.0, 0.0, 21.5], 21.5),
+            ball(1, [0.0, 700.0, 321.5], 21.5),
+            ball(2, [75.0, -720.0, 21.5], 21.5),
+            ball(3, [-440.0, 250.0, 60.0], 40.0),
+            ball(4, [30.0, 10.0, -900.0], 950.0),
+            ball(5, [60.0, 0.0, 140.0], 15.0),
+        ])
+    }
+
+    #[test]
+    fn spheres_give_every_kernel_the_pixels_of_tracing_every_primitive() {
+        use crate::sensor::SensorSpec;
+        let scene = sphere_scene();
+        let first = scene.boxes.len() + scene.quads.len() + scene.cylinders.len();
+        assert_eq!(scene.globals.counts[3], 6);
+        assert_eq!(scene.objects.len(), first + 6);
+        let sensor = SensorSpec::corner_paper("omni").build();
+        let poses = [
+            Isometry2::new(nalgebra::Vector2::zeros(), 0.0),
+            Isometry2::new(nalgebra::Vector2::new(37.0, -21.0), 1.234_567),
+            Isometry2::new(nalgebra::Vector2::new(-150.0, 90.0), -2.5),
+        ];
+        let mut rays = SensorRays::new(&sensor);
+        let avx2 = cfg!(target_arch = "x86_64") && std::arch::is_x86_feature_detected!("avx2");
+        eprintln!(
+            "kernels: portable and {}",
+            if avx2 { "AVX2" } else { "portable" }
+        );
+        let mut seen = [0usize; 6];
+        for (k, pose) in poses.iter().enumerate() {
+            let traced = trace_reference(&scene, &rays, pose);
+            for (i, n) in seen.iter_mut().enumerate() {
+                let rank = (first + 1 + i) as u32;
+                *n += traced.iter().filter(|r| r.code == rank).count();
+            }
+            for (kind, mut r) in [
+                ("vector", CpuRenderer::new()),
+                ("portable", CpuRenderer::portable()),
+            ] {
+                let n = traced.len();
+                let (mut pixels, mut t, mut codes) = (vec![0; n], vec![0.0; n], vec![0; n]);
+                r.render_truth(&scene, &mut rays, pose, &mut pixels, (&mut t, &mut codes));
+                let differ = (0..n)
+                    .filter(|&i| {
+                        let want = &traced[i];
+                        (pixels[i], t[i].to_bits(), codes[i])
+                            != (want.colour, want.t.to_bits(), want.code)
+                    })
+                    .count();
+                assert_eq!(differ, 0, "pose {k}, {kind} kernel");
+                let mut plain = vec![0; n];
+                r.render(&scene, &mut rays, pose, &mut plain);
+                assert_eq!(plain, pixels, "pose {k}, {kind} kernel without truth");
+            }
+        }
+        eprintln!("sphere pixels over the poses: {seen:?}");
+        assert!(seen.iter().all(|&n| n >= 10), "sphere pixels {seen:?}");
+    }
+
+    #[test]
+    fn a_sphere_is_met_where_it_stands_and_shaded_by_its_normal() {
+        let scene = Scene::new(&crate::layout::Layout::default(), &[]).with_spheres(&[
+            crate::sphere::Sphere {
+                center_mm: [500.0, 0.0, 300.0],
+                radius_mm: 20.0,
+                rgb: crate::Rgb([255, 255, 255]),
+                object: crate::labels::ObjectId::of(crate::labels::Class::Ball),
+            },
+        ]);
+        let sp = &scene.spheres[0];
+        // Straight at it from 480 mm off, in its equator's plane: met 460 mm on, normal -x.
+        let hit = trace::hit_sphere(sp, [20.0, 0.0, 300.0], [1.0, 0.0, 0.0], f32::INFINITY)
+            .expect("a hit");
+        assert_eq!((hit.t, hit.n), (460.0, [-1.0, 0.0, 0.0]));
+        // Passing 1 mm over its top: a miss; from inside, its far side.
+        assert!(trace::hit_sphere(sp, [0.0, 0.0, 321.0], [1.0, 0.0, 0.0], 1e9).is_none());
+        let inside = trace::hit_sphere(sp, [500.0, 0.0, 300.0], [0.0, 0.0, 1.0], 1e9).unwrap();
+        assert_eq!((inside.t, inside.n), (20.0, [0.0, 0.0, 1.0]));
+        // Beyond the nearest hit so far: none.
+        assert!(trace::hit_sphere(sp, [20.0, 0.0, 300.0], [1.0, 0.0, 0.0], 460.0).is_none());
+        // Straight down on it: its top, rank 1, lit as the floor (normal +z).
+        let traced = trace::trace_ray(&scene, [500.0, 0.0, 900.0], [0.0, 0.0, -1.0]);
+        assert_eq!((traced.t, traced.code), (580.0, 1));
+        let floor_lit = trace::shade(
+            &scene,
+            &Hit {
+                t: 0.0,
+                n: trace::FLOOR_NORMAL,
+                rgb: [1.0; 3],
+            },
+        );
+        assert_eq!(traced.colour, trace::pack(floor_lit));
     }
 }
