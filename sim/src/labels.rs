@@ -3,7 +3,7 @@
 //!
 //! Label numbers are fixed for the classes that have one instance (nothing, sky, own body, the
 //! floor's paints, walls, the two goals) and follow in order for the objects of a world:
-//! cubes, pillars, boards, robots, each by its index in the scenario. The same world gives the
+//! cubes, pillars, boards, robots, each by its index in the scenario, then balls. The same world gives the
 //! same numbers in every frame.
 
 use serde::Serialize;

@@ -1,8 +1,8 @@
 // omniloop catadioptric tracer: one invocation per pixel of each frame of a batch (z: frame).
 // camera ray -> mirror (hyperbolic, conical, spherical) or pinhole -> scene (floor, boxes,
-// quadrilateral prisms, cylinders, spheres, striped boards) -> Lambert shading -> packed RGBA8; a frame
-// that asks for its truth also gets, per pixel, the distance along the scene ray to what it
-// meets and what that is (trace.rs: Code).
+// quadrilateral prisms, cylinders, spheres, striped boards) -> Lambert shading -> packed RGBA8;
+// a frame that asks for its truth also gets, per pixel, the distance along the scene ray to what
+// it meets and what that is (trace.rs: Code).
 // The scene half matches sim/src/render/trace.rs operation for operation.
 
 struct Globals {
