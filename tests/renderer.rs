@@ -7,10 +7,12 @@ use nalgebra::{Isometry2, Vector2};
 use omniloop::load_scenario;
 use omniloop::run::render_snapshot;
 use omniloop::scenario::calibrate::calibrate_sensor;
+use omniloop_sim::labels::{Class, ObjectId};
 use omniloop_sim::optics::HyperbolicMirror;
 use omniloop_sim::render::{CpuRenderer, SensorRays};
 use omniloop_sim::{
-    FloorRect, FrameRequest, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorSpec, Wall,
+    FloorRect, FrameRequest, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorNoise,
+    SensorSpec, Sphere, Wall,
 };
 mod common;
 
@@ -414,6 +416,120 @@ fn a_gpu_batch_equals_its_frames_traced_one_by_one() {
         cpu_batch[1],
         cpu.render_packed(scene, sensor, pose).unwrap()
     );
+}
+
+/// The hyperbolic render example (the field, its cubes, the robot where it starts) with golf
+/// balls 43 mm across around the robot (at (-400, 400)): on the floor 400 and 800 mm off, one
+/// raised (its centre 300 mm up) 1.5 m off, one in the face of the cube at (-600, 300); and its
+/// sensor and pose.
+fn field_with_balls() -> (Scene, omniloop_sim::Sensor, Isometry2<f64>) {
+    let s = load_scenario(&scenario("render_hyperbolic.toml")).unwrap();
+    let world = omniloop_sim::World::new(&s.world, &s.robot_bodies(), 0.002).unwrap();
+    let pose = world.robot_state(0).pose;
+    let (x, y) = (pose.translation.x, pose.translation.y);
+    let ball = |k: u32, [dx, dy, z]: [f64; 3]| Sphere {
+        center_mm: [x + dx, y + dy, z],
+        radius_mm: 21.5,
+        rgb: Rgb([255, 110, 20]),
+        object: ObjectId::new(Class::Ball, k),
+    };
+    let balls = [
+        ball(0, [400.0, 0.0, 21.5]),
+        ball(1, [565.7, -565.7, 21.5]),
+        ball(2, [1477.2, -260.5, 300.0]),
+        ball(3, [-145.0, -70.0, 21.5]),
+    ];
+    let scene = Scene::of_world(&world).with_spheres(&balls);
+    (scene, s.robot.sensors[0].build(), pose)
+}
+
+/// The CPU and the GPU draw the same balls: the frames agree as those of the render examples
+/// do, and each renderer's image differs from the scene's without the balls where they stand.
+#[test]
+fn gpu_and_cpu_renders_agree_with_spheres_in_the_scene() {
+    let Some(mut gpu) = gpu_or_skip() else {
+        return;
+    };
+    let mut cpu = Renderer::cpu();
+    let (scene, sensor, pose) = field_with_balls();
+    let bare = bare_scene(scene.clone());
+    for noise in [None, Some(0x5eed)] {
+        let frame = |r: &mut Renderer, scene: &Scene| {
+            let mut noise = noise.map(SensorNoise::new);
+            r.render(scene, &sensor, &pose, noise.as_mut()).unwrap()
+        };
+        let (a, b) = (frame(&mut cpu, &scene), frame(&mut gpu, &scene));
+        let frac = share_within(&a, &b, 2);
+        let drawn = |img: &image::RgbaImage, without: &image::RgbaImage| {
+            let close = share_within(img, without, 2);
+            ((1.0 - close) * (img.width() * img.height()) as f64).round() as usize
+        };
+        let balls = [
+            drawn(&a, &frame(&mut cpu, &bare)),
+            drawn(&b, &frame(&mut gpu, &bare)),
+        ];
+        eprintln!(
+            "field with balls (noise {noise:?}): {:.4}% of pixels within 2 levels, the balls \
+             drawn on {balls:?} pixels (cpu, {})",
+            100.0 * frac,
+            gpu.name()
+        );
+        assert!(frac >= 0.999, "only {:.3}% within 2 levels", 100.0 * frac);
+        assert!(
+            balls.iter().all(|&n| n >= 40),
+            "balls drawn on {balls:?} pixels"
+        );
+    }
+}
+
+/// A scene without its spheres, as the scene of the same world had been before they existed.
+fn bare_scene(mut scene: Scene) -> Scene {
+    let n = scene.objects.len() - scene.spheres.len();
+    scene.objects.truncate(n);
+    scene.spheres.clear();
+    scene.globals.counts[3] = 0;
+    scene
+}
+
+/// One GPU batch of frames with and without spheres (the spheres' table shared, each frame's
+/// first sphere in its header) gives each frame the image it gets traced alone.
+#[test]
+fn a_gpu_batch_of_scenes_with_and_without_spheres_equals_its_frames_alone() {
+    let Some(mut gpu) = gpu_or_skip() else {
+        return;
+    };
+    let (scene, sensor, pose) = field_with_balls();
+    let mut fewer = scene.clone();
+    // The first ball left out: the frames' spheres differ in number and in place.
+    fewer.spheres.remove(0);
+    fewer.objects.remove(fewer.objects.len() - 4);
+    fewer.globals.counts[3] = 3;
+    let bare = bare_scene(scene.clone());
+    let turned = Isometry2::new(pose.translation.vector, pose.rotation.angle() + 1.0);
+    let frames = [
+        (&bare, pose),
+        (&scene, pose),
+        (&bare, turned),
+        (&fewer, turned),
+        (&scene, turned),
+    ];
+    let requests: Vec<FrameRequest> = (frames.iter())
+        .map(|(scene, pose)| FrameRequest {
+            scene,
+            sensor: &sensor,
+            pose,
+            noise: None,
+        })
+        .collect();
+    let batch = gpu.render_batch_packed(&requests).unwrap();
+    for (k, (scene, pose)) in frames.iter().enumerate() {
+        let alone = gpu.render_packed(scene, &sensor, pose).unwrap();
+        let diff = batch[k].iter().zip(alone).filter(|(a, b)| a != b).count();
+        assert_eq!(diff, 0, "frame {k}: {diff} pixels differ");
+    }
+    // The balls are in the frames that have them.
+    assert_ne!(batch[0], batch[1]);
+    assert_ne!(batch[3], batch[4]);
 }
 
 /// Golden images: the CPU render (no noise) of each render example. A render passes when at

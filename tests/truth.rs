@@ -5,6 +5,7 @@
 mod common;
 
 use common::scenario;
+use nalgebra::Vector3;
 use omniloop::run::truth_files;
 use omniloop_sim::labels::{self, Class, ObjectId};
 use omniloop_sim::optics::Optics;
@@ -12,7 +13,7 @@ use omniloop_sim::render::cpu::trace_reference;
 use omniloop_sim::render::trace::CODE_NOTHING;
 use omniloop_sim::render::truth::{self, TruthFrame, TruthRays};
 use omniloop_sim::render::{BatchServer, CpuRenderer, SensorRays};
-use omniloop_sim::{FrameRequest, Renderer, Scene, SensorNoise, World};
+use omniloop_sim::{FrameRequest, Renderer, Rgb, Scene, SensorNoise, Sphere, World};
 use std::ffi::OsStr;
 
 /// The world of a scenario with its robots where they start, and the first robot's pose.
@@ -485,4 +486,133 @@ fn a_gpu_batch_carries_the_truth_of_the_frames_that_ask() {
         assert_eq!(a.labels, b.labels);
         assert!((a.depth_mm.iter().zip(&b.depth_mm)).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
+}
+
+/// Golf balls (43 mm across) around the render example's robot (at (-400, 400) on a field of
+/// 2.74 m x 1.52 m, the cubes elsewhere): on the floor 400 mm off along +x and 800 mm off along
+/// -45 degrees, and one raised, its centre 150 mm up 1200 mm off along +x.
+fn golf_balls() -> Vec<Sphere> {
+    let ball = |k: u32, [x, y, z]: [f64; 3]| Sphere {
+        center_mm: [x, y, z],
+        radius_mm: 21.5,
+        rgb: Rgb([255, 110, 20]),
+        object: ObjectId::new(Class::Ball, k),
+    };
+    let at = |r: f64, deg: f64, z: f64| {
+        let a = deg.to_radians();
+        [-400.0 + r * a.cos(), 400.0 + r * a.sin(), z]
+    };
+    vec![
+        ball(0, at(400.0, 0.0, 21.5)),
+        ball(1, at(800.0, -45.0, 21.5)),
+        ball(2, at(1200.0, 0.0, 150.0)),
+    ]
+}
+
+/// The distance along the world ray `o + t d` (unit `d`) to its first crossing of `ball`, and
+/// the squared distance of the line from the ball's surface inwards (`r^2 - |line - centre|^2`,
+/// negative where it passes by), in `f64` from the textbook quadratic.
+fn ball_distance(o: Vector3<f64>, d: Vector3<f64>, ball: &Sphere) -> (f64, f64) {
+    let c = Vector3::from(ball.center_mm);
+    let m = o - c;
+    let b = m.dot(&d);
+    let disc = b * b - (m.dot(&m) - ball.radius_mm * ball.radius_mm);
+    (-b - disc.max(0.0).sqrt(), disc)
+}
+
+#[test]
+fn a_balls_depth_is_the_closed_form_distance_along_the_mirrors_ray_and_its_label_the_balls() {
+    let s = scenario("render_hyperbolic.toml");
+    let sensor = s.robot.sensors[0].build();
+    let (world, pose) = world_of(&s);
+    let balls = golf_balls();
+    let scene = Scene::of_world(&world).with_spheres(&balls);
+    let truth = Renderer::cpu()
+        .render_truth(&scene, &sensor, &pose)
+        .unwrap();
+    let labels: Vec<u16> = balls.iter().map(|b| truth.legend.label(b.object)).collect();
+    assert!(
+        labels
+            .iter()
+            .all(|&l| truth.legend.object(l).unwrap().class == Class::Ball)
+    );
+    let (rot, shift) = (pose.rotation.angle(), pose.translation.vector);
+    let (c, sn) = (rot.cos(), rot.sin());
+    let (mut seen, mut worst) = (vec![0; balls.len()], 0.0f64);
+    for v in 0..truth.height {
+        for u in 0..truth.width {
+            let Some(ray) = sensor.pixel_ray(u, v) else {
+                continue;
+            };
+            // The mirror's scene ray in the world.
+            let (p, q) = (ray.origin, ray.dir);
+            let o = Vector3::new(
+                shift.x + c * p.x - sn * p.y,
+                shift.y + sn * p.x + c * p.y,
+                p.z,
+            );
+            let d = Vector3::new(c * q.x - sn * q.y, sn * q.x + c * q.y, q.z);
+            let k = (v * truth.width + u) as usize;
+            for (j, ball) in balls.iter().enumerate() {
+                let (t, disc) = ball_distance(o, d, ball);
+                if truth.labels[k] == labels[j] {
+                    // The f32 tracer's ray may graze the ball where the f64 one just misses it.
+                    assert!(
+                        disc > -1.0,
+                        "({u}, {v}) labelled ball {j}: misses it by {disc}"
+                    );
+                    let depth = ray.path_mm + t;
+                    worst = worst.max((truth.depth_mm[k] as f64 - depth).abs());
+                    seen[j] += 1;
+                } else {
+                    // A ray well inside the ball's outline (nothing stands in front of them).
+                    let inside = disc > 0.1 * ball.radius_mm * ball.radius_mm;
+                    assert!(
+                        !inside || t < 0.0,
+                        "({u}, {v}) meets ball {j} at {t} (disc {disc}) but is labelled {:?} at {}",
+                        truth.legend.object(truth.labels[k]),
+                        truth.depth_mm[k] as f64 - ray.path_mm
+                    );
+                }
+            }
+        }
+    }
+    eprintln!("ball pixels {seen:?}: depth within {worst:.2e} mm of the closed form");
+    assert!(seen.iter().all(|&n| n >= 4), "ball pixels {seen:?}");
+    assert!(worst < 1.0, "depth off the closed form by {worst} mm");
+}
+
+/// On a field with golf balls, the GPU's truth is the CPU's as on the render examples, and the
+/// balls' pixels have the same labels on both.
+#[test]
+fn gpu_and_cpu_truth_agree_on_balls() {
+    let Some(mut gpu) = common::gpu_or_skip() else {
+        return;
+    };
+    let s = scenario("render_hyperbolic.toml");
+    let sensor = s.robot.sensors[0].build();
+    let (world, pose) = world_of(&s);
+    let scene = Scene::of_world(&world).with_spheres(&golf_balls());
+    let a = gpu.render_truth(&scene, &sensor, &pose).unwrap();
+    let b = Renderer::cpu()
+        .render_truth(&scene, &sensor, &pose)
+        .unwrap();
+    assert_eq!(a.legend, b.legend);
+    let d = truth_difference(&a, &b);
+    let is_ball =
+        |t: &TruthFrame, k: usize| t.legend.object(t.labels[k]).unwrap().class == Class::Ball;
+    let balls = (0..b.labels.len()).filter(|&k| is_ball(&b, k)).count();
+    let alike = (0..b.labels.len())
+        .filter(|&k| is_ball(&b, k) && a.labels[k] == b.labels[k])
+        .count();
+    eprintln!(
+        "{alike} of {balls} ball pixels labelled alike; {d:?} ({})",
+        gpu.name()
+    );
+    assert!(
+        balls >= 12 && alike + 1 >= balls,
+        "{alike} of {balls} ball pixels alike"
+    );
+    assert!(d.relabelled < 0.0005, "{d:?}");
+    assert!(d.near_over < 0.001 && d.near_worst < 1.0, "{d:?}");
 }

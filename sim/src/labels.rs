@@ -3,7 +3,7 @@
 //!
 //! Label numbers are fixed for the classes that have one instance (nothing, sky, own body, the
 //! floor's paints, walls, the two goals) and follow in order for the objects of a world:
-//! cubes, pillars, boards, robots, each by its index in the scenario. The same world gives the
+//! cubes, pillars, boards, robots, each by its index in the scenario, then balls. The same world gives the
 //! same numbers in every frame.
 
 use serde::Serialize;
@@ -40,6 +40,9 @@ pub enum Class {
     Board,
     /// Another robot (instance: its index in the team).
     Robot,
+    /// A ball (instance: which one, 0 for the first). Last of the classes, so that the label
+    /// numbers of a world without a ball are those it had before balls existed.
+    Ball,
 }
 
 impl Class {
@@ -68,6 +71,7 @@ impl Class {
             Class::Pillar => "pillar",
             Class::Board => "board",
             Class::Robot => "robot",
+            Class::Ball => "ball",
         }
     }
 }
@@ -204,7 +208,8 @@ fn name(o: ObjectId) -> String {
     match o.class {
         Class::Goal if o.instance == 0 => "goal +x".into(),
         Class::Goal => "goal -x".into(),
-        Class::Cube | Class::Pillar | Class::Board | Class::Robot => {
+        Class::Ball if o.instance == 0 => "ball".into(),
+        Class::Cube | Class::Pillar | Class::Board | Class::Robot | Class::Ball => {
             format!("{} {}", o.class.name(), o.instance)
         }
         c => c.name().into(),
@@ -273,5 +278,29 @@ mod tests {
         colours.sort_unstable();
         colours.dedup();
         assert_eq!(colours.len(), entries.len());
+    }
+
+    #[test]
+    fn a_ball_comes_after_every_other_object_and_leaves_their_labels_as_they_were() {
+        let others = [
+            ObjectId::new(Class::Cube, 0),
+            ObjectId::new(Class::Board, 1),
+            ObjectId::new(Class::Robot, 2),
+        ];
+        let before = Legend::new(others);
+        let with_balls = Legend::new(
+            [ObjectId::new(Class::Ball, 1), ObjectId::new(Class::Ball, 0)]
+                .into_iter()
+                .chain(others),
+        );
+        for o in others {
+            assert_eq!(with_balls.label(o), before.label(o), "{o:?}");
+        }
+        let ball = with_balls.label(ObjectId::new(Class::Ball, 0));
+        assert_eq!(ball as usize, before.len());
+        assert_eq!(with_balls.label(ObjectId::new(Class::Ball, 1)), ball + 1);
+        let entries = with_balls.entries();
+        assert_eq!(entries[ball as usize].name, "ball");
+        assert_eq!(entries[ball as usize + 1].name, "ball 1");
     }
 }

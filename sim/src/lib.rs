@@ -17,6 +17,7 @@ pub mod reachability;
 pub mod render;
 pub mod sensor;
 pub mod shapes;
+pub mod sphere;
 pub mod world;
 
 pub use ball::{BallSpec, BallState};
@@ -34,6 +35,7 @@ pub use render::{
 };
 pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};
+pub use sphere::Sphere;
 pub use world::{RobotBodySpec, RobotState, RobotStats, World};
 
 /// Errors of the simulator.

@@ -19,7 +19,7 @@
 
 mod packet;
 
-use super::scene::Scene;
+use super::scene::{BoxPrim, QuadPrim, Scene};
 use super::trace::{self, BLACK, FloorPaint, Hit, V3};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
@@ -276,6 +276,7 @@ enum Prim {
     Box(u32),
     Quad(u32),
     Cylinder(u32),
+    Sphere(u32),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -332,8 +333,8 @@ struct Sectors {
     /// The highest top of any primitive plus [`CULL_MARGIN_MM`]: a ray from above it that does
     /// not go down meets nothing.
     top_mm: f32,
-    /// The number of boxes and of quads, for [`Sectors::rank`].
-    counts: [u32; 2],
+    /// The number of boxes, of quads and of cylinders, for [`Sectors::rank`].
+    counts: [u32; 3],
 }
 
 /// The shaded, packed colours of a primitive's six faces in the order of their `index`, and two
@@ -542,18 +543,24 @@ impl Sectors {
         self.sky = trace::pack([g.sky_rgb[0], g.sky_rgb[1], g.sky_rgb[2]]);
         let tops = (scene.boxes.iter().map(|b| b.frame[3]))
             .chain(scene.quads.iter().map(|q| q.z[0]))
-            .chain(scene.cylinders.iter().map(|c| c.geom[3]));
+            .chain(scene.cylinders.iter().map(|c| c.geom[3]))
+            .chain(scene.spheres.iter().map(|s| s.geom[2] + s.geom[3]));
         self.top_mm = tops.fold(f32::NEG_INFINITY, f32::max) + CULL_MARGIN_MM;
-        self.counts = [scene.boxes.len() as u32, scene.quads.len() as u32];
+        self.counts = [
+            scene.boxes.len() as u32,
+            scene.quads.len() as u32,
+            scene.cylinders.len() as u32,
+        ];
     }
 
     /// A primitive's place in the scene's order, from 1 (0 is the floor's).
     fn rank(&self, prim: Prim) -> u32 {
-        let [boxes, quads] = self.counts;
+        let [boxes, quads, cylinders] = self.counts;
         match prim {
             Prim::Box(i) => 1 + i,
             Prim::Quad(i) => 1 + boxes + i,
             Prim::Cylinder(i) => 1 + boxes + quads + i,
+            Prim::Sphere(i) => 1 + boxes + quads + cylinders + i,
         }
     }
 
@@ -562,124 +569,28 @@ impl Sectors {
     /// test first).
     fn rebuild(&mut self, scene: &Scene, axis: [f32; 2], rho: f32, body: Option<usize>) {
         self.prepare_faces(scene);
-        let pairs = &mut self.pairs;
-        pairs.clear();
-        let mut add = |prim: Prim,
-                       d_min: f32,
-                       d_max: f32,
-                       top: f32,
-                       (centre, half): (f32, f32),
-                       corners: Option<&[[f32; 2]; 4]>| {
-            let item = Item {
-                d_min,
-                reach: d_max + rho + CULL_MARGIN_MM,
-                top: top + CULL_MARGIN_MM,
-                prim,
-            };
-            if d_min <= 2.0 * rho + 1.0 || half >= std::f32::consts::PI {
-                pairs.extend((0..SECTORS).map(|k| (k as u16, item)));
-                return;
-            }
-            let spread = (rho / d_min).min(1.0).asin();
-            let spread_cs = ((spread as f64).cos(), (spread as f64).sin());
-            let half = half + spread;
-            let width = std::f32::consts::TAU / SECTORS as f32;
-            // One sector to spare on either side: rays find their sector from 32-bit turns.
-            let start = ((wrap(centre - half)) / width).floor() as i64 - 1;
-            let n = ((2.0 * half) / width).ceil() as i64 + 1;
-            for k in start..=start + n + 1 {
-                let sector = k.rem_euclid(SECTORS as i64) as u16;
-                let Some(corners) = corners else {
-                    pairs.push((sector, item));
-                    continue;
-                };
-                // A polygon's part that the sector's rays can reach: nearer and farther than
-                // the whole footprint, or none at all.
-                if let Some((near, far)) = wedge_extent(corners, sector, spread_cs) {
-                    let item = Item {
-                        d_min: near.max(d_min),
-                        reach: far.min(d_max) + rho + CULL_MARGIN_MM,
-                        ..item
-                    };
-                    pairs.push((sector, item));
-                }
-            }
+        self.pairs.clear();
+        let mut bins = Binning {
+            pairs: &mut self.pairs,
+            axis,
+            rho,
         };
         for (i, b) in scene.boxes.iter().enumerate() {
-            let [cx, cy, hx, hy] = b.geom;
-            let [c, s, _, top] = b.frame;
-            let rx = axis[0] - cx;
-            let ry = axis[1] - cy;
-            let lx = (c * rx + s * ry).abs() - hx;
-            let ly = (-s * rx + c * ry).abs() - hy;
-            let d_min = (lx.max(0.0).powi(2) + ly.max(0.0).powi(2)).sqrt();
-            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
-                [
-                    cx + c * sx * hx - s * sy * hy - axis[0],
-                    cy + s * sx * hx + c * sy * hy - axis[1],
-                ]
-            });
-            let d_max = farthest(&corners);
-            if lx <= 0.0 && ly <= 0.0 {
-                add(Prim::Box(i as u32), 0.0, d_max, top, AROUND, None);
-                continue;
-            }
-            let centre = (cy - axis[1]).atan2(cx - axis[0]);
-            let half = half_angle(&corners, centre);
-            add(
-                Prim::Box(i as u32),
-                d_min,
-                d_max,
-                top,
-                (centre, half),
-                Some(&corners),
-            );
+            bins.add_box(i as u32, b);
         }
         for (i, q) in scene.quads.iter().enumerate() {
-            let corners = [0, 1, 2, 3].map(|k| {
-                let c = q.corner(k);
-                [c[0] - axis[0], c[1] - axis[1]]
-            });
-            let (d_min, inside) = polygon_distance(&corners);
-            let (d_max, top) = (farthest(&corners), q.z[0]);
-            if inside {
-                add(Prim::Quad(i as u32), 0.0, d_max, top, AROUND, None);
-                continue;
-            }
-            let (sx, sy) = corners
-                .iter()
-                .fold((0.0, 0.0), |(x, y), c| (x + c[0], y + c[1]));
-            let centre = sy.atan2(sx);
-            let half = half_angle(&corners, centre);
-            add(
-                Prim::Quad(i as u32),
-                d_min,
-                d_max,
-                top,
-                (centre, half),
-                Some(&corners),
-            );
+            bins.add_quad(i as u32, q);
         }
         for (i, cyl) in scene.cylinders.iter().enumerate() {
             if Some(i) == body {
                 continue;
             }
             let [cx, cy, r, top] = cyl.geom;
-            let dx = cx - axis[0];
-            let dy = cy - axis[1];
-            let dc = (dx * dx + dy * dy).sqrt();
-            if dc <= r {
-                add(Prim::Cylinder(i as u32), 0.0, dc + r, top, AROUND, None);
-                continue;
-            }
-            add(
-                Prim::Cylinder(i as u32),
-                dc - r,
-                dc + r,
-                top,
-                (dy.atan2(dx), (r / dc).asin()),
-                None,
-            );
+            bins.add_disc(Prim::Cylinder(i as u32), [cx, cy, r], top);
+        }
+        for (i, sp) in scene.spheres.iter().enumerate() {
+            let [cx, cy, cz, r] = sp.geom;
+            bins.add_disc(Prim::Sphere(i as u32), [cx, cy, r], cz + r);
         }
         // A stable sort keeps the scene's order among equal distances, so that exact ties
         // (coplanar faces) resolve as when every primitive is traced.
@@ -696,6 +607,126 @@ impl Sectors {
             }
             self.offsets.push(self.items.len() as u32);
         }
+    }
+}
+
+/// The (sector, item) pairs of a frame's primitives, as they are binned around the sensor axis
+/// at `axis` (world frame), whose rays start up to `rho` mm from it.
+struct Binning<'a> {
+    pairs: &'a mut Vec<(u16, Item)>,
+    axis: [f32; 2],
+    rho: f32,
+}
+
+impl Binning<'_> {
+    /// Puts `prim` in every sector whose rays may meet it: its footprint lies from `d_min` to
+    /// `d_max` from the axis, below `top`, within `half` (rad) of the azimuth `centre`; a
+    /// polygon's `corners` (relative to the axis) narrow its distances sector by sector.
+    fn add(
+        &mut self,
+        prim: Prim,
+        (d_min, d_max, top): (f32, f32, f32),
+        (centre, half): (f32, f32),
+        corners: Option<&[[f32; 2]; 4]>,
+    ) {
+        let rho = self.rho;
+        let item = Item {
+            d_min,
+            reach: d_max + rho + CULL_MARGIN_MM,
+            top: top + CULL_MARGIN_MM,
+            prim,
+        };
+        if d_min <= 2.0 * rho + 1.0 || half >= std::f32::consts::PI {
+            self.pairs.extend((0..SECTORS).map(|k| (k as u16, item)));
+            return;
+        }
+        let spread = (rho / d_min).min(1.0).asin();
+        let spread_cs = ((spread as f64).cos(), (spread as f64).sin());
+        let half = half + spread;
+        let width = std::f32::consts::TAU / SECTORS as f32;
+        // One sector to spare on either side: rays find their sector from 32-bit turns.
+        let start = ((wrap(centre - half)) / width).floor() as i64 - 1;
+        let n = ((2.0 * half) / width).ceil() as i64 + 1;
+        for k in start..=start + n + 1 {
+            let sector = k.rem_euclid(SECTORS as i64) as u16;
+            let Some(corners) = corners else {
+                self.pairs.push((sector, item));
+                continue;
+            };
+            // A polygon's part that the sector's rays can reach: nearer and farther than the
+            // whole footprint, or none at all.
+            if let Some((near, far)) = wedge_extent(corners, sector, spread_cs) {
+                let item = Item {
+                    d_min: near.max(d_min),
+                    reach: far.min(d_max) + rho + CULL_MARGIN_MM,
+                    ..item
+                };
+                self.pairs.push((sector, item));
+            }
+        }
+    }
+
+    /// Box `i`.
+    fn add_box(&mut self, i: u32, b: &BoxPrim) {
+        let axis = self.axis;
+        let [cx, cy, hx, hy] = b.geom;
+        let [c, s, _, top] = b.frame;
+        let rx = axis[0] - cx;
+        let ry = axis[1] - cy;
+        let lx = (c * rx + s * ry).abs() - hx;
+        let ly = (-s * rx + c * ry).abs() - hy;
+        let d_min = (lx.max(0.0).powi(2) + ly.max(0.0).powi(2)).sqrt();
+        let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(sx, sy)| {
+            [
+                cx + c * sx * hx - s * sy * hy - axis[0],
+                cy + s * sx * hx + c * sy * hy - axis[1],
+            ]
+        });
+        let d_max = farthest(&corners);
+        if lx <= 0.0 && ly <= 0.0 {
+            self.add(Prim::Box(i), (0.0, d_max, top), AROUND, None);
+            return;
+        }
+        let centre = (cy - axis[1]).atan2(cx - axis[0]);
+        let half = half_angle(&corners, centre);
+        let extent = (d_min, d_max, top);
+        self.add(Prim::Box(i), extent, (centre, half), Some(&corners));
+    }
+
+    /// Quad prism `i`.
+    fn add_quad(&mut self, i: u32, q: &QuadPrim) {
+        let axis = self.axis;
+        let corners = [0, 1, 2, 3].map(|k| {
+            let c = q.corner(k);
+            [c[0] - axis[0], c[1] - axis[1]]
+        });
+        let (d_min, inside) = polygon_distance(&corners);
+        let (d_max, top) = (farthest(&corners), q.z[0]);
+        if inside {
+            self.add(Prim::Quad(i), (0.0, d_max, top), AROUND, None);
+            return;
+        }
+        let (sx, sy) = corners
+            .iter()
+            .fold((0.0, 0.0), |(x, y), c| (x + c[0], y + c[1]));
+        let centre = sy.atan2(sx);
+        let half = half_angle(&corners, centre);
+        let extent = (d_min, d_max, top);
+        self.add(Prim::Quad(i), extent, (centre, half), Some(&corners));
+    }
+
+    /// A primitive standing over the disc of centre `(cx, cy)` and radius `r` of the floor, its
+    /// top at `top` (a cylinder; a sphere, wherever its centre is above the floor).
+    fn add_disc(&mut self, prim: Prim, [cx, cy, r]: [f32; 3], top: f32) {
+        let dx = cx - self.axis[0];
+        let dy = cy - self.axis[1];
+        let dc = (dx * dx + dy * dy).sqrt();
+        if dc <= r {
+            self.add(prim, (0.0, dc + r, top), AROUND, None);
+            return;
+        }
+        let span = (dy.atan2(dx), (r / dc).asin());
+        self.add(prim, (dc - r, dc + r, top), span, None);
     }
 }
 
@@ -966,5 +997,130 @@ mod tests {
             }
         }
         assert!(hits > 1000 && spared > 5000, "hits {hits}, spared {spared}");
+    }
+
+    /// A field with a cube and a pillar around the corner paper's robot at the origin, and
+    /// spheres: a ball on the floor, one 300 mm up, one half behind the pillar, one in the
+    /// cube's face, a large one cut by the floor under the robot (around the axis: in every
+    /// sector) and one just above the robot's body.
+    fn sphere_scene() -> Scene {
+        use crate::labels::{Class, ObjectId};
+        use crate::layout::{Cube, FieldSpec, Layout, Pillar};
+        use crate::sphere::Sphere;
+        let layout = Layout {
+            field: Some(FieldSpec::default()),
+            cubes: vec![Cube {
+                center_mm: [-500.0, 250.0],
+                size_mm: 130.0,
+                angle_deg: 20.0,
+                rgb: crate::Rgb([200, 40, 40]),
+            }],
+            pillars: vec![Pillar {
+                center_mm: [0.0, -600.0],
+                radius_mm: 60.0,
+                height_mm: 250.0,
+                rgb: crate::Rgb([90, 90, 200]),
+            }],
+            ..Layout::default()
+        };
+        let ball = |k: u32, [x, y, z]: [f64; 3], r: f64| Sphere {
+            center_mm: [x, y, z],
+            radius_mm: r,
+            rgb: crate::Rgb([255, 120, 0]),
+            object: ObjectId::new(Class::Ball, k),
+        };
+        Scene::new(&layout, &[]).with_spheres(&[
+            ball(0, [400.0, 0.0, 21.5], 21.5),
+            ball(1, [0.0, 700.0, 321.5], 21.5),
+            ball(2, [75.0, -720.0, 21.5], 21.5),
+            ball(3, [-440.0, 250.0, 60.0], 40.0),
+            ball(4, [30.0, 10.0, -900.0], 950.0),
+            ball(5, [60.0, 0.0, 140.0], 15.0),
+        ])
+    }
+
+    #[test]
+    fn spheres_give_every_kernel_the_pixels_of_tracing_every_primitive() {
+        use crate::sensor::SensorSpec;
+        let scene = sphere_scene();
+        let first = scene.boxes.len() + scene.quads.len() + scene.cylinders.len();
+        assert_eq!(scene.globals.counts[3], 6);
+        assert_eq!(scene.objects.len(), first + 6);
+        let sensor = SensorSpec::corner_paper("omni").build();
+        let poses = [
+            Isometry2::new(nalgebra::Vector2::zeros(), 0.0),
+            Isometry2::new(nalgebra::Vector2::new(37.0, -21.0), 1.234_567),
+            Isometry2::new(nalgebra::Vector2::new(-150.0, 90.0), -2.5),
+        ];
+        let mut rays = SensorRays::new(&sensor);
+        let avx2 = cfg!(target_arch = "x86_64") && std::arch::is_x86_feature_detected!("avx2");
+        eprintln!(
+            "kernels: portable and {}",
+            if avx2 { "AVX2" } else { "portable" }
+        );
+        let mut seen = [0usize; 6];
+        for (k, pose) in poses.iter().enumerate() {
+            let traced = trace_reference(&scene, &rays, pose);
+            for (i, n) in seen.iter_mut().enumerate() {
+                let rank = (first + 1 + i) as u32;
+                *n += traced.iter().filter(|r| r.code == rank).count();
+            }
+            for (kind, mut r) in [
+                ("vector", CpuRenderer::new()),
+                ("portable", CpuRenderer::portable()),
+            ] {
+                let n = traced.len();
+                let (mut pixels, mut t, mut codes) = (vec![0; n], vec![0.0; n], vec![0; n]);
+                r.render_truth(&scene, &mut rays, pose, &mut pixels, (&mut t, &mut codes));
+                let differ = (0..n)
+                    .filter(|&i| {
+                        let want = &traced[i];
+                        (pixels[i], t[i].to_bits(), codes[i])
+                            != (want.colour, want.t.to_bits(), want.code)
+                    })
+                    .count();
+                assert_eq!(differ, 0, "pose {k}, {kind} kernel");
+                let mut plain = vec![0; n];
+                r.render(&scene, &mut rays, pose, &mut plain);
+                assert_eq!(plain, pixels, "pose {k}, {kind} kernel without truth");
+            }
+        }
+        eprintln!("sphere pixels over the poses: {seen:?}");
+        assert!(seen.iter().all(|&n| n >= 10), "sphere pixels {seen:?}");
+    }
+
+    #[test]
+    fn a_sphere_is_met_where_it_stands_and_shaded_by_its_normal() {
+        let scene = Scene::new(&crate::layout::Layout::default(), &[]).with_spheres(&[
+            crate::sphere::Sphere {
+                center_mm: [500.0, 0.0, 300.0],
+                radius_mm: 20.0,
+                rgb: crate::Rgb([255, 255, 255]),
+                object: crate::labels::ObjectId::of(crate::labels::Class::Ball),
+            },
+        ]);
+        let sp = &scene.spheres[0];
+        // Straight at it from 480 mm off, in its equator's plane: met 460 mm on, normal -x.
+        let hit = trace::hit_sphere(sp, [20.0, 0.0, 300.0], [1.0, 0.0, 0.0], f32::INFINITY)
+            .expect("a hit");
+        assert_eq!((hit.t, hit.n), (460.0, [-1.0, 0.0, 0.0]));
+        // Passing 1 mm over its top: a miss; from inside, its far side.
+        assert!(trace::hit_sphere(sp, [0.0, 0.0, 321.0], [1.0, 0.0, 0.0], 1e9).is_none());
+        let inside = trace::hit_sphere(sp, [500.0, 0.0, 300.0], [0.0, 0.0, 1.0], 1e9).unwrap();
+        assert_eq!((inside.t, inside.n), (20.0, [0.0, 0.0, 1.0]));
+        // Beyond the nearest hit so far: none.
+        assert!(trace::hit_sphere(sp, [20.0, 0.0, 300.0], [1.0, 0.0, 0.0], 460.0).is_none());
+        // Straight down on it: its top, rank 1, lit as the floor (normal +z).
+        let traced = trace::trace_ray(&scene, [500.0, 0.0, 900.0], [0.0, 0.0, -1.0]);
+        assert_eq!((traced.t, traced.code), (580.0, 1));
+        let floor_lit = trace::shade(
+            &scene,
+            &Hit {
+                t: 0.0,
+                n: trace::FLOOR_NORMAL,
+                rgb: [1.0; 3],
+            },
+        );
+        assert_eq!(traced.colour, trace::pack(floor_lit));
     }
 }

@@ -14,7 +14,7 @@
 use super::error::RenderError;
 use super::noise::{FrameNoise, gauss_table};
 use super::scene::{
-    BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals,
+    BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals, SpherePrim,
 };
 use super::trace::Code;
 use crate::optics::Optics;
@@ -239,6 +239,8 @@ struct FrameParams {
     offsets: [u32; 4],
     /// First floor rectangle, quad, pixel; the noise's key.
     offsets2: [u32; 4],
+    /// First sphere, unused.
+    offsets3: [u32; 4],
 }
 
 /// One frame to trace: the scene, the sensor, the robot's pose and the frame's noise.
@@ -288,6 +290,7 @@ struct Batch {
     stripes: Vec<f32>,
     rects: Vec<FloorRectPrim>,
     quads: Vec<QuadPrim>,
+    spheres: Vec<SpherePrim>,
     pixels: usize,
     /// The pixels of the frames that ask for their truth.
     truth_pixels: usize,
@@ -318,6 +321,7 @@ impl Batch {
                     at(b.stripes.len())?,
                 ],
                 offsets2: [at(b.rects.len())?, at(b.quads.len())?, at(b.pixels)?, key],
+                offsets3: [at(b.spheres.len())?, 0, 0, 0],
             });
             b.boxes.extend_from_slice(&sc.boxes);
             b.cylinders.extend_from_slice(&sc.cylinders);
@@ -325,6 +329,7 @@ impl Batch {
             b.stripes.extend_from_slice(&sc.stripe_edges);
             b.rects.extend_from_slice(&sc.floor_rects);
             b.quads.extend_from_slice(&sc.quads);
+            b.spheres.extend_from_slice(&sc.spheres);
             b.pixels += n;
         }
         at(b.pixels)?;
@@ -454,6 +459,8 @@ pub struct GpuRenderer {
     stripes: Storage,
     rects: Storage,
     quads: Storage,
+    /// Spheres (room for some from the start: a binding is never empty).
+    spheres: Storage,
     /// The noise's Gaussian table, written once.
     gauss: wgpu::Buffer,
     /// The frames' packed RGBA8 pixels.
@@ -535,6 +542,7 @@ impl GpuRenderer {
         let stripes = Storage::new(&device, "stripes", 64 * 4, STORAGE_RW);
         let rects = Storage::new(&device, "rects", 8 * 48, STORAGE_RW);
         let quads = Storage::new(&device, "quads", 16 * 64, STORAGE_RW);
+        let spheres = Storage::new(&device, "spheres", 16 * 32, STORAGE_RW);
         let table: &[u8] = bytemuck::cast_slice(gauss_table());
         let gauss = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("gauss"),
@@ -558,6 +566,7 @@ impl GpuRenderer {
             stripes,
             rects,
             quads,
+            spheres,
             gauss,
             pixels,
             truth,
@@ -586,6 +595,7 @@ impl GpuRenderer {
                 entry(8, ro),
                 entry(9, ro),
                 entry(10, B::Storage { read_only: false }),
+                entry(11, ro),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -759,6 +769,7 @@ impl GpuRenderer {
         rebind |= self.stripes.write(d, q, bytemuck::cast_slice(&b.stripes));
         rebind |= self.rects.write(d, q, bytemuck::cast_slice(&b.rects));
         rebind |= self.quads.write(d, q, bytemuck::cast_slice(&b.quads));
+        rebind |= self.spheres.write(d, q, bytemuck::cast_slice(&b.spheres));
         rebind
     }
 
@@ -775,6 +786,7 @@ impl GpuRenderer {
             (8, &self.quads.buffer),
             (9, &self.gauss),
             (10, &self.truth.buffer),
+            (11, &self.spheres.buffer),
         ];
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()

@@ -1,6 +1,7 @@
 //! The 3-D scene a sensor sees, as flat `f32` arrays laid out for the GPU: the floor (floor
 //! region rectangles, field lines), boxes (walls, cubes, boards), upright cylinders (pillars,
-//! robots, the observer's own body), quadrilateral prisms (mitred wall pieces) and the light.
+//! robots, the observer's own body), quadrilateral prisms (mitred wall pieces), spheres (a ball)
+//! and the light.
 //!
 //! Both tracers, the WGSL one and the CPU reference, read exactly these arrays.
 
@@ -9,6 +10,7 @@ use crate::floor_marks::MarkShape;
 use crate::labels::{Legend, ObjectId};
 use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
+use crate::sphere::Sphere;
 use crate::world::World;
 use bytemuck::{Pod, Zeroable};
 
@@ -63,6 +65,27 @@ impl QuadPrim {
     }
 }
 
+/// A sphere, anywhere above (or on) the floor.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct SpherePrim {
+    /// centre x, centre y, centre height, radius (mm).
+    pub geom: [f32; 4],
+    /// r, g, b (0..1), unused.
+    pub color: [f32; 4],
+}
+
+impl SpherePrim {
+    /// The primitive of `sphere`.
+    pub fn of(sphere: &Sphere) -> Self {
+        let [x, y, z] = sphere.center_mm;
+        Self {
+            geom: [x as f32, y as f32, z as f32, sphere.radius_mm as f32],
+            color: rgb4(sphere.rgb, 0.0),
+        }
+    }
+}
+
 /// The stripes of a board: a range of `stripe_edges` and the two alternating colours.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -102,7 +125,7 @@ pub struct SceneGlobals {
     pub field: [f32; 4],
     /// field present (0/1), any floor region (0/1), box count, cylinder count.
     pub flags: [u32; 4],
-    /// floor rectangle and mark count, board count, quad count, unused.
+    /// floor rectangle and mark count, board count, quad count, sphere count.
     pub counts: [u32; 4],
     /// Floor region colour.
     pub floor_rgb: [f32; 4],
@@ -135,8 +158,10 @@ pub struct Scene {
     pub stripe_edges: Vec<f32>,
     /// Floor-region rectangles.
     pub floor_rects: Vec<FloorRectPrim>,
-    /// What each box, quad prism and cylinder is, in that order (a primitive's rank in the
-    /// scene's order less one): the per-pixel labels' source.
+    /// Spheres.
+    pub spheres: Vec<SpherePrim>,
+    /// What each box, quad prism, cylinder and sphere is, in that order (a primitive's rank in
+    /// the scene's order less one): the per-pixel labels' source.
     pub objects: Vec<ObjectId>,
 }
 
@@ -325,8 +350,18 @@ impl Scene {
             boards,
             stripe_edges,
             floor_rects,
+            spheres: Vec::new(),
             objects: objects_by_rank(&solids),
         }
+    }
+
+    /// The scene with `spheres` added after those it has (their ranks after every other
+    /// primitive's, their objects last in [`Scene::objects`]).
+    pub fn with_spheres(mut self, spheres: &[Sphere]) -> Self {
+        self.spheres.extend(spheres.iter().map(SpherePrim::of));
+        self.objects.extend(spheres.iter().map(|s| s.object));
+        self.globals.counts[3] = self.spheres.len() as u32;
+        self
     }
 
     /// The legend of the labels of this scene's things.

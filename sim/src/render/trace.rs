@@ -1,8 +1,8 @@
 //! The scene half of the tracer in `f32`, written to match `trace.wgsl` operation for
-//! operation: floor colouring, box, quad, cylinder and floor intersections, stripe lookup, shading
-//! and packing. The CPU renderer calls these; the GPU runs the WGSL twin.
+//! operation: floor colouring, box, quad, cylinder, sphere and floor intersections, stripe lookup,
+//! shading and packing. The CPU renderer calls these; the GPU runs the WGSL twin.
 
-use super::scene::{BoxPrim, CylinderPrim, FLOOR_REGION, QuadPrim, SQUARE_MARK, Scene};
+use super::scene::{BoxPrim, CylinderPrim, FLOOR_REGION, QuadPrim, SQUARE_MARK, Scene, SpherePrim};
 
 /// A 3-vector in `f32`.
 pub type V3 = [f32; 3];
@@ -423,6 +423,51 @@ pub fn hit_cylinder(cy: &CylinderPrim, o: V3, d: V3, t_max: f32) -> Option<Hit> 
     best
 }
 
+/// Where the unit ray `o + t d` crosses a sphere: the offset `m = o - centre` and, where it
+/// crosses at all, the distances `(t0, t1)` of its entry and exit (`t0 <= t1`).
+///
+/// The discriminant is taken as `r^2 - |m - (m . d) d|^2` (the radius squared less the squared
+/// distance of the line from the centre), not as `(m . d)^2 - (|m|^2 - r^2)`, whose two large
+/// terms cancel in `f32` for a small sphere far off (4 m away, each is some 1.6e7 mm^2 and
+/// rounds by 1 or 2, against a 43 mm ball's 462 mm^2).
+#[inline]
+pub fn sphere_crossing(sp: &SpherePrim, o: V3, d: V3) -> (V3, Option<(f32, f32)>) {
+    let [cx, cy, cz, r] = sp.geom;
+    let m = [o[0] - cx, o[1] - cy, o[2] - cz];
+    let b = m[0] * d[0] + m[1] * d[1] + m[2] * d[2];
+    let fx = m[0] - b * d[0];
+    let fy = m[1] - b * d[1];
+    let fz = m[2] - b * d[2];
+    let disc = r * r - (fx * fx + fy * fy + fz * fz);
+    if disc < 0.0 {
+        return (m, None);
+    }
+    let sq = disc.sqrt();
+    (m, Some((-b - sq, -b + sq)))
+}
+
+/// The first crossing of a sphere beyond [`T_EPS`] (its entry, or its exit for a ray that starts
+/// inside), if before `t_max`, with the outward normal there.
+#[inline]
+pub fn hit_sphere(sp: &SpherePrim, o: V3, d: V3, t_max: f32) -> Option<Hit> {
+    let (m, crossing) = sphere_crossing(sp, o, d);
+    let (t0, t1) = crossing?;
+    let t = if t0 > T_EPS { t0 } else { t1 };
+    if !(t > T_EPS && t < t_max) {
+        return None;
+    }
+    let r = sp.geom[3];
+    Some(Hit {
+        t,
+        n: [
+            (m[0] + t * d[0]) / r,
+            (m[1] + t * d[1]) / r,
+            (m[2] + t * d[2]) / r,
+        ],
+        rgb: [sp.color[0], sp.color[1], sp.color[2]],
+    })
+}
+
 /// The floor hit, if the ray goes down.
 pub fn hit_floor(s: &Scene, o: V3, d: V3) -> Option<Hit> {
     let t = floor_t(o, d)?;
@@ -450,7 +495,7 @@ pub fn pack(c: V3) -> u32 {
 }
 
 /// What a ray shows, as a number: a primitive's rank in the scene's order (boxes from 1, then
-/// quad prisms, then cylinders), [`CODE_FLOOR`] with the floor paint's index
+/// quad prisms, then cylinders, then spheres), [`CODE_FLOOR`] with the floor paint's index
 /// ([`paint_index`]), or [`CODE_SKY`].
 pub type Code = u32;
 
@@ -524,6 +569,14 @@ pub fn trace_ray(s: &Scene, o: V3, d: V3) -> Traced {
     for c in &s.cylinders {
         keep(
             hit_cylinder(c, o, d, t_max),
+            &mut t_max,
+            &mut best,
+            &mut rank,
+        );
+    }
+    for sp in &s.spheres {
+        keep(
+            hit_sphere(sp, o, d, t_max),
             &mut t_max,
             &mut best,
             &mut rank,

@@ -1,14 +1,14 @@
 // omniloop catadioptric tracer: one invocation per pixel of each frame of a batch (z: frame).
 // camera ray -> mirror (hyperbolic, conical, spherical) or pinhole -> scene (floor, boxes,
-// quadrilateral prisms, cylinders, striped boards) -> Lambert shading -> packed RGBA8; a frame
-// that asks for its truth also gets, per pixel, the distance along the scene ray to what it
-// meets and what that is (trace.rs: Code).
+// quadrilateral prisms, cylinders, spheres, striped boards) -> Lambert shading -> packed RGBA8;
+// a frame that asks for its truth also gets, per pixel, the distance along the scene ray to what
+// it meets and what that is (trace.rs: Code).
 // The scene half matches sim/src/render/trace.rs operation for operation.
 
 struct Globals {
     field: vec4<f32>,       // A1, B, line width, centre circle radius
     flags: vec4<u32>,       // field present, any floor region, box count, cylinder count
-    counts: vec4<u32>,      // floor rect count, board count, quad count
+    counts: vec4<u32>,      // floor rect count, board count, quad count, sphere count
     floor_rgb: vec4<f32>,
     outside_rgb: vec4<f32>,
     line_rgb: vec4<f32>,
@@ -36,6 +36,7 @@ struct CylinderPrim { geom: vec4<f32>, color: vec4<f32>, top: vec4<f32> };
 struct BoardPrim { range: vec4<u32>, color_a: vec4<f32>, color_b: vec4<f32> };
 struct FloorRectPrim { geom: vec4<f32>, frame: vec4<f32>, color: vec4<f32> };
 struct QuadPrim { c01: vec4<f32>, c23: vec4<f32>, z: vec4<f32>, color: vec4<f32> };
+struct SpherePrim { geom: vec4<f32>, color: vec4<f32> };
 
 // One frame of a batch: its scene's scalars, its sensor and pose, and where its primitives and
 // pixels start in the shared arrays.
@@ -44,6 +45,7 @@ struct Frame {
     sensor: SensorParams,
     offsets: vec4<u32>,     // first box, cylinder, board, stripe edge
     offsets2: vec4<u32>,    // first floor rect, quad, pixel; noise key
+    offsets3: vec4<u32>,    // first sphere, unused
 };
 
 @group(0) @binding(0) var<storage, read> frames: array<Frame>;
@@ -59,18 +61,20 @@ struct Frame {
 // Per pixel of the frames that ask for their truth: the distance t along the scene ray (f32
 // bits) and what the ray meets (a code, as trace.rs's Code), the frames one after the other.
 @group(0) @binding(10) var<storage, read_write> truth: array<vec2<u32>>;
+@group(0) @binding(11) var<storage, read> spheres: array<SpherePrim>;
 
 // The invocation's frame (global_invocation_id.z), read once in main.
 var<private> g: Globals;
 var<private> sensor: SensorParams;
 var<private> off: vec4<u32>;
 var<private> off2: vec4<u32>;
+var<private> off3: vec4<u32>;
 
 const T_EPS: f32 = 1e-3;
 const BIG: f32 = 3.0e38;
 const BLACK: u32 = 0xff000000u;
 // The codes of what a pixel shows (trace.rs: Code): a primitive's rank from 1 (boxes, quads,
-// cylinders), the floor bit with the paint's index, the sky, or no mirror at all.
+// cylinders, spheres), the floor bit with the paint's index, the sky, or no mirror at all.
 const CODE_FLOOR: u32 = 0x80000000u;
 const CODE_SKY: u32 = 0xffffffffu;
 const CODE_NOTHING: u32 = 0xfffffffeu;
@@ -504,6 +508,29 @@ fn hit_cylinder(cy: CylinderPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit
     return best;
 }
 
+// The first crossing of a sphere beyond T_EPS (trace.rs: sphere_crossing, hit_sphere): the
+// discriminant as r^2 less the squared distance of the line from the centre.
+fn hit_sphere(sp: SpherePrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
+    let r = sp.geom.w;
+    let mx = o.x - sp.geom.x;
+    let my = o.y - sp.geom.y;
+    let mz = o.z - sp.geom.z;
+    let b = mx * d.x + my * d.y + mz * d.z;
+    let fx = mx - b * d.x;
+    let fy = my - b * d.y;
+    let fz = mz - b * d.z;
+    let disc = r * r - (fx * fx + fy * fy + fz * fz);
+    if (disc < 0.0) { return no_hit(); }
+    let sq = sqrt(disc);
+    let t0 = -b - sq;
+    let t1 = -b + sq;
+    var t = t1;
+    if (t0 > T_EPS) { t = t0; }
+    if (!(t > T_EPS && t < t_max)) { return no_hit(); }
+    let n = vec3<f32>((mx + t * d.x) / r, (my + t * d.y) / r, (mz + t * d.z) / r);
+    return Hit(t, n, sp.color.xyz, true);
+}
+
 fn pack(c: vec3<f32>) -> u32 {
     let q = vec3<u32>(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
     return q.x | (q.y << 8u) | (q.z << 16u) | (255u << 24u);
@@ -555,7 +582,7 @@ fn trace_scene(o: vec3<f32>, d: vec3<f32>) -> Seen {
             t_max = t;
         }
     }
-    // Ranks from 1: boxes, then quads, then cylinders.
+    // Ranks from 1: boxes, then quads, then cylinders, then spheres.
     var rank = 1u;
     for (var i = 0u; i < g.flags.z; i = i + 1u) {
         let hb = hit_box(boxes[off.x + i], o, d, t_max);
@@ -570,6 +597,11 @@ fn trace_scene(o: vec3<f32>, d: vec3<f32>) -> Seen {
     for (var i = 0u; i < g.flags.w; i = i + 1u) {
         let hc = hit_cylinder(cylinders[off.y + i], o, d, t_max);
         if (hc.ok) { best = hc; t_max = hc.t; code = rank + i; }
+    }
+    rank = rank + g.flags.w;
+    for (var i = 0u; i < g.counts.w; i = i + 1u) {
+        let hs = hit_sphere(spheres[off3.x + i], o, d, t_max);
+        if (hs.ok) { best = hs; t_max = hs.t; code = rank + i; }
     }
     return Seen(best, code);
 }
@@ -590,6 +622,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     sensor = fr.sensor;
     off = fr.offsets;
     off2 = fr.offsets2;
+    off3 = fr.offsets3;
     let w = sensor.size.x;
     let h = sensor.size.y;
     if (id.x >= w || id.y >= h) { return; }

@@ -18,7 +18,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::{Item, Prim, SECTOR_SHIFT, Sectors};
-use crate::render::scene::{BoxPrim, CylinderPrim, FLOOR_REGION, QuadPrim, SQUARE_MARK, Scene};
+use crate::render::scene::{
+    BoxPrim, CylinderPrim, FLOOR_REGION, QuadPrim, SQUARE_MARK, Scene, SpherePrim,
+};
 use crate::render::trace::{self, BoxFace, T_EPS};
 
 /// Rays in a packet.
@@ -303,6 +305,7 @@ fn trace_sector(
             Prim::Box(i) => hit_box(frame, i as usize, o, d, &limit),
             Prim::Quad(i) => hit_quad(frame, i as usize, o, d, &limit),
             Prim::Cylinder(i) => hit_cylinder(frame, i as usize, o, d, &limit),
+            Prim::Sphere(i) => hit_sphere(frame, i as usize, o, d, &limit),
         };
         near.keep(rank, &found, &t, &colour);
     }
@@ -515,6 +518,46 @@ fn hit_cylinder(frame: &FrameRays, k: usize, o: &[F; 3], d: &[F; 3], limit: &F) 
             t: t_hit[i],
             n: [normal[0][i], normal[1][i], 0.0],
             rgb: [cyl.color[0], cyl.color[1], cyl.color[2]],
+        };
+        colour[i] = trace::pack(trace::shade(frame.scene, &hit));
+    }
+    (found, t_hit, colour)
+}
+
+/// [`trace::hit_sphere`] over lanes (with [`trace::sphere_crossing`]'s steps), with the shaded
+/// colour at the hit.
+#[inline(always)]
+fn hit_sphere(frame: &FrameRays, k: usize, o: &[F; 3], d: &[F; 3], limit: &F) -> (M, F, U) {
+    let sp: &SpherePrim = &frame.scene.spheres[k];
+    let [cx, cy, cz, r] = sp.geom;
+    let (mut found, mut t_hit, mut colour) = ([false; LANES], [0.0; LANES], [0; LANES]);
+    let mut normal = [[0.0; LANES]; 3];
+    for i in 0..LANES {
+        let (dx, dy, dz) = (d[0][i], d[1][i], d[2][i]);
+        let mx = o[0][i] - cx;
+        let my = o[1][i] - cy;
+        let mz = o[2][i] - cz;
+        let b = mx * dx + my * dy + mz * dz;
+        let fx = mx - b * dx;
+        let fy = my - b * dy;
+        let fz = mz - b * dz;
+        let disc = r * r - (fx * fx + fy * fy + fz * fz);
+        let sq = disc.sqrt();
+        let t0 = -b - sq;
+        let t1 = -b + sq;
+        let t = if t0 > T_EPS { t0 } else { t1 };
+        found[i] = disc >= 0.0 && t > T_EPS && t < limit[i];
+        t_hit[i] = t;
+        normal[0][i] = (mx + t * dx) / r;
+        normal[1][i] = (my + t * dy) / r;
+        normal[2][i] = (mz + t * dz) / r;
+    }
+    // Lambert with the normal at the hit, where the sphere is hit.
+    for i in (0..LANES).filter(|&i| found[i]) {
+        let hit = trace::Hit {
+            t: t_hit[i],
+            n: [normal[0][i], normal[1][i], normal[2][i]],
+            rgb: [sp.color[0], sp.color[1], sp.color[2]],
         };
         colour[i] = trace::pack(trace::shade(frame.scene, &hit));
     }

@@ -353,6 +353,7 @@ fn trace_sector(frame: &FrameRays, sector: usize, lanes: V, sky: V, r: &Rays, ne
             Prim::Box(i) => hit_box(frame, i as usize, r, limit),
             Prim::Quad(i) => hit_quad(frame, i as usize, r, limit),
             Prim::Cylinder(i) => hit_cylinder(frame, i as usize, r, limit),
+            Prim::Sphere(i) => hit_sphere(frame, i as usize, r, limit),
         };
         near.keep(rank, found, t, colour);
     }
@@ -520,7 +521,11 @@ fn hit_cylinder(frame: &FrameRays, k: usize, r: &Rays, limit: V) -> (V, V, I) {
     let found = or(side, cap);
     let rv = splat(radius);
     let n = [div(add(mx, mul(t, dx)), rv), div(add(my, mul(t, dy)), rv)];
-    let side_colour = shade_side(frame.scene, n, [cyl.color[0], cyl.color[1], cyl.color[2]]);
+    let side_colour = shade(
+        frame.scene,
+        [n[0], n[1], zero],
+        [cyl.color[0], cyl.color[1], cyl.color[2]],
+    );
     let top_colour = splat_u(frame.sectors.cylinder_tops[k]);
     (
         found,
@@ -529,16 +534,56 @@ fn hit_cylinder(frame: &FrameRays, k: usize, r: &Rays, limit: V) -> (V, V, I) {
     )
 }
 
-/// [`trace::pack`] of [`trace::shade`] for a side (normal `n`, no z) of colour `rgb`, lane by
-/// lane: `(light + diffuse max(n . l, 0)) scale`, each channel clamped to 0..1 and rounded to
-/// the nearest of 255 levels (no lane is NaN: clamping by `min`/`max` is `f32::clamp`).
+/// The first crossing of sphere `k` beyond `T_EPS`, as `trace::hit_sphere` finds it (with
+/// `trace::sphere_crossing`'s steps), and its shaded colour.
 #[inline]
 #[target_feature(enable = "avx2")]
-fn shade_side(scene: &Scene, n: [V; 2], rgb: [f32; 3]) -> I {
+fn hit_sphere(frame: &FrameRays, k: usize, r: &Rays, limit: V) -> (V, V, I) {
+    let sp = &frame.scene.spheres[k];
+    let [cx, cy, cz, radius] = sp.geom;
+    let [dx, dy, dz] = r.d;
+    let mx = sub(r.o[0], splat(cx));
+    let my = sub(r.o[1], splat(cy));
+    let mz = sub(r.o[2], splat(cz));
+    let b = add(add(mul(mx, dx), mul(my, dy)), mul(mz, dz));
+    let fx = sub(mx, mul(b, dx));
+    let fy = sub(my, mul(b, dy));
+    let fz = sub(mz, mul(b, dz));
+    let f2 = add(add(mul(fx, fx), mul(fy, fy)), mul(fz, fz));
+    let disc = sub(splat(radius * radius), f2);
+    let sq = _mm256_sqrt_ps(disc);
+    let t0 = sub(neg(b), sq);
+    let t1 = add(neg(b), sq);
+    let eps = splat(T_EPS);
+    let t = select(gt(t0, eps), t0, t1);
+    let found = and(ge(disc, splat(0.0)), and(gt(t, eps), lt(t, limit)));
+    if !any(found) {
+        return (found, t, splat_u(0));
+    }
+    let rv = splat(radius);
+    let n = [
+        div(add(mx, mul(t, dx)), rv),
+        div(add(my, mul(t, dy)), rv),
+        div(add(mz, mul(t, dz)), rv),
+    ];
+    (
+        found,
+        t,
+        shade(frame.scene, n, [sp.color[0], sp.color[1], sp.color[2]]),
+    )
+}
+
+/// [`trace::pack`] of [`trace::shade`] for the normal `n` and colour `rgb`, lane by lane:
+/// `(light + diffuse max(n . l, 0)) scale`, each channel clamped to 0..1 and rounded to the
+/// nearest of 255 levels (a lane whose colour is kept is not NaN: clamping by `min`/`max` is
+/// `f32::clamp` there).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn shade(scene: &Scene, n: [V; 3], rgb: [f32; 3]) -> I {
     let g = &scene.globals;
     let dot = add(
         add(mul(n[0], splat(g.light[0])), mul(n[1], splat(g.light[1]))),
-        mul(splat(0.0), splat(g.light[2])),
+        mul(n[2], splat(g.light[2])),
     );
     let lambert = _mm256_max_ps(dot, splat(0.0));
     let k = mul(
