@@ -164,15 +164,18 @@ pub fn truth_frame(
     let legend = scene.legend();
     let labeller = Labeller::new(scene, &legend, own_body(scene, pose));
     let n = rays.len().min(t.len()).min(codes.len());
-    // In parallel over the cores, in runs of rows.
-    let labels: Vec<u16> = (codes[..n].par_iter())
-        .with_min_len(PIXELS_A_TASK)
-        .zip(&rays.path_mm[..n])
-        .map(|(&code, path)| {
-            let code = if path.is_nan() { CODE_NOTHING } else { code };
-            labeller.label(code)
-        })
-        .collect();
+    // In parallel over the cores, in runs of rows, each a plain loop (whose pixels the
+    // compiler sees together, however it inlines the parallel iterator).
+    let mut labels = vec![labels::NOTHING; n];
+    (labels.par_chunks_mut(PIXELS_A_TASK))
+        .zip(codes[..n].par_chunks(PIXELS_A_TASK))
+        .zip(rays.path_mm[..n].par_chunks(PIXELS_A_TASK))
+        .for_each(|((out, codes), paths)| {
+            for ((label, &code), path) in out.iter_mut().zip(codes).zip(paths) {
+                let code = if path.is_nan() { CODE_NOTHING } else { code };
+                *label = labeller.label(code);
+            }
+        });
     // The sky's distance is infinite, a pixel that sees no mirror has none (its path is NaN):
     // the sum holds both.
     let depth_mm: Vec<f32> = (rays.path_mm[..n].par_iter())
