@@ -603,3 +603,53 @@ fn auto_picks_a_hardware_gpu_and_passes_over_a_software_rasterizer() {
         assert!(said.is_empty(), "{said}");
     }
 }
+
+/// Golden images with the ball: each render example's first camera (no noise, CPU) with a ball
+/// on the floor 400 mm ahead of the robot and one in the air (a chip, 300 mm up, 500 mm ahead
+/// and 300 mm to the right), each visible (the frame differs from the one without them), against
+/// `tests/golden/NAME_ball.png` as the examples are against theirs.
+#[test]
+fn golden_images_of_the_render_examples_with_a_ball() {
+    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
+    let bless = std::env::var_os("OMNILOOP_BLESS").is_some();
+    let mut cpu = Renderer::cpu();
+    for name in RENDER_EXAMPLES {
+        let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
+        let world = omniloop_sim::World::new(&s.world, &s.robot_bodies(), 0.002).unwrap();
+        let pose = world.robot_state(0).pose;
+        let at = |ahead: f64, left: f64| pose * nalgebra::Point2::new(ahead, left);
+        let ball = |p: nalgebra::Point2<f64>, z: f64| Sphere {
+            center_mm: [p.x, p.y, z],
+            radius_mm: 21.5,
+            rgb: Rgb([255, 110, 20]),
+            object: ObjectId::of(Class::Ball),
+        };
+        let balls = [ball(at(400.0, 0.0), 21.5), ball(at(500.0, -300.0), 300.0)];
+        let sensor = s.robot.sensors[0].build();
+        let bare = cpu
+            .render(&Scene::of_world(&world), &sensor, &pose, None)
+            .unwrap();
+        let scene = Scene::of_world(&world).with_spheres(&balls);
+        let img = cpu.render(&scene, &sensor, &pose, None).unwrap();
+        let changed = img
+            .pixels()
+            .zip(bare.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(changed >= 4, "{name}: the balls change {changed} pixels");
+        let path = golden_dir.join(format!("{name}_ball.png"));
+        if bless {
+            img.save(&path).unwrap();
+            continue;
+        }
+        let golden = image::open(&path)
+            .unwrap_or_else(|e| panic!("{}: {e} (OMNILOOP_BLESS=1 writes it)", path.display()))
+            .to_rgba8();
+        assert_eq!(golden.dimensions(), img.dimensions(), "{name}");
+        let off = (img.pixels().zip(golden.pixels()))
+            .filter(|(p, q)| (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 2))
+            .count();
+        let total = (img.width() * img.height()) as usize;
+        assert!(off * 200 <= total, "{name}: {off} of {total} pixels differ");
+    }
+}

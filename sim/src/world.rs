@@ -561,6 +561,22 @@ impl World {
         self.play.as_ref().map(|p| (&p.spec, p.state))
     }
 
+    /// The ball as the renderers see it: a sphere labelled `ball` (none without a ball).
+    pub fn spheres(&self) -> Vec<crate::sphere::Sphere> {
+        (self.play.iter())
+            .map(|p| crate::sphere::Sphere {
+                center_mm: [
+                    p.state.position_mm.x,
+                    p.state.position_mm.y,
+                    p.state.height_mm,
+                ],
+                radius_mm: p.spec.radius_mm,
+                rgb: p.spec.rgb,
+                object: ObjectId::of(Class::Ball),
+            })
+            .collect()
+    }
+
     /// The robot whose dribbler holds the ball.
     pub fn ball_holder(&self) -> Option<usize> {
         self.play.as_ref().and_then(play::Play::holder)

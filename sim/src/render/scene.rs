@@ -265,12 +265,13 @@ impl Scene {
         Self::from_solids(layout, layout.solids().iter().chain(extra))
     }
 
-    /// The scene a world shows now: its layout, its solids and every robot.
+    /// The scene a world shows now: its layout, its solids, every robot and the ball.
     pub fn of_world(world: &World) -> Self {
         Self::from_solids(
             world.layout(),
             world.solids().iter().chain(&world.robot_solids(None)),
         )
+        .with_spheres(&world.spheres())
     }
 
     /// The scene of a layout's floor with the given solids (which must include the layout's own
