@@ -538,32 +538,38 @@ fn a_gpu_batch_of_scenes_with_and_without_spheres_equals_its_frames_alone() {
 /// far more). `OMNILOOP_BLESS=1 cargo test --test renderer golden` rewrites them.
 #[test]
 fn golden_images_of_the_render_examples() {
-    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
-    let bless = std::env::var_os("OMNILOOP_BLESS").is_some();
     let mut cpu = Renderer::cpu();
     for name in RENDER_EXAMPLES {
         let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
         let img = render_snapshot(&s, &mut cpu, None, None, false).unwrap();
-        let path = golden_dir.join(format!("{name}.png"));
-        if bless {
-            img.save(&path).unwrap();
-            continue;
-        }
-        let golden = image::open(&path)
-            .unwrap_or_else(|e| panic!("{}: {e} (OMNILOOP_BLESS=1 writes it)", path.display()))
-            .to_rgba8();
-        assert_eq!(golden.dimensions(), img.dimensions(), "{name}");
-        let off = img
-            .pixels()
-            .zip(golden.pixels())
-            .filter(|(p, q)| (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 2))
-            .count();
-        let total = (img.width() * img.height()) as usize;
-        assert!(
-            off * 200 <= total,
-            "{name}: {off} of {total} pixels differ from the golden image by more than 2 levels"
-        );
+        against_golden(name, &img);
     }
+}
+
+/// Compares `img` with `tests/golden/NAME.png` (at most 0.5% of its pixels more than 2 levels
+/// off in some channel), or writes it there with `OMNILOOP_BLESS` set.
+fn against_golden(name: &str, img: &image::RgbaImage) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(format!("{name}.png"));
+    if std::env::var_os("OMNILOOP_BLESS").is_some() {
+        img.save(&path).unwrap();
+        return;
+    }
+    let golden = image::open(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (OMNILOOP_BLESS=1 writes it)", path.display()))
+        .to_rgba8();
+    assert_eq!(golden.dimensions(), img.dimensions(), "{name}");
+    let off = img
+        .pixels()
+        .zip(golden.pixels())
+        .filter(|(p, q)| (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 2))
+        .count();
+    let total = (img.width() * img.height()) as usize;
+    assert!(
+        off * 200 <= total,
+        "{name}: {off} of {total} pixels differ from the golden image by more than 2 levels"
+    );
 }
 
 #[test]
@@ -610,8 +616,6 @@ fn auto_picks_a_hardware_gpu_and_passes_over_a_software_rasterizer() {
 /// `tests/golden/NAME_ball.png` as the examples are against theirs.
 #[test]
 fn golden_images_of_the_render_examples_with_a_ball() {
-    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
-    let bless = std::env::var_os("OMNILOOP_BLESS").is_some();
     let mut cpu = Renderer::cpu();
     for name in RENDER_EXAMPLES {
         let s = load_scenario(&scenario(&format!("{name}.toml"))).unwrap();
@@ -637,19 +641,6 @@ fn golden_images_of_the_render_examples_with_a_ball() {
             .filter(|(a, b)| a != b)
             .count();
         assert!(changed >= 4, "{name}: the balls change {changed} pixels");
-        let path = golden_dir.join(format!("{name}_ball.png"));
-        if bless {
-            img.save(&path).unwrap();
-            continue;
-        }
-        let golden = image::open(&path)
-            .unwrap_or_else(|e| panic!("{}: {e} (OMNILOOP_BLESS=1 writes it)", path.display()))
-            .to_rgba8();
-        assert_eq!(golden.dimensions(), img.dimensions(), "{name}");
-        let off = (img.pixels().zip(golden.pixels()))
-            .filter(|(p, q)| (0..3).any(|c| (p.0[c] as i32 - q.0[c] as i32).abs() > 2))
-            .count();
-        let total = (img.width() * img.height()) as usize;
-        assert!(off * 200 <= total, "{name}: {off} of {total} pixels differ");
+        against_golden(&format!("{name}_ball"), &img);
     }
 }

@@ -16,8 +16,12 @@ Importing this module registers ``omniloop/Scenario-v0``::
 - Action: a ``Box`` of body-frame velocities within the scenario's limits:
   ``(vx_mm_s, vy_mm_s, omega_rad_s)`` with ``|v| <= robot.max_speed_mm_s`` per axis and
   ``|omega| <= max_omega_rad_s`` (default pi rad/s), or ``(v_mm_s, omega_rad_s)`` for a
-  differential robot (its turn rate limit from ``[robot.differential]``). Actions outside are
-  clipped to the box.
+  differential robot (its turn rate limit from ``[robot.differential]``). A robot with a kicker
+  (``[robot.kicker]``) takes two more: ``kick_mm_s`` (0 to its kicker's limit: above 0 arms a
+  flat kick that fires when the ball is at the dribbler, 0 disarms) and ``dribbler_rpm`` (0 to
+  its full pull's speed), and its observation has ``"ball_in_dribbler"`` (``float32[1]``: the
+  light barrier, 1 when it sees the ball); the vector environment drives the wheels alone.
+  Actions outside are clipped to the box.
 - Reward: progress toward the goal over the step in metres (the true distance before minus
   after), minus ``contact_penalty`` (default 1.0) for each new contact with a wall, cube,
   pillar or robot; without a goal, the contact penalty alone.
@@ -101,6 +105,7 @@ class _Task:
         robot: RobotInfo,
         contact_penalty: float,
         max_omega_rad_s: Optional[float],
+        ball_actions: bool = True,
     ) -> None:
         if not (math.isfinite(contact_penalty) and contact_penalty >= 0.0):
             raise ValueError(f"contact_penalty={contact_penalty}: a finite number >= 0")
@@ -118,13 +123,25 @@ class _Task:
             high = np.array([vmax, vmax, wmax], dtype=np.float32)
         if not (math.isfinite(wmax) and wmax > 0.0):
             raise ValueError(f"max_omega_rad_s={max_omega_rad_s}: a finite number > 0")
-        self.action_space = spaces.Box(-high, high, dtype=np.float32)
+        low = -high
+        self.kicker = robot["kicker"] if ball_actions else None
+        #: How many of the action's numbers drive the wheels (the rest: kick, dribbler).
+        self.motion = len(high)
+        if self.kicker is not None:
+            more = [self.kicker["max_kick_mm_s"], self.kicker["full_pull_rpm"]]
+            high = np.concatenate([high, np.array(more, dtype=np.float32)])
+            low = np.concatenate([low, np.zeros(2, dtype=np.float32)])
+        self.action_space = spaces.Box(low, high, dtype=np.float32)
         parts: dict[str, spaces.Space[Any]] = {
             name: spaces.Box(0, 255, (h, w, 3), dtype=np.uint8) for name, h, w in self.sensors
         }
-        if "odometry" in parts or "goal" in parts:
-            raise ValueError("a camera may not be called `odometry` or `goal` in a Gym env")
+        if {"odometry", "goal", "ball_in_dribbler"} & set(parts):
+            raise ValueError(
+                "a camera may not be called `odometry`, `goal` or `ball_in_dribbler` in a Gym env"
+            )
         parts["odometry"] = spaces.Box(-np.inf, np.inf, (3,), dtype=np.float32)
+        if self.kicker is not None:
+            parts["ball_in_dribbler"] = spaces.Box(0.0, 1.0, (1,), dtype=np.float32)
         if self.goal is not None:
             parts["goal"] = spaces.Box(-np.inf, np.inf, (2,), dtype=np.float32)
         self.observation_space = spaces.Dict(parts)
@@ -133,6 +150,9 @@ class _Task:
         out: dict[str, np.ndarray] = {name: obs.frames[name] for name, _, _ in self.sensors}
         o = obs.odometry
         out["odometry"] = np.array([o.vx_mm_s, o.vy_mm_s, o.omega_rad_s], dtype=np.float32)
+        if self.kicker is not None:
+            seen = 1.0 if obs.ball_in_dribbler else 0.0
+            out["ball_in_dribbler"] = np.array([seen], dtype=np.float32)
         if self.goal is not None:
             x, y, theta = obs.odometry_pose
             dx, dy = self.goal[0] - x, self.goal[1] - y
@@ -158,6 +178,14 @@ class _Task:
         if not np.all(np.isfinite(a)):
             raise ValueError(f"action {a} is not finite")
         return np.clip(a, self.action_space.low, self.action_space.high)
+
+    def split(self, a: np.ndarray) -> tuple[np.ndarray, Optional[list[Any]]]:
+        """A clipped action as the wheels' command and, with a kicker, the kick and dribbler
+        commands of ``Simulation.step``."""
+        if self.kicker is None:
+            return a, None
+        kick, rpm = float(a[self.motion]), float(a[self.motion + 1])
+        return a[: self.motion], [{"kick_mm_s": kick}, {"dribbler_rpm": rpm}]
 
 
 class OmniloopEnv(gymnasium.Env):
@@ -210,7 +238,8 @@ class OmniloopEnv(gymnasium.Env):
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         if self._episode_seed is None:
             raise RuntimeError("call reset() before step()")
-        obs = self.sim.step(self._task.command(action))
+        motion, actuators = self._task.split(self._task.command(action))
+        obs = self.sim.step(motion, actuators=actuators)
         truth = self.sim.truth()
         reward = self._task.reward(self._truth, truth)
         self._truth = truth
@@ -241,7 +270,9 @@ class OmniloopVectorEnv(VectorEnv):
         truth_frames: bool = False,
     ) -> None:
         self.scenario = _one_robot(_scenario(scenario))
-        self._task = _Task(self.scenario.robot, contact_penalty, max_omega_rad_s)
+        self._task = _Task(
+            self.scenario.robot, contact_penalty, max_omega_rad_s, ball_actions=False
+        )
         self.num_envs = int(num_envs)
         self.single_observation_space = self._task.observation_space
         self.single_action_space = self._task.action_space

@@ -14,7 +14,9 @@ Every agent sees, acts and is rewarded as the Gymnasium environment's one robot
 (``omniloop.gym``): its observation is a ``Dict`` of its own camera images (by sensor name),
 ``"odometry"`` (``float32[3]``, its wheel odometry) and ``"goal"`` (``float32[2]``: its goal
 in its body frame, where its own dead reckoning puts it; absent without a goal); its action a
-``Box`` of body-frame velocities within its limits; its reward its progress toward its goal
+``Box`` of body-frame velocities within its limits (with a kicker also ``kick_mm_s`` and
+``dribbler_rpm``, and ``"ball_in_dribbler"`` in its observation, as ``omniloop.gym`` has them);
+its reward its progress toward its goal
 over the step in metres, minus ``contact_penalty`` for each new contact of its (a wall, a
 cube, a pillar or another robot). The other robots are what its cameras show: no agent sees
 another's state or the truth. ``infos[agent]`` holds its truth (for scoring, never in an
@@ -147,11 +149,15 @@ class OmniloopParallelEnv(ParallelEnv):  # type: ignore[misc]
         missing = [a for a in self.agents if a not in actions]
         if missing:
             raise ValueError(f"no action for agent {missing[0]!r}")
-        commands = {
-            a: (self._tasks[a].command(actions[a]) if a in actions else self._still[a])
+        split = {
+            a: self._tasks[a].split(
+                self._tasks[a].command(actions[a]) if a in actions else self._still[a]
+            )
             for a in self.possible_agents
         }
-        obs = cast("dict[str, Observation]", self.sim.step(commands))
+        commands = {a: c for a, (c, _) in split.items()}
+        kicks = {a: k for a, (_, k) in split.items() if k is not None}
+        obs = cast("dict[str, Observation]", self.sim.step(commands, actuators=kicks or None))
         truth = cast("dict[str, Truth]", self.sim.truth())
         done = self.sim.done
         observations, rewards, terminations, truncations, infos = {}, {}, {}, {}, {}

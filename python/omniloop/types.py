@@ -20,6 +20,7 @@ __all__ = [
     "FreeSpace",
     "Goal",
     "Kick",
+    "KickerInfo",
     "LegendEntry",
     "OdometryErrors",
     "PanAt",
@@ -148,6 +149,17 @@ class Goal(TypedDict):
     waypoints_mm: List[List[float]]
 
 
+class KickerInfo(TypedDict):
+    """A robot's kicker and dribbler (``RobotInfo["kicker"]``)."""
+
+    #: The fastest kick, mm/s.
+    max_kick_mm_s: float
+    #: The dribbler speed of its full pull, rpm.
+    full_pull_rpm: float
+    #: The flat front's distance from the centre, mm.
+    front_mm: float
+
+
 class RobotInfo(TypedDict):
     """What a robot knows of itself (``Scenario.robot``, ``Scenario.robots``)."""
 
@@ -159,6 +171,8 @@ class RobotInfo(TypedDict):
     accel_limit_mm_s2: float
     angular_accel_limit_rad_s2: float
     differential: Optional[Differential]
+    #: Its kicker and dribbler (``[robot.kicker]``), if it has them.
+    kicker: Optional[KickerInfo]
     sensors: List[SensorInfo]
     odometry: OdometryErrors
     goal: Optional[Goal]

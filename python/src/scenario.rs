@@ -213,6 +213,16 @@ fn robot_dict<'py>(py: Python<'py>, s: &Scenario, name: &str) -> PyResult<Bound<
     d.set_item("max_speed_mm_s", r.max_speed_mm_s)?;
     d.set_item("accel_limit_mm_s2", r.accel_limit_mm_s2)?;
     d.set_item("angular_accel_limit_rad_s2", r.angular_accel_limit_rad_s2)?;
+    match &r.kicker {
+        Some(k) => {
+            let kd = PyDict::new(py);
+            kd.set_item("max_kick_mm_s", k.max_kick_mm_s)?;
+            kd.set_item("full_pull_rpm", k.full_pull_rpm)?;
+            kd.set_item("front_mm", k.front_mm)?;
+            d.set_item("kicker", kd)?;
+        }
+        None => d.set_item("kicker", py.None())?,
+    }
     match &r.differential {
         Some(diff) => {
             let dd = PyDict::new(py);

@@ -76,6 +76,14 @@ def test_gymnasium_and_pettingzoo_checks_pass_with_a_ball():
     env = omniloop.gym.OmniloopEnv(scenario)
     check_env(env, skip_render_check=True)
     assert gymnasium is not None
+    # The kicker's two numbers after the wheels', the light barrier in the observation.
+    assert env.action_space.shape == (5,)
+    assert list(env.action_space.high[3:]) == [6500.0, 5000.0]
+    assert env.observation_space["ball_in_dribbler"].shape == (1,)
+    # The vector environment drives the wheels alone.
+    vec = omniloop.gym.OmniloopVectorEnv(scenario, num_envs=2)
+    assert vec.single_action_space.shape == (3,)
+    vec.close()
     pytest.importorskip("pettingzoo")
     from pettingzoo.test import parallel_api_test
 
@@ -83,3 +91,17 @@ def test_gymnasium_and_pettingzoo_checks_pass_with_a_ball():
 
     teams = omniloop.Scenario.load(SCENARIOS / "ssl_teams_ball.toml")
     parallel_api_test(omniloop.pettingzoo.parallel_env(teams), num_cycles=3)
+
+
+def test_a_gym_agent_kicks_with_its_action(rollout):
+    import numpy as np
+
+    pytest.importorskip("gymnasium")
+    import omniloop.gym
+
+    env = omniloop.gym.OmniloopEnv(rollout)
+    obs, _ = env.reset(seed=1)
+    assert obs["ball_in_dribbler"][0] == 1.0
+    obs, _, _, _, info = env.step(np.array([0.0, 0.0, 0.0, 2000.0, 0.0], dtype=np.float32))
+    assert info["ball"]["vx_mm_s"] > 1500.0
+    assert obs["ball_in_dribbler"][0] == 0.0

@@ -24,8 +24,10 @@ def test_an_observation_holds_what_the_sensors_give(corner):
     assert obs.estimates is None
     # The truth is the simulator's: no pose, contacts or goal flag in an observation.
     public = {a for a in dir(obs) if not a.startswith("_")}
+    # What the robot's sensors give, the light barrier of a dribbler among them; no truth.
     assert public == {
-        "t_s", "cycle", "frames", "odometry", "odometry_pose", "actuators", "done", "estimates"
+        "t_s", "cycle", "frames", "odometry", "odometry_pose", "actuators", "ball_in_dribbler",
+        "done", "estimates",
     }
     truth = sim.truth()
     assert truth["x_mm"] > corner.robot["start"][0]
