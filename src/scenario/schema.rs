@@ -440,7 +440,7 @@ impl Scenario {
             rgb: self.robot.rgb,
             marking_rgb: self.robot.marking_rgb,
             differential: self.differential_drive(),
-            kicker: self.robot.kicker.clone(),
+            kicker: self.robot.kicker,
         }
     }
 
