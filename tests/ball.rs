@@ -22,6 +22,7 @@ fn striker(x: f64, y: f64, heading: f64) -> RobotBodySpec {
         height_mm: 150.0,
         accel_limit_mm_s2: 6000.0,
         angular_accel_limit_rad_s2: 40.0,
+        max_speed_mm_s: 3000.0,
         rgb: Rgb([20, 20, 20]),
         marking_rgb: None,
         differential: None,

@@ -21,7 +21,8 @@ Importing this module registers ``omniloop/Scenario-v0``::
   flat kick that fires when the ball is at the dribbler, 0 disarms) and ``dribbler_rpm`` (0 to
   its full pull's speed), and its observation has ``"ball_in_dribbler"`` (``float32[1]``: the
   light barrier, 1 when it sees the ball); the vector environment drives the wheels alone.
-  Actions outside are clipped to the box.
+  Actions outside are clipped to the box; the world then scales a velocity over the top speed
+  down to it by its norm (a diagonal at the box's corner runs at the top speed, not 1.41 times it).
 - Reward: progress toward the goal over the step in metres (the true distance before minus
   after), minus ``contact_penalty`` (default 1.0) for each new contact with a wall, cube,
   pillar or robot; without a goal, the contact penalty alone.

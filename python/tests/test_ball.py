@@ -105,3 +105,13 @@ def test_a_gym_agent_kicks_with_its_action(rollout):
     obs, _, _, _, info = env.step(np.array([0.0, 0.0, 0.0, 2000.0, 0.0], dtype=np.float32))
     assert info["ball"]["vx_mm_s"] > 1500.0
     assert obs["ball_in_dribbler"][0] == 0.0
+
+
+def test_the_world_holds_every_robot_to_its_top_speed_by_the_norm(smoke):
+    # smoke.toml's robot: 400 mm/s at most, 300 mm/s^2; a diagonal of 400 on each axis asks 566.
+    sim = omniloop.Simulation(smoke)
+    sim.reset(seed=1)
+    for _ in range(100):
+        sim.step((400.0, 400.0, 0.0))
+    t = sim.truth()
+    assert math.hypot(t["vx_mm_s"], t["vy_mm_s"]) == pytest.approx(400.0, abs=1.0)

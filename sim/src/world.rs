@@ -40,6 +40,8 @@ pub struct RobotBodySpec {
     pub accel_limit_mm_s2: f64,
     /// Rotational acceleration limit.
     pub angular_accel_limit_rad_s2: f64,
+    /// Top speed: a command faster than this is scaled down to it by its norm, whoever gave it.
+    pub max_speed_mm_s: f64,
     /// Body colour (for rendering).
     pub rgb: Rgb,
     /// Colour of its top face, a team's marking that other robots' cameras see (for
@@ -264,11 +266,15 @@ impl World {
     }
 
     /// Sets the velocity command (world frame) robot `i` follows (through its drive) from now
-    /// on. A differential robot keeps the part along its present heading: it cannot move
-    /// sideways.
-    pub fn set_command(&mut self, i: usize, command: VelocityCommand) {
+    /// on, scaled down by its norm to the robot's top speed where it is faster. A differential
+    /// robot keeps the part along its present heading: it cannot move sideways.
+    pub fn set_command(&mut self, i: usize, mut command: VelocityCommand) {
         let heading = self.robot_state(i).pose.rotation;
         let r = &mut self.robots[i];
+        let speed = command.v_mm_s.norm();
+        if speed > r.spec.max_speed_mm_s {
+            command.v_mm_s *= r.spec.max_speed_mm_s / speed;
+        }
         r.command = match r.spec.differential {
             None => command,
             Some(_) => VelocityCommand {
@@ -644,6 +650,7 @@ mod tests {
             height_mm: 140.0,
             accel_limit_mm_s2: 300.0,
             angular_accel_limit_rad_s2: 10.0,
+            max_speed_mm_s: 3000.0,
             rgb: Rgb([20, 20, 20]),
             marking_rgb: None,
             differential: None,
@@ -704,6 +711,23 @@ mod tests {
         w.advance(3.0);
         assert_eq!(w.stats(0).contacts, 0);
         assert!((w.stats(0).min_clearance_mm - 10.0).abs() < 0.5);
+    }
+
+    #[test]
+    fn a_command_over_the_top_speed_is_scaled_down_by_its_norm() {
+        let mut spec = robot_at(0.0, 0.0);
+        spec.max_speed_mm_s = 400.0;
+        let mut w = World::new(&Layout::default(), &[spec], 0.002).unwrap();
+        // A diagonal 400 mm/s on each axis: 566 mm/s, taken as 400 along the same direction.
+        w.set_command(0, VelocityCommand::translate(Vector2::new(400.0, 400.0)));
+        let c = w.command(0).v_mm_s;
+        assert!((c.norm() - 400.0).abs() < 1e-9 && (c.x - c.y).abs() < 1e-9, "{c}");
+        w.advance(3.0);
+        let v = w.robot_state(0).velocity_mm_s;
+        assert!((v.norm() - 400.0).abs() < 0.5, "{v}");
+        // Within the top speed: as given.
+        w.set_command(0, VelocityCommand::translate(Vector2::new(100.0, -50.0)));
+        assert_eq!(w.command(0).v_mm_s, Vector2::new(100.0, -50.0));
     }
 
     #[test]

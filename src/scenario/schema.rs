@@ -187,7 +187,8 @@ pub struct RobotSpec {
     /// Body height.
     #[serde(default = "default_height")]
     pub height_mm: f64,
-    /// Top speed the controllers command.
+    /// Top speed: the controllers command at most this, and the world scales a faster command
+    /// down to it by its norm (from Rust, Python, Gymnasium, PettingZoo and ROS 2 alike).
     #[serde(default = "default_max_speed")]
     pub max_speed_mm_s: f64,
     /// Translational acceleration limit alpha of eq. (8).
@@ -420,6 +421,7 @@ impl Scenario {
                 height_mm: o.height_mm,
                 accel_limit_mm_s2: o.accel_limit_mm_s2,
                 angular_accel_limit_rad_s2: default_angular_accel(),
+                max_speed_mm_s: o.max_speed_mm_s,
                 rgb: o.rgb,
                 marking_rgb: None,
                 differential: None,
@@ -437,6 +439,7 @@ impl Scenario {
             height_mm: self.robot.height_mm,
             accel_limit_mm_s2: self.robot.accel_limit_mm_s2,
             angular_accel_limit_rad_s2: self.robot.angular_accel_limit_rad_s2,
+            max_speed_mm_s: self.robot.max_speed_mm_s,
             rgb: self.robot.rgb,
             marking_rgb: self.robot.marking_rgb,
             differential: self.differential_drive(),
