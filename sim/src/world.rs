@@ -271,8 +271,10 @@ impl World {
     pub fn set_command(&mut self, i: usize, mut command: VelocityCommand) {
         let heading = self.robot_state(i).pose.rotation;
         let r = &mut self.robots[i];
+        // Over by more than rounding (a controller's command at the top speed may come out a
+        // bit above it): scaled down.
         let speed = command.v_mm_s.norm();
-        if speed > r.spec.max_speed_mm_s {
+        if speed > r.spec.max_speed_mm_s * (1.0 + 1e-9) {
             command.v_mm_s *= r.spec.max_speed_mm_s / speed;
         }
         r.command = match r.spec.differential {
@@ -721,7 +723,10 @@ mod tests {
         // A diagonal 400 mm/s on each axis: 566 mm/s, taken as 400 along the same direction.
         w.set_command(0, VelocityCommand::translate(Vector2::new(400.0, 400.0)));
         let c = w.command(0).v_mm_s;
-        assert!((c.norm() - 400.0).abs() < 1e-9 && (c.x - c.y).abs() < 1e-9, "{c}");
+        assert!(
+            (c.norm() - 400.0).abs() < 1e-9 && (c.x - c.y).abs() < 1e-9,
+            "{c}"
+        );
         w.advance(3.0);
         let v = w.robot_state(0).velocity_mm_s;
         assert!((v.norm() - 400.0).abs() < 0.5, "{v}");
