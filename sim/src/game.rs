@@ -274,11 +274,6 @@ impl Referee {
     pub fn figures(&self) -> &BallFigures {
         &self.figures
     }
-
-    /// Who touched the ball last.
-    pub fn last_touch(&self) -> Option<usize> {
-        self.last_touch
-    }
 }
 
 #[cfg(test)]

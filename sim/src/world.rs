@@ -538,11 +538,6 @@ impl World {
         }
     }
 
-    /// What robot `i` commands its kicker and dribbler.
-    pub fn ball_command(&self, i: usize) -> BallCommand {
-        self.robots[i].ball_command
-    }
-
     /// Whether robot `i`'s light barrier sees the ball now (false without a kicker or ball).
     pub fn light_barrier(&self, i: usize) -> bool {
         let Some(play) = &self.play else {
