@@ -4,7 +4,7 @@
 //! further than the rules allow (1 m) and the ball faster than their limit (6.5 m/s).
 
 use crate::ball::{BallSpec, BallState};
-use crate::layout::FieldSpec;
+use crate::FieldSpec;
 use nalgebra::Point2;
 use serde::Serialize;
 

@@ -46,6 +46,25 @@ pub enum Class {
 }
 
 impl Class {
+    /// Every class, in the order of their numbers.
+    pub const ALL: [Class; 15] = [
+        Class::Nothing,
+        Class::Sky,
+        Class::OwnBody,
+        Class::FloorRegion,
+        Class::FloorLine,
+        Class::FloorMark,
+        Class::FloorOutside,
+        Class::FieldWall,
+        Class::Wall,
+        Class::Goal,
+        Class::Cube,
+        Class::Pillar,
+        Class::Board,
+        Class::Robot,
+        Class::Ball,
+    ];
+
     /// Whether the class is the floor (region, lines, marks or outside).
     pub fn is_floor(self) -> bool {
         matches!(

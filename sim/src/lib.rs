@@ -2,14 +2,11 @@
 //! Small-Size field (or any floor of walls, cubes and pillars) and acceleration-limited
 //! omnidirectional robots.
 
-pub mod ball;
 pub mod calibration;
 pub mod color;
-pub mod corridor;
-pub mod floor_marks;
-pub mod floor_rect;
 pub mod game;
 pub mod kicker;
+pub mod kinds;
 pub mod labels;
 pub mod layout;
 pub mod optics;
@@ -20,6 +17,9 @@ pub mod shapes;
 pub mod sphere;
 pub mod world;
 
+// The kinds' modules under their old paths too.
+pub use kinds::{ball, corridor, floor_marks, floor_rect};
+
 pub use ball::{BallSpec, BallState};
 pub use color::Rgb;
 pub use corridor::Corridor;
@@ -27,7 +27,13 @@ pub use floor_marks::{FloorMark, MarkScatter, MarkShape};
 pub use floor_rect::FloorRect;
 pub use game::{BallEvent, BallFigures, GoalSide, Release};
 pub use kicker::{BallCommand, Kick, KickerSpec};
-pub use layout::{Board, Cube, FieldSpec, Layout, Pillar, Wall};
+pub use kinds::board::Board;
+pub use kinds::cube::Cube;
+pub use kinds::field::FieldSpec;
+pub use kinds::pillar::Pillar;
+pub use kinds::wall::Wall;
+pub use kinds::{FieldLines, Kind, KindVisitor, MapFeature, Stripes};
+pub use layout::Layout;
 pub use reachability::{Reachability, Target, reachability};
 pub use render::{
     CameraEffects, FrameNoise, FrameRequest, RenderError, Renderer, RendererChoice, Scene,
@@ -36,7 +42,7 @@ pub use render::{
 pub use sensor::{Sensor, SensorSpec};
 pub use shapes::{Solid, SolidShape};
 pub use sphere::Sphere;
-pub use world::{RobotBodySpec, RobotState, RobotStats, World};
+pub use world::{ContactsByClass, RobotBodySpec, RobotState, RobotStats, World};
 
 /// Errors of the simulator.
 #[derive(Debug, thiserror::Error)]

@@ -442,7 +442,7 @@ fn widest_mm(grid: &Grid, radius_mm: f64, start: usize, regions: &[Vec<usize>]) 
 mod tests {
     use super::*;
     use crate::color::Rgb;
-    use crate::layout::{Cube, FieldSpec, Wall};
+    use crate::{Cube, FieldSpec, Wall};
 
     fn field(cubes: Vec<Cube>, walls: Vec<Wall>) -> Layout {
         Layout {

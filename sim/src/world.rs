@@ -65,6 +65,35 @@ pub struct RobotState {
     pub omega_rad_s: f64,
 }
 
+/// Touches counted by the class of what was touched.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ContactsByClass([u32; Class::ALL.len()]);
+
+impl ContactsByClass {
+    /// One more touch of a thing of `class`.
+    fn add(&mut self, class: Class) {
+        self.0[class as usize] += 1;
+    }
+
+    /// How many touches of things of `class`.
+    pub fn of(&self, class: Class) -> u32 {
+        self.0[class as usize]
+    }
+
+    /// The classes touched at least once, with their counts, in the classes' order.
+    pub fn touched(&self) -> impl Iterator<Item = (Class, u32)> + '_ {
+        Class::ALL.into_iter().map(|c| (c, self.of(c))).filter(|(_, n)| *n > 0)
+    }
+}
+
+impl std::ops::AddAssign for ContactsByClass {
+    fn add_assign(&mut self, other: Self) {
+        for (a, b) in self.0.iter_mut().zip(other.0) {
+            *a += b;
+        }
+    }
+}
+
 /// What happened to a robot so far, measured at every physics step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RobotStats {
@@ -74,6 +103,8 @@ pub struct RobotStats {
     pub solid_contacts: u32,
     /// Of those, how many were with another robot.
     pub robot_contacts: u32,
+    /// All of them by the class of what was touched (from the touched collider's own object).
+    pub contacts_by_class: ContactsByClass,
     /// Largest |dv| / dt between two physics steps.
     pub peak_accel_mm_s2: f64,
     /// Largest speed.
@@ -92,6 +123,7 @@ impl RobotStats {
             contacts: 0,
             solid_contacts: 0,
             robot_contacts: 0,
+            contacts_by_class: ContactsByClass::default(),
             peak_accel_mm_s2: 0.0,
             peak_speed_mm_s: 0.0,
             min_clearance_mm: f64::INFINITY,
@@ -118,11 +150,35 @@ struct Robot {
     kicker_ready_at_s: f64,
 }
 
-/// What a collider belongs to.
-#[derive(Debug, Clone, Copy)]
+/// What a collider belongs to, kept in its `user_data`: the collider itself says what was
+/// touched.
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum Owner {
     Solid(usize),
     Robot(usize),
+}
+
+impl Owner {
+    const SOLID: u128 = 1 << 64;
+    const ROBOT: u128 = 2 << 64;
+
+    /// The collider's `user_data` that names this owner.
+    fn user_data(self) -> u128 {
+        match self {
+            Owner::Solid(k) => Self::SOLID | k as u128,
+            Owner::Robot(i) => Self::ROBOT | i as u128,
+        }
+    }
+
+    /// The owner a collider's `user_data` names.
+    fn of(user_data: u128) -> Option<Self> {
+        let index = (user_data & u128::from(u64::MAX)) as usize;
+        match user_data & !u128::from(u64::MAX) {
+            Self::SOLID => Some(Owner::Solid(index)),
+            Self::ROBOT => Some(Owner::Robot(index)),
+            _ => None,
+        }
+    }
 }
 
 /// The simulated world.
@@ -138,7 +194,6 @@ pub struct World {
     collisions: Receiver<CollisionEvent>,
     _forces: Receiver<ContactForceEvent>,
     _tears: Receiver<SoftBodyTearEvent>,
-    owners: Vec<(ColliderHandle, Owner)>,
     physics_step_s: f64,
     steps: u64,
     /// Touches between two robots (their indices, the lower first), each once.
@@ -191,11 +246,12 @@ impl World {
         physics.integration_parameters.length_unit = 1000.0;
 
         let solids = layout.solids();
-        let mut owners = Vec::with_capacity(solids.len() + robots.len());
-        for s in &solids {
-            let collider = solid_collider(&s.shape)?;
-            let h = physics.insert_collider(collider.friction(0.0).restitution(0.0), None);
-            owners.push((h, Owner::Solid(owners.len())));
+        for (k, s) in solids.iter().enumerate() {
+            let collider = solid_collider(&s.shape)?
+                .friction(0.0)
+                .restitution(0.0)
+                .user_data(Owner::Solid(k).user_data());
+            physics.insert_collider(collider, None);
         }
 
         let mut out = Vec::with_capacity(robots.len());
@@ -211,9 +267,9 @@ impl World {
             let collider = ColliderBuilder::ball(spec.radius_mm as Real)
                 .friction(0.0)
                 .restitution(0.0)
-                .active_events(ActiveEvents::COLLISION_EVENTS);
+                .active_events(ActiveEvents::COLLISION_EVENTS)
+                .user_data(Owner::Robot(out.len()).user_data());
             let (body, collider) = physics.insert(body, collider);
-            owners.push((collider, Owner::Robot(out.len())));
             out.push(Robot {
                 spec: spec.clone(),
                 body,
@@ -239,7 +295,6 @@ impl World {
             collisions: crx,
             _forces: frx,
             _tears: trx,
-            owners,
             physics_step_s,
             steps: 0,
             robot_touches: Vec::new(),
@@ -369,12 +424,20 @@ impl World {
         (solids, robots)
     }
 
-    /// What collider `h` belongs to.
+    /// What collider `h` belongs to, as its `user_data` says.
     fn owner(&self, h: ColliderHandle) -> Option<Owner> {
-        self.owners
-            .iter()
-            .find(|(o, _)| *o == h)
-            .map(|(_, owner)| *owner)
+        self.physics
+            .colliders
+            .get(h)
+            .and_then(|c| Owner::of(c.user_data))
+    }
+
+    /// The thing an owner of a collider is.
+    fn object(&self, owner: Owner) -> ObjectId {
+        match owner {
+            Owner::Solid(k) => self.solids[k].object,
+            Owner::Robot(j) => ObjectId::new(Class::Robot, j as u32),
+        }
     }
 
     /// Gap between robot `i`'s disc and the collider `other`.
@@ -615,8 +678,12 @@ impl World {
                 let now = self.gap_mm(i, other) <= TOUCH_TOLERANCE_MM;
                 if now && !touching {
                     let owner = self.owner(other);
+                    let class = owner.map(|o| self.object(o).class);
                     let st = &mut self.robots[i].stats;
                     st.contacts += 1;
+                    if let Some(class) = class {
+                        st.contacts_by_class.add(class);
+                    }
                     match owner {
                         Some(Owner::Robot(j)) => {
                             st.robot_contacts += 1;
@@ -638,7 +705,7 @@ impl World {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layout::Wall;
+    use crate::Wall;
 
     fn robot_at(x: f64, y: f64) -> RobotBodySpec {
         RobotBodySpec {
@@ -805,6 +872,34 @@ mod tests {
         w.advance(2.5);
         assert_eq!(w.stats(1).solid_contacts, 1);
         assert_eq!(w.robot_touches().len(), 1);
+        let by_class: Vec<_> = w.stats(1).contacts_by_class.touched().collect();
+        assert_eq!(by_class, [(Class::Wall, 1), (Class::Robot, 1)]);
+    }
+
+    #[test]
+    fn a_touch_is_classified_by_the_touched_collider_own_object() {
+        let layout = Layout {
+            cubes: vec![crate::Cube {
+                center_mm: [300.0, 0.0],
+                size_mm: 130.0,
+                angle_deg: 0.0,
+                rgb: Rgb([40, 40, 40]),
+            }],
+            ..Layout::default()
+        };
+        let mut w = World::new(&layout, &[robot_at(0.0, 0.0)], 0.002).unwrap();
+        w.set_command(0, VelocityCommand::translate(Vector2::new(300.0, 0.0)));
+        w.advance(2.0);
+        let st = w.stats(0);
+        assert_eq!((st.contacts, st.solid_contacts), (1, 1));
+        assert_eq!(st.contacts_by_class.of(Class::Cube), 1);
+        assert_eq!(st.contacts_by_class.of(Class::Wall), 0);
+        // The collider names its owner; nothing else does.
+        for (h, c) in w.physics.colliders.iter() {
+            let owner = Owner::of(c.user_data).unwrap();
+            assert_eq!(w.owner(h), Some(owner));
+        }
+        assert_eq!(Owner::of(0), None);
     }
 
     #[test]

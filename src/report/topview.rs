@@ -309,7 +309,7 @@ fn draw_floor(
         );
         plot.draw(&Polygon::new(pts, rgb(layout.floor_rgb).filled()))?;
     }
-    if let Some(f) = &layout.field {
+    if let Some(f) = layout.field_lines() {
         let line = rgb(layout.line_rgb).stroke_width(1);
         let (a, b) = (f.half_length_mm, f.half_width_mm);
         plot.draw(&PathElement::new(

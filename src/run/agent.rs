@@ -555,6 +555,7 @@ impl Agent {
             contacts: stats.contacts,
             solid_contacts: stats.solid_contacts,
             robot_contacts: stats.robot_contacts,
+            contacts_by_class: super::record::contact_counts(&stats.contacts_by_class),
             min_clearance_mm: stats.min_clearance_mm,
             min_robot_clearance_mm: stats.min_robot_clearance_mm,
             path_length_mm: stats.path_length_mm,

@@ -105,6 +105,10 @@ pub struct Summary {
     pub cycles_per_s: f64,
     /// How many times the robot started touching a wall, cube, pillar or robot (physics engine).
     pub wall_contacts: u32,
+    /// Those touches by the class of what was touched (`wall`, `cube`, `robot`, ...; the ball
+    /// is no wall and never in it), left out when there were none.
+    #[serde(skip_serializing_if = "ContactCounts::is_empty", default)]
+    pub contacts_by_class: ContactCounts,
     /// Largest speed of the robot.
     pub peak_speed_mm_s: f64,
     /// Largest acceleration between two physics steps.
@@ -193,6 +197,9 @@ pub struct RobotSummary {
     pub solid_contacts: u32,
     /// Of those, other robots.
     pub robot_contacts: u32,
+    /// All of them by the class of what was touched, left out when there were none.
+    #[serde(skip_serializing_if = "ContactCounts::is_empty", default)]
+    pub contacts_by_class: ContactCounts,
     /// Least distance from its edge to anything (`null`: no step ran).
     #[serde(deserialize_with = "null_as_infinity")]
     pub min_clearance_mm: f64,
@@ -259,6 +266,17 @@ pub struct TeamFigures {
     /// Total path of the robots with a goal over the total of their straight lines, each less
     /// its goal's tolerance (as the clutter benchmark's `path_ratio`).
     pub path_ratio: Option<f64>,
+}
+
+/// Touches by the name of the class of what was touched.
+pub type ContactCounts = std::collections::BTreeMap<String, u32>;
+
+/// The counts of `by_class` under their classes' names.
+pub fn contact_counts(by_class: &omniloop_sim::ContactsByClass) -> ContactCounts {
+    by_class
+        .touched()
+        .map(|(class, n)| (class.name().to_string(), n))
+        .collect()
 }
 
 /// A planar pose as written in `estimates.jsonl`.

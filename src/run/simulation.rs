@@ -12,7 +12,7 @@ use super::error::RunError;
 use super::observer::{CycleView, ObserverHandle, RobotCycle};
 use super::outcome::{GoalFigures, GoalOutcome};
 use super::pilot::Pilot;
-use super::record::{RobotSummary, Summary, TeamFigures, TrajectoryRow};
+use super::record::{ContactCounts, RobotSummary, Summary, TeamFigures, TrajectoryRow};
 use super::score::FloorRegionScore;
 use crate::scenario::Scenario;
 use nalgebra::{Isometry2, Point2, Vector2};
@@ -657,6 +657,7 @@ impl Simulation {
             wall_time_s,
             cycles_per_s: 0.0,
             wall_contacts: r.contacts,
+            contacts_by_class: r.contacts_by_class,
             peak_speed_mm_s: r.peak_speed_mm_s,
             peak_accel_mm_s2: r.peak_accel_mm_s2,
             reached_goal: r.reached_goal,
@@ -697,6 +698,7 @@ impl Simulation {
         Summary {
             controller: names.join("+"),
             wall_contacts: figures.solid_contacts + figures.robot_contacts,
+            contacts_by_class: team_contacts(&rows, figures.robot_contacts),
             peak_speed_mm_s: rows.iter().map(|r| r.peak_speed_mm_s).fold(0.0, f64::max),
             peak_accel_mm_s2: rows.iter().map(|r| r.peak_accel_mm_s2).fold(0.0, f64::max),
             reached_goal: figures.with_goal > 0 && figures.all_arrived,
@@ -753,6 +755,21 @@ fn team_goal_figures(rows: &[RobotSummary]) -> Option<GoalFigures> {
             .collect::<Option<Vec<f64>>>()
             .and_then(|m| m.into_iter().reduce(f64::min)),
     })
+}
+
+/// The team's touches by class: its robots' own, a touch between two robots once
+/// (`robot_touches`), so that they add up to the team's `wall_contacts`.
+fn team_contacts(rows: &[RobotSummary], robot_touches: u32) -> ContactCounts {
+    let mut all = ContactCounts::new();
+    for (class, n) in rows.iter().flat_map(|r| &r.contacts_by_class) {
+        *all.entry(class.clone()).or_default() += n;
+    }
+    let robot = omniloop_sim::labels::Class::Robot.name().to_string();
+    all.remove(&robot);
+    if robot_touches > 0 {
+        all.insert(robot, robot_touches);
+    }
+    all
 }
 
 /// A team's figures from its robots' rows and the world's record of touches.

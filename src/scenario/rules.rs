@@ -69,72 +69,9 @@ fn check_run(c: &mut Problems, s: &Scenario) {
     }
 }
 
-/// `[world]`: positive sizes, corridors and walls of some length.
+/// `[world]`: every thing on the floor, each kind checking its own entries.
 fn check_world(c: &mut Problems, w: &Layout) {
-    if let Some(f) = &w.field {
-        for (name, v) in [
-            ("half_length_mm", f.half_length_mm),
-            ("half_width_mm", f.half_width_mm),
-            ("goal_depth_mm", f.goal_depth_mm),
-            ("goal_width_mm", f.goal_width_mm),
-            ("goal_wall_height_mm", f.goal_wall_height_mm),
-            ("wall_height_mm", f.wall_height_mm),
-            ("wall_thickness_mm", f.wall_thickness_mm),
-            ("line_width_mm", f.line_width_mm),
-            ("centre_circle_radius_mm", f.centre_circle_radius_mm),
-        ] {
-            c.positive(format!("world.field.{name}"), v);
-        }
-        if f.goal_width_mm >= 2.0 * f.half_width_mm {
-            c.fail(
-                "world.field.goal_width_mm",
-                "must be narrower than the field (2 * half_width_mm)",
-            );
-        }
-    }
-    for (i, fr) in w.floor_rects.iter().enumerate() {
-        c.positive(format!("world.floor_rects[{i}].size_mm"), fr.size_mm[0]);
-        c.positive(format!("world.floor_rects[{i}].size_mm"), fr.size_mm[1]);
-    }
-    for (i, cor) in w.corridors.iter().enumerate() {
-        let p = format!("world.corridors[{i}]");
-        c.positive(format!("{p}.width_mm"), cor.width_mm);
-        c.positive(format!("{p}.wall_thickness_mm"), cor.wall_thickness_mm);
-        c.positive(format!("{p}.wall_height_mm"), cor.wall_height_mm);
-        if cor.points_mm.len() < 2 {
-            c.fail(
-                format!("{p}.points_mm"),
-                format!("needs at least two points (got {})", cor.points_mm.len()),
-            );
-        }
-        for (k, pair) in cor.points_mm.windows(2).enumerate() {
-            let len = (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
-            if !(len.is_finite() && len > 0.0) {
-                c.fail(
-                    format!("{p}.points_mm[{}]", k + 1),
-                    "must differ from the point before it",
-                );
-            }
-        }
-    }
-    for (i, wall) in w.walls.iter().enumerate() {
-        let p = format!("world.walls[{i}]");
-        c.positive(format!("{p}.thickness_mm"), wall.thickness_mm);
-        c.positive(format!("{p}.height_mm"), wall.height_mm);
-        let len = ((wall.to_mm[0] - wall.from_mm[0]).powi(2)
-            + (wall.to_mm[1] - wall.from_mm[1]).powi(2))
-        .sqrt();
-        if len.is_nan() || len <= 0.0 {
-            c.fail(format!("{p}.to_mm"), "must differ from from_mm");
-        }
-    }
-    for (i, cube) in w.cubes.iter().enumerate() {
-        c.positive(format!("world.cubes[{i}].size_mm"), cube.size_mm);
-    }
-    for (i, p) in w.pillars.iter().enumerate() {
-        c.positive(format!("world.pillars[{i}].radius_mm"), p.radius_mm);
-        c.positive(format!("world.pillars[{i}].height_mm"), p.height_mm);
-    }
+    c.extend(w.check());
 }
 
 /// `[robot]`: its body, where it starts, and its sensors (named once each).
@@ -179,31 +116,15 @@ fn check_robot(c: &mut Problems, s: &Scenario) {
     }
 }
 
-/// `[world.ball]`: its figures; on the floor, clear of every solid and robot at the start.
+/// `[world.ball]` clear of every robot at the start (its figures and its place on the floor
+/// are its kind's check).
 fn check_ball(c: &mut Problems, s: &Scenario) {
     let Some(b) = &s.world.ball else {
         return;
     };
-    let mut p = Problems::under("world.ball");
-    b.check(&mut p);
-    c.extend(p);
     let at = Point2::from(b.center_mm);
     if !(at.x.is_finite() && at.y.is_finite() && b.radius_mm > 0.0) {
         return;
-    }
-    let place = |what: &str| format!("({}, {}) mm is {what}", at.x, at.y);
-    if !in_floor(&s.world, at) {
-        c.fail("world.ball.center_mm", place("outside the floor region"));
-    }
-    if s.world
-        .solids()
-        .iter()
-        .any(|o| o.shape.distance_mm(at) < b.radius_mm)
-    {
-        c.fail(
-            "world.ball.center_mm",
-            place("inside a wall, cube, pillar or board"),
-        );
     }
     let names = s.robot_names();
     for (i, body) in s.robot_bodies().iter().enumerate() {
@@ -216,7 +137,7 @@ fn check_ball(c: &mut Problems, s: &Scenario) {
             let name = name.unwrap_or_else(|| format!("other_robots[{}]", i - names.len()));
             c.fail(
                 "world.ball.center_mm",
-                place(&format!("inside robot {name}")),
+                format!("({}, {}) mm is inside robot {name}", at.x, at.y),
             );
         }
     }
@@ -330,7 +251,6 @@ fn check_software(c: &mut Problems, s: &Scenario) {
         );
     }
     check_timing(c, &s.robot.timing, s.run.physics_step_s);
-    check_boards(c, s);
     let g = s.control.localization_gain;
     if g.is_nan() || !(0.0..=1.0).contains(&g) {
         c.fail(
@@ -551,28 +471,6 @@ fn software_config(
     let mut cal = cal;
     cal.sensor = sensors[index].name.clone();
     Some(s.robot_config(vec![cal], Vec::new()))
-}
-
-/// The named boards (the robot's striped marks) are named once and striped well.
-fn check_boards(c: &mut Problems, s: &Scenario) {
-    let mut names: Vec<&str> = Vec::new();
-    for (i, b) in s.world.boards.iter().enumerate() {
-        let Some(name) = &b.name else { continue };
-        if names.contains(&name.as_str()) {
-            c.fail(
-                format!("world.boards[{i}].name"),
-                format!("{name:?} names two boards"),
-            );
-        }
-        names.push(name);
-        let pattern = omniloop_vision::resection::StripePattern::new(name, &b.stripes);
-        if let Err(e) = pattern.validate() {
-            c.fail(
-                format!("world.boards[{i}].stripes"),
-                format!("mark {name:?}: {e}"),
-            );
-        }
-    }
 }
 
 /// Resection reads bearings through vision's camera, level when it is a pinhole.

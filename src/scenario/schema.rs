@@ -3,7 +3,7 @@
 //! Every table rejects unknown keys, but for the tables that registered parts own and check
 //! themselves (`[control.*]` of controllers and stages, `[experiment.NAME]`).
 
-use nalgebra::{Isometry2, Point2, Rotation2, Vector2};
+use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_control::DifferentialDrive;
 use omniloop_problem::Problem;
 use omniloop_robot::perception::CameraNeed;
@@ -11,7 +11,7 @@ use omniloop_robot::{
     BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StageEntry,
     StereoRig, Tables, VisionSpec, WorldMap, stages_of,
 };
-use omniloop_sim::{Layout, Rgb, SensorSpec};
+use omniloop_sim::{Layout, MapFeature, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
 use omniloop_vision::forward::ForwardCamera;
 use omniloop_vision::omnistereo::OmnistereoConfig;
@@ -592,86 +592,63 @@ impl Scenario {
         })
     }
 
-    /// The map the robot is given: the world's pillars (landmarks, by colour) and its walls,
-    /// boards (straight obstacles), the cubes (boxes, which may be moved) and the walls that
-    /// bound the floor (the field's and the corridors').
+    /// The map the robot is given: what each kind of thing on the floor puts in it (the
+    /// pillars as landmarks by colour, walls and boards as straight obstacles, the cubes as
+    /// boxes which may be moved, the field's walls and the corridors' faces as the floor's
+    /// bounds, the named boards as marks).
     pub fn robot_map(&self) -> WorldMap {
-        let w = &self.world;
-        let p = |a: [f64; 2]| Point2::new(a[0], a[1]);
-        let seg = |a: [f64; 2], b: [f64; 2], t: f64| MapSegment {
-            from_mm: p(a),
-            to_mm: p(b),
-            half_thickness_mm: 0.5 * t,
+        let mut map = WorldMap {
+            landmarks: Vec::new(),
+            segments: Vec::new(),
+            boxes: Vec::new(),
+            bounds: Vec::new(),
+            marks: Vec::new(),
         };
-        let segments: Vec<MapSegment> = w
-            .walls
-            .iter()
-            .map(|x| seg(x.from_mm, x.to_mm, x.thickness_mm))
-            .chain(
-                w.boards
-                    .iter()
-                    .map(|b| seg(b.from_mm, b.to_mm, b.thickness_mm)),
-            )
-            .collect();
-        let mut bounds: Vec<MapSegment> = w
-            .field
-            .iter()
-            .flat_map(|f| f.walls())
-            .map(|x| seg(x.from_mm, x.to_mm, x.thickness_mm))
-            .collect();
-        // Corridor walls by their inner faces, the outline of the corridors' floor.
-        for contour in omniloop_sim::corridor::outline(&w.corridors) {
-            let n = contour.len();
-            bounds.extend((0..n).map(|k| MapSegment {
-                from_mm: contour[k],
-                to_mm: contour[(k + 1) % n],
-                half_thickness_mm: 0.0,
-            }));
+        for feature in self.world.map_features() {
+            match feature {
+                MapFeature::Landmark {
+                    centre_mm,
+                    radius_mm,
+                    rgb,
+                } => map.landmarks.push(MapLandmark {
+                    centre_mm,
+                    radius_mm,
+                    rgb: rgb.0,
+                }),
+                MapFeature::Segment {
+                    from_mm,
+                    to_mm,
+                    half_thickness_mm,
+                } => map.segments.push(MapSegment {
+                    from_mm,
+                    to_mm,
+                    half_thickness_mm,
+                }),
+                MapFeature::Bound {
+                    from_mm,
+                    to_mm,
+                    half_thickness_mm,
+                } => map.bounds.push(MapSegment {
+                    from_mm,
+                    to_mm,
+                    half_thickness_mm,
+                }),
+                MapFeature::BoxEdge { from_mm, to_mm } => map.boxes.push(MapSegment {
+                    from_mm,
+                    to_mm,
+                    half_thickness_mm: 0.0,
+                }),
+                MapFeature::Mark {
+                    name,
+                    centre_mm,
+                    stripes,
+                } => map.marks.push(MapMark {
+                    centre_mm,
+                    pattern: StripePattern::new(&name, &stripes),
+                }),
+            }
         }
-        let mut boxes = Vec::new();
-        for cube in &w.cubes {
-            let (h, a) = (0.5 * cube.size_mm, cube.angle_deg.to_radians());
-            let corner = |sx: f64, sy: f64| {
-                let v = Rotation2::new(a) * Vector2::new(sx * h, sy * h);
-                [cube.center_mm[0] + v.x, cube.center_mm[1] + v.y]
-            };
-            let c = [
-                corner(-1.0, -1.0),
-                corner(1.0, -1.0),
-                corner(1.0, 1.0),
-                corner(-1.0, 1.0),
-            ];
-            boxes.extend((0..4).map(|k| seg(c[k], c[(k + 1) % 4], 0.0)));
-        }
-        WorldMap {
-            landmarks: w
-                .pillars
-                .iter()
-                .map(|x| MapLandmark {
-                    centre_mm: p(x.center_mm),
-                    radius_mm: x.radius_mm,
-                    rgb: x.rgb.0,
-                })
-                .collect(),
-            segments,
-            boxes,
-            bounds,
-            marks: w
-                .boards
-                .iter()
-                .filter_map(|b| {
-                    let name = b.name.as_ref()?;
-                    let c = [
-                        0.5 * (b.from_mm[0] + b.to_mm[0]),
-                        0.5 * (b.from_mm[1] + b.to_mm[1]),
-                    ];
-                    Some(MapMark {
-                        centre_mm: p(c),
-                        pattern: StripePattern::new(name, &b.stripes),
-                    })
-                })
-                .collect(),
-        }
+        map
     }
 
     /// The omnistereo rig of `vision.omnistereo`'s two sensors, or the field at fault and why.

@@ -1005,7 +1005,7 @@ mod tests {
     /// sector) and one just above the robot's body.
     fn sphere_scene() -> Scene {
         use crate::labels::{Class, ObjectId};
-        use crate::layout::{Cube, FieldSpec, Layout, Pillar};
+        use crate::{Cube, FieldSpec, Layout, Pillar};
         use crate::sphere::Sphere;
         let layout = Layout {
             field: Some(FieldSpec::default()),

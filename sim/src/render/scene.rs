@@ -237,7 +237,7 @@ impl SceneGlobals {
             + LIGHT_DIR[2] * LIGHT_DIR[2])
             .sqrt();
         let l = [LIGHT_DIR[0] / n, LIGHT_DIR[1] / n, LIGHT_DIR[2] / n];
-        let field = layout.field.as_ref();
+        let field = layout.field_lines();
         Self {
             field: field.map_or([0.0; 4], |f| {
                 [
@@ -325,14 +325,13 @@ impl Scene {
         }
         let mut boards = Vec::new();
         let mut stripe_edges = Vec::new();
-        for b in &layout.boards {
-            let edges = b.stripe_edges();
+        for b in layout.stripes() {
             boards.push(BoardPrim {
-                range: [stripe_edges.len() as u32, edges.len() as u32, 0, 0],
+                range: [stripe_edges.len() as u32, b.edges.len() as u32, 0, 0],
                 color_a: rgb4(b.rgb_a, 0.0),
                 color_b: rgb4(b.rgb_b, 0.0),
             });
-            stripe_edges.extend(edges.iter().map(|&e| e as f32));
+            stripe_edges.extend(b.edges.iter().map(|&e| e as f32));
         }
         let (floor_rects, any_region) = floor_rects(layout);
         let counts = [

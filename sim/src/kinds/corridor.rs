@@ -11,12 +11,15 @@
 //! corner by the thickness (the outside of a convex corner is never floor).
 
 use crate::color::Rgb;
-use crate::floor_rect::FloorRect;
+use super::floor_rect::FloorRect;
+use super::{Kind, MapFeature};
+use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
 use nalgebra::{Point2, Vector2};
+use omniloop_problem::Problems;
 use serde::{Deserialize, Serialize};
 
 /// A corridor (`[[world.corridors]]`).
@@ -83,6 +86,50 @@ fn rect_corners(r: &FloorRect) -> Vec<[f64; 2]> {
             ]
         })
         .collect()
+}
+
+impl Kind for Corridor {
+    fn check(&self, _world: &Layout, c: &mut Problems) {
+        c.positive("width_mm", self.width_mm);
+        c.positive("wall_thickness_mm", self.wall_thickness_mm);
+        c.positive("wall_height_mm", self.wall_height_mm);
+        if self.points_mm.len() < 2 {
+            c.fail(
+                "points_mm",
+                format!("needs at least two points (got {})", self.points_mm.len()),
+            );
+        }
+        for (k, pair) in self.points_mm.windows(2).enumerate() {
+            let len = (pair[1][0] - pair[0][0]).hypot(pair[1][1] - pair[0][1]);
+            if !(len.is_finite() && len > 0.0) {
+                c.fail(
+                    format!("points_mm[{}]", k + 1),
+                    "must differ from the point before it",
+                );
+            }
+        }
+    }
+
+    /// The corridors' walls run along the outline of all their floors together.
+    fn solids_of_all(all: &[Self], out: &mut Vec<Solid>) {
+        out.extend(walls(all));
+    }
+
+    fn floor_rects(&self, out: &mut Vec<FloorRect>) {
+        out.extend(Corridor::floor_rects(self));
+    }
+
+    /// The floor's boundary: the walls' inner faces, the outline of all the corridors' floor.
+    fn map_of_all(all: &[Self], out: &mut Vec<MapFeature>) {
+        for contour in outline(all) {
+            let n = contour.len();
+            out.extend((0..n).map(|k| MapFeature::Bound {
+                from_mm: contour[k],
+                to_mm: contour[(k + 1) % n],
+                half_thickness_mm: 0.0,
+            }));
+        }
+    }
 }
 
 /// The outline of the union of the corridors' floors: closed contours, each with the floor on

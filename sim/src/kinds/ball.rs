@@ -24,7 +24,9 @@
 //! `restitution`; the tangential part is kept. Robots are taken as infinitely heavy: a 46 g
 //! ball does not move a robot of some 2.5 kg, so the ball's mass does not enter.
 
+use super::Kind;
 use crate::color::Rgb;
+use crate::layout::Layout;
 use nalgebra::{Point2, Vector2};
 use omniloop_problem::Problems;
 use serde::{Deserialize, Serialize};
@@ -83,9 +85,9 @@ impl Default for BallSpec {
 }
 
 impl BallSpec {
-    /// Checks every field, under the collector's prefix (the ball's place against the world
-    /// is the scenario's check).
-    pub fn check(&self, p: &mut Problems) {
+    /// Checks every figure, under the collector's prefix (its place against the world is
+    /// [`Kind::check`]'s).
+    pub fn check_figures(&self, p: &mut Problems) {
         for (name, v) in [
             ("center_mm", self.center_mm),
             ("velocity_mm_s", self.velocity_mm_s),
@@ -121,6 +123,29 @@ impl BallSpec {
             + k * k * v0_mm_s * v0_mm_s / (2.0 * a_r);
         let t = (1.0 - k) * v0_mm_s / a_s + k * v0_mm_s / a_r;
         (d, t)
+    }
+}
+
+impl Kind for BallSpec {
+    /// Its figures; on the floor and clear of every solid at the start (clear of the robots is
+    /// the scenario's check, which knows them).
+    fn check(&self, world: &Layout, p: &mut Problems) {
+        self.check_figures(p);
+        let at = Point2::from(self.center_mm);
+        if !(at.x.is_finite() && at.y.is_finite() && self.radius_mm > 0.0) {
+            return;
+        }
+        let place = |what: &str| format!("({}, {}) mm is {what}", at.x, at.y);
+        if !world.is_floor(at) {
+            p.fail("center_mm", place("outside the floor region"));
+        }
+        let solids = world.solids();
+        if solids
+            .iter()
+            .any(|o| o.shape.distance_mm(at) < self.radius_mm)
+        {
+            p.fail("center_mm", place("inside a wall, cube, pillar or board"));
+        }
     }
 }
 
@@ -381,7 +406,7 @@ mod tests {
             ..BallSpec::default()
         };
         let mut p = Problems::under("world.ball");
-        spec.check(&mut p);
+        spec.check_figures(&mut p);
         let text = format!("{p:?}");
         for f in ["radius_mm", "restitution", "center_mm"] {
             assert!(text.contains(f), "{f} in {text}");

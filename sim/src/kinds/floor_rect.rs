@@ -1,6 +1,9 @@
 //! Rectangles of floor colour: the floor region of corridors and rooms.
 
+use super::Kind;
+use crate::layout::Layout;
 use nalgebra::Point2;
+use omniloop_problem::Problems;
 use serde::{Deserialize, Serialize};
 
 /// A rectangle of floor colour (for floors other than the field, e.g. corridors).
@@ -24,5 +27,16 @@ impl FloorRect {
         let lx = c * d.x + s * d.y;
         let ly = -s * d.x + c * d.y;
         lx.abs() <= self.size_mm[0] / 2.0 && ly.abs() <= self.size_mm[1] / 2.0
+    }
+}
+
+impl Kind for FloorRect {
+    fn check(&self, _world: &Layout, c: &mut Problems) {
+        c.positive("size_mm", self.size_mm[0]);
+        c.positive("size_mm", self.size_mm[1]);
+    }
+
+    fn floor_rects(&self, out: &mut Vec<FloorRect>) {
+        out.push(self.clone());
     }
 }
