@@ -3,8 +3,8 @@
 //! ball wholly over the goal line between the posts), the ball leaving the field, dribbling
 //! further than the rules allow (1 m) and the ball faster than their limit (6.5 m/s).
 
-use crate::ball::{BallSpec, BallState};
 use crate::FieldSpec;
+use crate::ball::{BallSpec, BallState};
 use nalgebra::Point2;
 use serde::Serialize;
 

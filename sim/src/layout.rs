@@ -1,49 +1,15 @@
-//! The world as plain data: the registry of the kinds of things on the floor
-//! ([`crate::kinds`]), which makes [`Layout`], and what the systems ask of all of them together:
+//! The world as plain data: [`Layout`], which the registry of the kinds of things on the floor
+//! makes ([`crate::kinds`]), and what the systems ask of all the kinds together:
 //! the solids both the physics world and the renderer use, the floor region, the floor's
 //! paint, the scenario's checks and the robot's map.
 
-use crate::kinds::ball::BallSpec;
-use crate::kinds::board::Board;
-use crate::kinds::corridor::Corridor;
-use crate::kinds::cube::Cube;
-use crate::kinds::field::FieldSpec;
-use crate::kinds::floor_marks::{FloorMark, MarkScatter};
-use crate::kinds::floor_rect::FloorRect;
-use crate::kinds::pillar::Pillar;
-use crate::kinds::wall::Wall;
-use crate::kinds::{
-    FieldLines, Kind, KindVisitor, MapFeature, Stripes, entry_path, things_on_the_floor,
-};
+use crate::floor_marks::FloorMark;
+use crate::floor_rect::FloorRect;
+pub use crate::kinds::Layout;
+use crate::kinds::{FieldLines, Kind, KindVisitor, MapFeature, Stripes, Surroundings, entry_path};
 use crate::shapes::Solid;
 use nalgebra::Point2;
 use omniloop_problem::Problems;
-
-// The registry: a kind's line gives `Layout` its field, in the order every system goes through
-// the kinds (the order of the solids, of the floor's rectangles and of the map's features).
-things_on_the_floor! {
-    /// Corridors: floor and walls from a centre polyline and a width (`[[world.corridors]]`).
-    corridors: Vec<Corridor>,
-    /// The RoboCup Small-Size field, when present (`[world.field]`).
-    field: Option<FieldSpec>,
-    /// Extra rectangles of floor colour (`[[world.floor_rects]]`). With no floor rectangle of
-    /// any kind the whole plane is floor.
-    floor_rects: Vec<FloorRect>,
-    /// Free-standing walls (`[[world.walls]]`).
-    walls: Vec<Wall>,
-    /// Cubes (`[[world.cubes]]`).
-    cubes: Vec<Cube>,
-    /// Pillars (`[[world.pillars]]`).
-    pillars: Vec<Pillar>,
-    /// Striped boards, the landmarks (`[[world.boards]]`).
-    boards: Vec<Board>,
-    /// Marks painted on the floor (`[[world.floor_marks]]`).
-    floor_marks: Vec<FloorMark>,
-    /// Marks scattered at random over a rectangle of the floor (`[world.mark_scatter]`).
-    mark_scatter: Option<MarkScatter>,
-    /// The ball (`[world.ball]`), when there is one.
-    ball: Option<BallSpec>,
-}
 
 impl Layout {
     /// Every mark painted on the floor, kind by kind.
@@ -148,7 +114,7 @@ impl Layout {
             fn visit<K: Kind>(&mut self, key: &'static str, list: bool, entries: &[K]) {
                 for (i, e) in entries.iter().enumerate() {
                     let mut p = Problems::under(entry_path(key, list, i));
-                    e.check(self.0, &mut p);
+                    e.check(&entries[..i], self.0, &mut p);
                     self.1.extend(p);
                 }
             }
@@ -159,9 +125,20 @@ impl Layout {
     }
 }
 
+impl Surroundings for Layout {
+    fn is_floor(&self, p: Point2<f64>) -> bool {
+        Layout::is_floor(self, p)
+    }
+
+    fn solids(&self) -> Vec<Solid> {
+        Layout::solids(self)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::FieldSpec;
 
     #[test]
     fn field_floor_region_includes_goal_pockets_only_within_the_mouth() {

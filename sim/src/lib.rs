@@ -4,6 +4,8 @@
 
 pub mod calibration;
 pub mod color;
+pub mod floor_marks;
+pub mod floor_rect;
 pub mod game;
 pub mod kicker;
 pub mod kinds;
@@ -18,7 +20,7 @@ pub mod sphere;
 pub mod world;
 
 // The kinds' modules under their old paths too.
-pub use kinds::{ball, corridor, floor_marks, floor_rect};
+pub use kinds::{ball, corridor};
 
 pub use ball::{BallSpec, BallState};
 pub use color::Rgb;
@@ -32,7 +34,7 @@ pub use kinds::cube::Cube;
 pub use kinds::field::FieldSpec;
 pub use kinds::pillar::Pillar;
 pub use kinds::wall::Wall;
-pub use kinds::{FieldLines, Kind, KindVisitor, MapFeature, Stripes};
+pub use kinds::{FieldLines, Kind, KindVisitor, MapFeature, Stripes, Surroundings};
 pub use layout::Layout;
 pub use reachability::{Reachability, Target, reachability};
 pub use render::{

@@ -82,7 +82,10 @@ impl ContactsByClass {
 
     /// The classes touched at least once, with their counts, in the classes' order.
     pub fn touched(&self) -> impl Iterator<Item = (Class, u32)> + '_ {
-        Class::ALL.into_iter().map(|c| (c, self.of(c))).filter(|(_, n)| *n > 0)
+        Class::ALL
+            .into_iter()
+            .map(|c| (c, self.of(c)))
+            .filter(|(_, n)| *n > 0)
     }
 }
 

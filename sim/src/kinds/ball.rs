@@ -24,9 +24,8 @@
 //! `restitution`; the tangential part is kept. Robots are taken as infinitely heavy: a 46 g
 //! ball does not move a robot of some 2.5 kg, so the ball's mass does not enter.
 
-use super::Kind;
+use super::kind::{Kind, Surroundings};
 use crate::color::Rgb;
-use crate::layout::Layout;
 use nalgebra::{Point2, Vector2};
 use omniloop_problem::Problems;
 use serde::{Deserialize, Serialize};
@@ -129,17 +128,17 @@ impl BallSpec {
 impl Kind for BallSpec {
     /// Its figures; on the floor and clear of every solid at the start (clear of the robots is
     /// the scenario's check, which knows them).
-    fn check(&self, world: &Layout, p: &mut Problems) {
+    fn check(&self, _: &[Self], around: &dyn Surroundings, p: &mut Problems) {
         self.check_figures(p);
         let at = Point2::from(self.center_mm);
         if !(at.x.is_finite() && at.y.is_finite() && self.radius_mm > 0.0) {
             return;
         }
         let place = |what: &str| format!("({}, {}) mm is {what}", at.x, at.y);
-        if !world.is_floor(at) {
+        if !around.is_floor(at) {
             p.fail("center_mm", place("outside the floor region"));
         }
-        let solids = world.solids();
+        let solids = around.solids();
         if solids
             .iter()
             .any(|o| o.shape.distance_mm(at) < self.radius_mm)

@@ -1,10 +1,9 @@
 //! Striped boards (`[[world.boards]]`): flat upright boards carrying vertical stripes, the
 //! marks a robot knows by name.
 
-use super::{Kind, MapFeature, Stripes};
+use super::kind::{Kind, MapFeature, Stripes, Surroundings};
 use crate::color::Rgb;
 use crate::labels::{Class, ObjectId};
-use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Point2, Vector2};
 use omniloop_problem::Problems;
@@ -68,10 +67,9 @@ impl Board {
 
 impl Kind for Board {
     /// A named board is named once in the world, and its stripes make a mark.
-    fn check(&self, world: &Layout, c: &mut Problems) {
+    fn check(&self, earlier: &[Self], _: &dyn Surroundings, c: &mut Problems) {
         let Some(name) = &self.name else { return };
-        let earlier = world.boards.iter().take_while(|b| !std::ptr::eq(*b, self));
-        if earlier.filter_map(|b| b.name.as_ref()).any(|n| n == name) {
+        if earlier.iter().filter_map(|b| b.name.as_ref()).any(|n| n == name) {
             c.fail("name", format!("{name:?} names two boards"));
         }
         if let Err(e) = StripePattern::new(name, &self.stripes).validate() {

@@ -11,9 +11,8 @@
 //! corner by the thickness (the outside of a convex corner is never floor).
 
 use crate::color::Rgb;
-use super::floor_rect::FloorRect;
-use super::{Kind, MapFeature};
-use crate::layout::Layout;
+use crate::floor_rect::FloorRect;
+use super::kind::{Kind, MapFeature, Surroundings};
 use crate::shapes::{Solid, SolidShape};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
@@ -89,7 +88,7 @@ fn rect_corners(r: &FloorRect) -> Vec<[f64; 2]> {
 }
 
 impl Kind for Corridor {
-    fn check(&self, _world: &Layout, c: &mut Problems) {
+    fn check(&self, _: &[Self], _: &dyn Surroundings, c: &mut Problems) {
         c.positive("width_mm", self.width_mm);
         c.positive("wall_thickness_mm", self.wall_thickness_mm);
         c.positive("wall_height_mm", self.wall_height_mm);

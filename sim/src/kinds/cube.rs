@@ -1,10 +1,9 @@
 //! Cubes standing on the floor (`[[world.cubes]]`): obstacles a robot could push away, so its
 //! map knows them as boxes.
 
-use super::{Kind, MapFeature};
+use super::kind::{Kind, MapFeature, Surroundings};
 use crate::color::Rgb;
 use crate::labels::{Class, ObjectId};
-use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Point2, Rotation2, Vector2};
 use omniloop_problem::Problems;
@@ -45,7 +44,7 @@ impl Cube {
 }
 
 impl Kind for Cube {
-    fn check(&self, _world: &Layout, c: &mut Problems) {
+    fn check(&self, _: &[Self], _: &dyn Surroundings, c: &mut Problems) {
         c.positive("size_mm", self.size_mm);
     }
 

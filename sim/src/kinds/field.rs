@@ -2,12 +2,11 @@
 //! the goal pockets), its walls and goals, its white lines (painted by the renderer from its
 //! figures).
 
-use super::floor_rect::FloorRect;
+use crate::floor_rect::FloorRect;
 use super::wall::Wall;
-use super::{FieldLines, Kind, MapFeature};
+use super::kind::{FieldLines, Kind, MapFeature, Surroundings};
 use crate::color::Rgb;
 use crate::labels::{Class, ObjectId};
-use crate::layout::Layout;
 use crate::shapes::Solid;
 use nalgebra::Point2;
 use omniloop_problem::Problems;
@@ -162,7 +161,7 @@ impl FieldSpec {
 }
 
 impl Kind for FieldSpec {
-    fn check(&self, _world: &Layout, c: &mut Problems) {
+    fn check(&self, _: &[Self], _: &dyn Surroundings, c: &mut Problems) {
         for (name, v) in [
             ("half_length_mm", self.half_length_mm),
             ("half_width_mm", self.half_width_mm),

@@ -1,189 +1,43 @@
-//! The kinds of things on the floor: each is a scenario entry type in its own file here, and
-//! one line of the registry in [`crate::layout`] (`things_on_the_floor!`). That line gives
-//! [`Layout`] the kind's field (`[world.KEY]` or `[[world.KEY]]`) and makes every system reach
-//! it through [`Kind`]: the scenario's checks, the physics world's solids, the renderer's
-//! primitives and their truth classes, the floor region and its paint, the top view and MCAP
-//! (drawn from the solids), reachability and the map the robot is told. No system names a kind.
+//! The kinds of things on the floor: each is a scenario entry type with its own file here, and
+//! one line of the registry below. That line declares the kind's module, gives [`Layout`] the
+//! kind's field (`[world.KEY]` or `[[world.KEY]]`) and makes every system reach it through
+//! [`Kind`]: the scenario's checks, the physics world's solids, the renderer's primitives and
+//! their truth classes, the floor region and its paint, the top view and MCAP (drawn from the
+//! solids), reachability and the map the robot is told. No system names a kind.
 //!
 //! A kind made of existing primitives (boxes, quad prisms, cylinders on the floor) is a file
 //! with its entry type and its `impl Kind`, plus its registry line.
 
-pub mod ball;
-pub mod board;
-pub mod corridor;
-pub mod cube;
-pub mod field;
-pub mod floor_marks;
-pub mod floor_rect;
-pub mod pillar;
-pub mod wall;
+pub mod kind;
 
-use crate::color::Rgb;
-use crate::layout::Layout;
-use crate::shapes::Solid;
-use floor_marks::FloorMark;
-use floor_rect::FloorRect;
-use nalgebra::Point2;
-use omniloop_problem::Problems;
+pub use kind::{FieldLines, Kind, KindVisitor, MapFeature, Stripes, Surroundings, entry_path};
 
-/// What the map a robot is told holds of a thing on the floor (its world's map: the robot
-/// knows its world's plan, never where the moving things are).
-#[derive(Debug, Clone, PartialEq)]
-pub enum MapFeature {
-    /// A landmark known by its colour (a pillar).
-    Landmark {
-        /// Centre of its footprint.
-        centre_mm: Point2<f64>,
-        /// Radius.
-        radius_mm: f64,
-        /// Colour.
-        rgb: Rgb,
-    },
-    /// A straight obstacle that stays where it is (a wall, a board).
-    Segment {
-        /// One end of its centre line.
-        from_mm: Point2<f64>,
-        /// The other end.
-        to_mm: Point2<f64>,
-        /// Half its thickness.
-        half_thickness_mm: f64,
-    },
-    /// A piece of the floor's boundary (a field wall, a corridor's inner face).
-    Bound {
-        /// One end of its centre line.
-        from_mm: Point2<f64>,
-        /// The other end.
-        to_mm: Point2<f64>,
-        /// Half its thickness (0 for a face).
-        half_thickness_mm: f64,
-    },
-    /// An edge of a box that may be moved (a cube).
-    BoxEdge {
-        /// One end.
-        from_mm: Point2<f64>,
-        /// The other end.
-        to_mm: Point2<f64>,
-    },
-    /// A named striped mark (a board with a name).
-    Mark {
-        /// Its name.
-        name: String,
-        /// Centre of the board.
-        centre_mm: Point2<f64>,
-        /// Relative stripe widths.
-        stripes: Vec<f64>,
-    },
-}
-
-/// Lines painted on the floor region after the Small-Size field's markings (its boundary, the
-/// centre line and the centre circle), which the renderers and the top view paint from these
-/// figures.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FieldLines {
-    /// Half-length of the boundary.
-    pub half_length_mm: f64,
-    /// Half-width of the boundary.
-    pub half_width_mm: f64,
-    /// Width of each line.
-    pub line_width_mm: f64,
-    /// Radius of the centre circle.
-    pub centre_circle_radius_mm: f64,
-}
-
-/// The vertical stripes on a striped solid (a board), from one end to the other.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Stripes {
-    /// Cumulative stripe boundaries as fractions of the length, ending at 1.
-    pub edges: Vec<f64>,
-    /// Colour of the first, third, ... stripe.
-    pub rgb_a: Rgb,
-    /// Colour of the second, fourth, ... stripe.
-    pub rgb_b: Rgb,
-}
-
-/// A kind of thing on the floor, as the systems see it. Every method has a default that adds
-/// nothing, so that a kind says only what it is.
-pub trait Kind: Sized {
-    /// The problems of this entry, its fields named relative to the entry (`size_mm` for
-    /// `world.cubes[2].size_mm`). `world` is the whole layout, for rules about the rest of it.
-    fn check(&self, _world: &Layout, _problems: &mut Problems) {}
-
-    /// The solids entry `index` (its rank among the entries of its kind) puts on the floor, each
-    /// with its truth object: what the physics world collides with and the renderer draws.
-    fn solids(&self, _index: u32, _out: &mut Vec<Solid>) {}
-
-    /// The solids of all entries of the kind; a kind whose entries join (corridors) overrides it.
-    fn solids_of_all(all: &[Self], out: &mut Vec<Solid>) {
-        for (i, entry) in all.iter().enumerate() {
-            entry.solids(i as u32, out);
-        }
-    }
-
-    /// The floor-coloured rectangles it adds to the floor region.
-    fn floor_rects(&self, _out: &mut Vec<FloorRect>) {}
-
-    /// The marks it paints on the floor.
-    fn floor_marks(&self, _out: &mut Vec<FloorMark>) {}
-
-    /// The lines it paints on the floor region.
-    fn field_lines(&self, _out: &mut Vec<FieldLines>) {}
-
-    /// The stripes of its striped solids, one for each solid whose `board` is `Some`: that
-    /// solid's `board` is the rank of its stripes among those of its kind's entries (the layout
-    /// numbers them across the kinds).
-    fn stripes(&self, _out: &mut Vec<Stripes>) {}
-
-    /// What the robot's map holds of it.
-    fn map(&self, _out: &mut Vec<MapFeature>) {}
-
-    /// The map of all entries of the kind; a kind whose entries join (corridors) overrides it.
-    fn map_of_all(all: &[Self], out: &mut Vec<MapFeature>) {
-        for entry in all {
-            entry.map(out);
-        }
-    }
-}
-
-/// Something that goes through the registry's kinds, each with its entries (see
-/// [`Layout::visit_kinds`]).
-pub trait KindVisitor {
-    /// The entries of one kind: `key` its scenario path (`world.cubes`), `list` whether the
-    /// scenario gives it as a list (`[[world.cubes]]`) rather than one table.
-    fn visit<K: Kind>(&mut self, key: &'static str, list: bool, entries: &[K]);
-}
-
-/// The scenario path of entry `index` of a kind (`world.cubes[2]`, or `world.field`).
-pub fn entry_path(key: &str, list: bool, index: usize) -> String {
-    if list {
-        format!("{key}[{index}]")
-    } else {
-        key.to_string()
-    }
-}
-
-/// The registry: `Layout` with one field per kind, in the order its systems go through them.
+/// The registry: each line declares the kind's module and gives `Layout` its field, in the
+/// order the systems go through the kinds.
 macro_rules! things_on_the_floor {
-    ($($(#[$doc:meta])* $key:ident: $holder:ident<$kind:ty>,)*) => {
+    ($($(#[$doc:meta])* $key:ident: $holder:ident<$module:ident::$kind:ident>,)*) => {
+        $(pub mod $module;)*
+
         /// The world as plain data: the floor's colours and the things on the floor, one field
         /// a kind. Scenario files embed it as `[world]`.
         #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
         #[serde(deny_unknown_fields, default)]
         pub struct Layout {
             /// Colour of the floor region (field green).
-            pub floor_rgb: $crate::color::Rgb,
+            pub floor_rgb: crate::color::Rgb,
             /// Colour of the floor outside the floor region.
-            pub outside_rgb: $crate::color::Rgb,
+            pub outside_rgb: crate::color::Rgb,
             /// Colour of the field's white lines.
-            pub line_rgb: $crate::color::Rgb,
-            $($(#[$doc])* pub $key: $holder<$kind>,)*
+            pub line_rgb: crate::color::Rgb,
+            $($(#[$doc])* pub $key: $holder<$module::$kind>,)*
         }
 
         impl Default for Layout {
             fn default() -> Self {
                 Self {
-                    floor_rgb: $crate::color::Rgb([30, 130, 55]),
-                    outside_rgb: $crate::color::Rgb([120, 100, 80]),
-                    line_rgb: $crate::color::Rgb([240, 240, 240]),
+                    floor_rgb: crate::color::Rgb([30, 130, 55]),
+                    outside_rgb: crate::color::Rgb([120, 100, 80]),
+                    line_rgb: crate::color::Rgb([240, 240, 240]),
                     $($key: Default::default(),)*
                 }
             }
@@ -191,8 +45,8 @@ macro_rules! things_on_the_floor {
 
         impl Layout {
             /// Goes through every kind of the registry in its order, with its entries.
-            pub fn visit_kinds(&self, visitor: &mut impl $crate::kinds::KindVisitor) {
-                $(visitor.visit::<$kind>(
+            pub fn visit_kinds(&self, visitor: &mut impl KindVisitor) {
+                $(visitor.visit::<$module::$kind>(
                     concat!("world.", stringify!($key)),
                     stringify!($holder) == "Vec",
                     self.$key.as_slice(),
@@ -201,4 +55,27 @@ macro_rules! things_on_the_floor {
         }
     };
 }
-pub(crate) use things_on_the_floor;
+
+things_on_the_floor! {
+    /// Corridors: floor and walls from a centre polyline and a width (`[[world.corridors]]`).
+    corridors: Vec<corridor::Corridor>,
+    /// The RoboCup Small-Size field, when present (`[world.field]`).
+    field: Option<field::FieldSpec>,
+    /// Extra rectangles of floor colour (`[[world.floor_rects]]`). With no floor rectangle of
+    /// any kind the whole plane is floor.
+    floor_rects: Vec<floor_rect::FloorRect>,
+    /// Free-standing walls (`[[world.walls]]`).
+    walls: Vec<wall::Wall>,
+    /// Cubes (`[[world.cubes]]`).
+    cubes: Vec<cube::Cube>,
+    /// Pillars (`[[world.pillars]]`).
+    pillars: Vec<pillar::Pillar>,
+    /// Striped boards, the landmarks (`[[world.boards]]`).
+    boards: Vec<board::Board>,
+    /// Marks painted on the floor (`[[world.floor_marks]]`).
+    floor_marks: Vec<floor_mark::FloorMark>,
+    /// Marks scattered at random over a rectangle of the floor (`[world.mark_scatter]`).
+    mark_scatter: Option<mark_scatter::MarkScatter>,
+    /// The ball (`[world.ball]`), when there is one.
+    ball: Option<ball::BallSpec>,
+}

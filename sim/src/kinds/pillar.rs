@@ -1,9 +1,8 @@
 //! Pillars (`[[world.pillars]]`): upright cylinders, the landmarks a robot knows by colour.
 
-use super::{Kind, MapFeature};
+use super::kind::{Kind, MapFeature, Surroundings};
 use crate::color::Rgb;
 use crate::labels::{Class, ObjectId};
-use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::Point2;
 use omniloop_problem::Problems;
@@ -24,7 +23,7 @@ pub struct Pillar {
 }
 
 impl Kind for Pillar {
-    fn check(&self, _world: &Layout, c: &mut Problems) {
+    fn check(&self, _: &[Self], _: &dyn Surroundings, c: &mut Problems) {
         c.positive("radius_mm", self.radius_mm);
         c.positive("height_mm", self.height_mm);
     }

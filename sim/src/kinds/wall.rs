@@ -1,9 +1,8 @@
 //! Free-standing walls (`[[world.walls]]`).
 
-use super::{Kind, MapFeature};
+use super::kind::{Kind, MapFeature, Surroundings};
 use crate::color::Rgb;
 use crate::labels::{Class, ObjectId};
-use crate::layout::Layout;
 use crate::shapes::{Solid, SolidShape};
 use nalgebra::{Point2, Vector2};
 use omniloop_problem::Problems;
@@ -57,7 +56,7 @@ impl Wall {
 }
 
 impl Kind for Wall {
-    fn check(&self, _world: &Layout, c: &mut Problems) {
+    fn check(&self, _: &[Self], _: &dyn Surroundings, c: &mut Problems) {
         c.positive("thickness_mm", self.thickness_mm);
         c.positive("height_mm", self.height_mm);
         let len = ((self.to_mm[0] - self.from_mm[0]).powi(2)

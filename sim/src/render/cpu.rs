@@ -1005,8 +1005,8 @@ mod tests {
     /// sector) and one just above the robot's body.
     fn sphere_scene() -> Scene {
         use crate::labels::{Class, ObjectId};
-        use crate::{Cube, FieldSpec, Layout, Pillar};
         use crate::sphere::Sphere;
+        use crate::{Cube, FieldSpec, Layout, Pillar};
         let layout = Layout {
             field: Some(FieldSpec::default()),
             cubes: vec![Cube {

@@ -1,7 +1,6 @@
 //! Marks painted on the floor: squares and discs of their own colour (the dark marks a forward
 //! camera tracks for visual odometry), given one by one or scattered over an area at random.
 
-use super::Kind;
 use crate::color::Rgb;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -117,17 +116,5 @@ mod tests {
         assert!(m.iter().any(|k| k.shape == MarkShape::Square));
         assert_eq!(m, s.marks());
         assert_ne!(m, MarkScatter { seed: 4, ..s }.marks());
-    }
-}
-
-impl Kind for FloorMark {
-    fn floor_marks(&self, out: &mut Vec<FloorMark>) {
-        out.push(self.clone());
-    }
-}
-
-impl Kind for MarkScatter {
-    fn floor_marks(&self, out: &mut Vec<FloorMark>) {
-        out.extend(self.marks());
     }
 }
