@@ -8,90 +8,79 @@
 
 use serde::Serialize;
 
-/// A class of thing a pixel can show.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Class {
+/// The classes: each line a class, its name in the legend and whether a world has several
+/// things of it (numbered by instance) or one.
+macro_rules! classes {
+    ($($(#[$doc:meta])* $class:ident = $name:literal, $several:literal;)*) => {
+        /// A class of thing a pixel can show.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+        #[serde(rename_all = "snake_case")]
+        pub enum Class {
+            $($(#[$doc])* $class,)*
+        }
+
+        impl Class {
+            /// Every class, in the order of their numbers.
+            pub const ALL: &[Class] = &[$(Class::$class,)*];
+
+            /// Its name in the legend (`floor_region`, `cube`, ...).
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Class::$class => $name,)*
+                }
+            }
+
+            /// Whether a world may have several things of the class, told apart by instance.
+            pub fn has_instances(self) -> bool {
+                match self {
+                    $(Class::$class => $several,)*
+                }
+            }
+        }
+    };
+}
+
+classes! {
     /// Outside the mirror's image circle: the camera sees no mirror there.
-    Nothing,
+    Nothing = "nothing", false;
     /// A ray that meets nothing.
-    Sky,
+    Sky = "sky", false;
     /// The observing robot's own body.
-    OwnBody,
+    OwnBody = "own_body", false;
     /// Bare floor inside the floor region (the floor colour).
-    FloorRegion,
+    FloorRegion = "floor_region", false;
     /// A field line painted on the floor region.
-    FloorLine,
+    FloorLine = "floor_line", false;
     /// A mark painted on the floor.
-    FloorMark,
+    FloorMark = "floor_mark", false;
     /// Floor outside the floor region.
-    FloorOutside,
+    FloorOutside = "floor_outside", false;
     /// A wall of the Small-Size field around the floor region.
-    FieldWall,
+    FieldWall = "field_wall", false;
     /// A free-standing or corridor wall.
-    Wall,
+    Wall = "wall", false;
     /// A goal's walls (instance 0: the goal at +x, 1: at -x).
-    Goal,
+    Goal = "goal", true;
     /// A cube (instance: its index in `[[world.cubes]]`).
-    Cube,
+    Cube = "cube", true;
     /// A pillar (instance: its index in `[[world.pillars]]`).
-    Pillar,
+    Pillar = "pillar", true;
     /// A striped board (instance: its index in `[[world.boards]]`).
-    Board,
+    Board = "board", true;
     /// Another robot (instance: its index in the team).
-    Robot,
+    Robot = "robot", true;
     /// A ball (instance: which one, 0 for the first). Last of the classes, so that the label
     /// numbers of a world without a ball are those it had before balls existed.
-    Ball,
+    Ball = "ball", true;
 }
 
 impl Class {
-    /// Every class, in the order of their numbers.
-    pub const ALL: [Class; 15] = [
-        Class::Nothing,
-        Class::Sky,
-        Class::OwnBody,
-        Class::FloorRegion,
-        Class::FloorLine,
-        Class::FloorMark,
-        Class::FloorOutside,
-        Class::FieldWall,
-        Class::Wall,
-        Class::Goal,
-        Class::Cube,
-        Class::Pillar,
-        Class::Board,
-        Class::Robot,
-        Class::Ball,
-    ];
-
     /// Whether the class is the floor (region, lines, marks or outside).
     pub fn is_floor(self) -> bool {
         matches!(
             self,
             Class::FloorRegion | Class::FloorLine | Class::FloorMark | Class::FloorOutside
         )
-    }
-
-    /// Its name in the legend (`floor_region`, `cube`, ...).
-    pub fn name(self) -> &'static str {
-        match self {
-            Class::Nothing => "nothing",
-            Class::Sky => "sky",
-            Class::OwnBody => "own_body",
-            Class::FloorRegion => "floor_region",
-            Class::FloorLine => "floor_line",
-            Class::FloorMark => "floor_mark",
-            Class::FloorOutside => "floor_outside",
-            Class::FieldWall => "field_wall",
-            Class::Wall => "wall",
-            Class::Goal => "goal",
-            Class::Cube => "cube",
-            Class::Pillar => "pillar",
-            Class::Board => "board",
-            Class::Robot => "robot",
-            Class::Ball => "ball",
-        }
     }
 }
 
@@ -228,9 +217,7 @@ fn name(o: ObjectId) -> String {
         Class::Goal if o.instance == 0 => "goal +x".into(),
         Class::Goal => "goal -x".into(),
         Class::Ball if o.instance == 0 => "ball".into(),
-        Class::Cube | Class::Pillar | Class::Board | Class::Robot | Class::Ball => {
-            format!("{} {}", o.class.name(), o.instance)
-        }
+        c if c.has_instances() => format!("{} {}", c.name(), o.instance),
         c => c.name().into(),
     }
 }

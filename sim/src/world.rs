@@ -83,17 +83,9 @@ impl ContactsByClass {
     /// The classes touched at least once, with their counts, in the classes' order.
     pub fn touched(&self) -> impl Iterator<Item = (Class, u32)> + '_ {
         Class::ALL
-            .into_iter()
-            .map(|c| (c, self.of(c)))
+            .iter()
+            .map(|&c| (c, self.of(c)))
             .filter(|(_, n)| *n > 0)
-    }
-}
-
-impl std::ops::AddAssign for ContactsByClass {
-    fn add_assign(&mut self, other: Self) {
-        for (a, b) in self.0.iter_mut().zip(other.0) {
-            *a += b;
-        }
     }
 }
 
