@@ -283,6 +283,12 @@ fn a_robot_commanded_into_a_wall_at_2000_mm_s_stays_outside_and_the_contact_is_c
     assert!(!m.reached_goal);
     assert!(m.peak_speed_mm_s >= 1999.0, "{m:?}");
     assert_eq!(m.wall_contacts, 1, "{m:?}");
+    let by_class: Vec<(&str, u32)> = m
+        .contacts_by_class
+        .iter()
+        .map(|(k, v)| (k.as_str(), *v))
+        .collect();
+    assert_eq!(by_class, [("wall", 1)], "{m:?}");
     // Wall face at x = 550: the centre never gets past 550 - 90 = 460 (1 mm tolerance).
     let max_x = out
         .trajectory
