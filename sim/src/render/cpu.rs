@@ -19,7 +19,7 @@
 
 mod packet;
 
-use super::scene::{BoxPrim, QuadPrim, Scene};
+use super::scene::{BoxPrim, QuadPrim, RANKED, Scene, SceneList, rank_slot};
 use super::trace::{self, BLACK, FloorPaint, Hit, V3};
 use crate::sensor::Sensor;
 use nalgebra::Isometry2;
@@ -333,8 +333,9 @@ struct Sectors {
     /// The highest top of any primitive plus [`CULL_MARGIN_MM`]: a ray from above it that does
     /// not go down meets nothing.
     top_mm: f32,
-    /// The number of boxes, of quads and of cylinders, for [`Sectors::rank`].
-    counts: [u32; 3],
+    /// The rank of each ranked list's first primitive ([`Scene::first_ranks`]), for
+    /// [`Sectors::rank`].
+    first_ranks: [u32; RANKED.len()],
 }
 
 /// The shaded, packed colours of a primitive's six faces in the order of their `index`, and two
@@ -546,21 +547,17 @@ impl Sectors {
             .chain(scene.cylinders.iter().map(|c| c.geom[3]))
             .chain(scene.spheres.iter().map(|s| s.geom[2] + s.geom[3]));
         self.top_mm = tops.fold(f32::NEG_INFINITY, f32::max) + CULL_MARGIN_MM;
-        self.counts = [
-            scene.boxes.len() as u32,
-            scene.quads.len() as u32,
-            scene.cylinders.len() as u32,
-        ];
+        self.first_ranks = scene.first_ranks();
     }
 
     /// A primitive's place in the scene's order, from 1 (0 is the floor's).
     fn rank(&self, prim: Prim) -> u32 {
-        let [boxes, quads, cylinders] = self.counts;
+        let first = &self.first_ranks;
         match prim {
-            Prim::Box(i) => 1 + i,
-            Prim::Quad(i) => 1 + boxes + i,
-            Prim::Cylinder(i) => 1 + boxes + quads + i,
-            Prim::Sphere(i) => 1 + boxes + quads + cylinders + i,
+            Prim::Box(i) => first[const { rank_slot(SceneList::Boxes) }] + i,
+            Prim::Quad(i) => first[const { rank_slot(SceneList::Quads) }] + i,
+            Prim::Cylinder(i) => first[const { rank_slot(SceneList::Cylinders) }] + i,
+            Prim::Sphere(i) => first[const { rank_slot(SceneList::Spheres) }] + i,
         }
     }
 

@@ -13,9 +13,7 @@
 
 use super::error::RenderError;
 use super::noise::{FrameNoise, gauss_table};
-use super::scene::{
-    BoardPrim, BoxPrim, CylinderPrim, FloorRectPrim, QuadPrim, Scene, SceneGlobals, SpherePrim,
-};
+use super::scene::{SCENE_LISTS, Scene, SceneGlobals};
 use super::trace::Code;
 use crate::optics::Optics;
 use crate::optics::calibrated::{CalibratedCamera, MAX_POLYNOMIAL};
@@ -235,13 +233,16 @@ fn calibrated_params(c: &CalibratedCamera) -> (u32, Vec<f64>, [f64; 2]) {
 struct FrameParams {
     globals: SceneGlobals,
     sensor: SensorParams,
-    /// First box, cylinder, board, stripe edge.
-    offsets: [u32; 4],
-    /// First floor rectangle, quad, pixel; the noise's key.
-    offsets2: [u32; 4],
-    /// First sphere, unused.
-    offsets3: [u32; 4],
+    /// The frame's first element of each scene list, at its row's `offset_word` of
+    /// [`SCENE_LISTS`]; word 6 its first pixel, word 7 its noise's key (`offsets`, `offsets2`
+    /// and `offsets3` of `trace.wgsl`).
+    offsets: [u32; 12],
 }
+
+/// Offset word of a frame's first pixel.
+const PIXEL_WORD: usize = 6;
+/// Offset word of a frame's noise key.
+const NOISE_KEY_WORD: usize = 7;
 
 /// One frame to trace: the scene, the sensor, the robot's pose and the frame's noise.
 #[derive(Debug, Clone, Copy)]
@@ -284,13 +285,10 @@ pub type TracedFrame = (Vec<u32>, Option<PixelTruth>);
 #[derive(Default)]
 struct Batch {
     frames: Vec<FrameParams>,
-    boxes: Vec<BoxPrim>,
-    cylinders: Vec<CylinderPrim>,
-    boards: Vec<BoardPrim>,
-    stripes: Vec<f32>,
-    rects: Vec<FloorRectPrim>,
-    quads: Vec<QuadPrim>,
-    spheres: Vec<SpherePrim>,
+    /// Every frame's scene lists, concatenated, one a row of [`SCENE_LISTS`], as bytes.
+    lists: [Vec<u8>; SCENE_LISTS.len()],
+    /// How many elements each of `lists` has.
+    lengths: [usize; SCENE_LISTS.len()],
     pixels: usize,
     /// The pixels of the frames that ask for their truth.
     truth_pixels: usize,
@@ -311,25 +309,20 @@ impl Batch {
                 sensor.size[3] = at(b.truth_pixels + 1)?;
                 b.truth_pixels += n;
             }
+            let mut offsets = [0; 12];
+            for (k, row) in SCENE_LISTS.iter().enumerate() {
+                let (bytes, len) = sc.list(row.list);
+                offsets[row.offset_word] = at(b.lengths[k])?;
+                b.lists[k].extend_from_slice(bytes);
+                b.lengths[k] += len;
+            }
+            offsets[PIXEL_WORD] = at(b.pixels)?;
+            offsets[NOISE_KEY_WORD] = key;
             b.frames.push(FrameParams {
                 globals: sc.globals,
                 sensor,
-                offsets: [
-                    at(b.boxes.len())?,
-                    at(b.cylinders.len())?,
-                    at(b.boards.len())?,
-                    at(b.stripes.len())?,
-                ],
-                offsets2: [at(b.rects.len())?, at(b.quads.len())?, at(b.pixels)?, key],
-                offsets3: [at(b.spheres.len())?, 0, 0, 0],
+                offsets,
             });
-            b.boxes.extend_from_slice(&sc.boxes);
-            b.cylinders.extend_from_slice(&sc.cylinders);
-            b.boards.extend_from_slice(&sc.boards);
-            b.stripes.extend_from_slice(&sc.stripe_edges);
-            b.rects.extend_from_slice(&sc.floor_rects);
-            b.quads.extend_from_slice(&sc.quads);
-            b.spheres.extend_from_slice(&sc.spheres);
             b.pixels += n;
         }
         at(b.pixels)?;
@@ -453,14 +446,8 @@ pub struct GpuRenderer {
     layout: wgpu::BindGroupLayout,
     adapter_name: String,
     frames: Storage,
-    boxes: Storage,
-    cylinders: Storage,
-    boards: Storage,
-    stripes: Storage,
-    rects: Storage,
-    quads: Storage,
-    /// Spheres (room for some from the start: a binding is never empty).
-    spheres: Storage,
+    /// The scene lists' buffers, one a row of [`SCENE_LISTS`].
+    lists: [Storage; SCENE_LISTS.len()],
     /// The noise's Gaussian table, written once.
     gauss: wgpu::Buffer,
     /// The frames' packed RGBA8 pixels.
@@ -470,6 +457,31 @@ pub struct GpuRenderer {
     truth: Output,
     bind_group: Option<wgpu::BindGroup>,
 }
+
+/// `trace.wgsl` after the declarations laid out from [`SCENE_LISTS`]: each list's binding
+/// (`boxes`, ...) and the offset word of its first element in a frame (`FIRST_BOXES`, ...).
+fn shader_source() -> String {
+    let mut text = String::from("// Laid out from SCENE_LISTS (sim/src/render/scene.rs).\n");
+    for row in SCENE_LISTS {
+        let (name, ty) = (row.list.name(), row.list.wgsl_type());
+        text += &format!(
+            "@group(0) @binding({}) var<storage, read> {name}: array<{ty}>;\n",
+            row.binding
+        );
+        let first = format!("FIRST_{}", name.to_uppercase());
+        text += &format!("const {first}: u32 = {}u;\n", row.offset_word);
+    }
+    text += &format!(
+        "const FIRST_PIXEL: u32 = {PIXEL_WORD}u;\nconst NOISE_KEY: u32 = {NOISE_KEY_WORD}u;\n"
+    );
+    text + include_str!("trace.wgsl")
+}
+
+/// The bindings of `trace.wgsl` that are not scene lists ([`SCENE_LISTS`] has theirs).
+const FRAMES_BINDING: u32 = 0;
+const PIXELS_BINDING: u32 = 7;
+const GAUSS_BINDING: u32 = 9;
+const TRUTH_BINDING: u32 = 10;
 
 const STORAGE_RW: wgpu::BufferUsages =
     wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST);
@@ -536,13 +548,10 @@ impl GpuRenderer {
             std::mem::size_of::<FrameParams>() as u64,
             STORAGE_RW,
         );
-        let boxes = Storage::new(&device, "boxes", 64 * 48, STORAGE_RW);
-        let cylinders = Storage::new(&device, "cylinders", 16 * 48, STORAGE_RW);
-        let boards = Storage::new(&device, "boards", 4 * 48, STORAGE_RW);
-        let stripes = Storage::new(&device, "stripes", 64 * 4, STORAGE_RW);
-        let rects = Storage::new(&device, "rects", 8 * 48, STORAGE_RW);
-        let quads = Storage::new(&device, "quads", 16 * 64, STORAGE_RW);
-        let spheres = Storage::new(&device, "spheres", 16 * 32, STORAGE_RW);
+        let lists = SCENE_LISTS.map(|row| {
+            let bytes = row.initial_room * row.list.element_bytes() as u64;
+            Storage::new(&device, row.list.name(), bytes, STORAGE_RW)
+        });
         let table: &[u8] = bytemuck::cast_slice(gauss_table());
         let gauss = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("gauss"),
@@ -560,13 +569,7 @@ impl GpuRenderer {
             layout,
             adapter_name,
             frames,
-            boxes,
-            cylinders,
-            boards,
-            stripes,
-            rects,
-            quads,
-            spheres,
+            lists,
             gauss,
             pixels,
             truth,
@@ -578,25 +581,21 @@ impl GpuRenderer {
     fn trace_pipeline(device: &wgpu::Device) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("trace.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("trace.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         use wgpu::BufferBindingType as B;
         let ro = B::Storage { read_only: true };
+        let rw = B::Storage { read_only: false };
+        let mut entries = vec![
+            entry(FRAMES_BINDING, ro),
+            entry(PIXELS_BINDING, rw),
+            entry(GAUSS_BINDING, ro),
+            entry(TRUTH_BINDING, rw),
+        ];
+        entries.extend(SCENE_LISTS.iter().map(|row| entry(row.binding, ro)));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace"),
-            entries: &[
-                entry(0, ro),
-                entry(2, ro),
-                entry(3, ro),
-                entry(4, ro),
-                entry(5, ro),
-                entry(6, ro),
-                entry(7, B::Storage { read_only: false }),
-                entry(8, ro),
-                entry(9, ro),
-                entry(10, B::Storage { read_only: false }),
-                entry(11, ro),
-            ],
+            entries: &entries,
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("trace"),
@@ -761,33 +760,22 @@ impl GpuRenderer {
         rebind |= self.truth.fit(&self.device, truth_bytes);
         let (d, q) = (&self.device, &self.queue);
         rebind |= self.frames.write(d, q, bytemuck::cast_slice(&b.frames));
-        rebind |= self.boxes.write(d, q, bytemuck::cast_slice(&b.boxes));
-        rebind |= self
-            .cylinders
-            .write(d, q, bytemuck::cast_slice(&b.cylinders));
-        rebind |= self.boards.write(d, q, bytemuck::cast_slice(&b.boards));
-        rebind |= self.stripes.write(d, q, bytemuck::cast_slice(&b.stripes));
-        rebind |= self.rects.write(d, q, bytemuck::cast_slice(&b.rects));
-        rebind |= self.quads.write(d, q, bytemuck::cast_slice(&b.quads));
-        rebind |= self.spheres.write(d, q, bytemuck::cast_slice(&b.spheres));
+        for (buffer, bytes) in self.lists.iter_mut().zip(&b.lists) {
+            rebind |= buffer.write(d, q, bytes);
+        }
         rebind
     }
 
     /// A new bind group over the current buffers.
     fn rebind(&mut self) {
-        let buffers = [
-            (0, &self.frames.buffer),
-            (2, &self.boxes.buffer),
-            (3, &self.cylinders.buffer),
-            (4, &self.boards.buffer),
-            (5, &self.stripes.buffer),
-            (6, &self.rects.buffer),
-            (7, &self.pixels.buffer),
-            (8, &self.quads.buffer),
-            (9, &self.gauss),
-            (10, &self.truth.buffer),
-            (11, &self.spheres.buffer),
+        let mut buffers = vec![
+            (FRAMES_BINDING, &self.frames.buffer),
+            (PIXELS_BINDING, &self.pixels.buffer),
+            (GAUSS_BINDING, &self.gauss),
+            (TRUTH_BINDING, &self.truth.buffer),
         ];
+        let lists = SCENE_LISTS.iter().zip(&self.lists);
+        buffers.extend(lists.map(|(row, storage)| (row.binding, &storage.buffer)));
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
             .map(|(i, b)| wgpu::BindGroupEntry {

@@ -117,6 +117,150 @@ pub const SQUARE_MARK: f32 = 1.0;
 /// `FloorRectPrim::frame[2]` of a disc mark.
 pub const DISC_MARK: f32 = 2.0;
 
+/// The scene's lists, as the kernels read them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SceneList {
+    /// [`Scene::boxes`].
+    Boxes,
+    /// [`Scene::cylinders`].
+    Cylinders,
+    /// [`Scene::boards`].
+    Boards,
+    /// [`Scene::stripe_edges`].
+    StripeEdges,
+    /// [`Scene::floor_rects`].
+    FloorRects,
+    /// [`Scene::quads`].
+    Quads,
+    /// [`Scene::spheres`].
+    Spheres,
+}
+
+impl SceneList {
+    /// Its name: its array's in `trace.wgsl`, its GPU buffer's label.
+    pub fn name(self) -> &'static str {
+        match self {
+            SceneList::Boxes => "boxes",
+            SceneList::Cylinders => "cylinders",
+            SceneList::Boards => "boards",
+            SceneList::StripeEdges => "stripe_edges",
+            SceneList::FloorRects => "floor_rects",
+            SceneList::Quads => "quads",
+            SceneList::Spheres => "spheres",
+        }
+    }
+
+    /// The WGSL type of its elements (the structs of `trace.wgsl`, twins of this file's).
+    pub fn wgsl_type(self) -> &'static str {
+        match self {
+            SceneList::Boxes => "BoxPrim",
+            SceneList::Cylinders => "CylinderPrim",
+            SceneList::Boards => "BoardPrim",
+            SceneList::StripeEdges => "f32",
+            SceneList::FloorRects => "FloorRectPrim",
+            SceneList::Quads => "QuadPrim",
+            SceneList::Spheres => "SpherePrim",
+        }
+    }
+
+    /// The bytes of one of its elements.
+    pub fn element_bytes(self) -> usize {
+        match self {
+            SceneList::Boxes => std::mem::size_of::<BoxPrim>(),
+            SceneList::Cylinders => std::mem::size_of::<CylinderPrim>(),
+            SceneList::Boards => std::mem::size_of::<BoardPrim>(),
+            SceneList::StripeEdges => std::mem::size_of::<f32>(),
+            SceneList::FloorRects => std::mem::size_of::<FloorRectPrim>(),
+            SceneList::Quads => std::mem::size_of::<QuadPrim>(),
+            SceneList::Spheres => std::mem::size_of::<SpherePrim>(),
+        }
+    }
+}
+
+/// One row of [`SCENE_LISTS`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ListLayout {
+    /// The list.
+    pub list: SceneList,
+    /// Its storage binding in `trace.wgsl`'s group 0.
+    pub binding: u32,
+    /// Where a frame's first element of it goes among the frame's offset words (`Frame.offsets`,
+    /// `offsets2`, `offsets3` of `trace.wgsl`, as one array of twelve).
+    pub offset_word: usize,
+    /// The elements the GPU's buffer has room for at the start (never empty: a binding needs
+    /// bytes).
+    pub initial_room: u64,
+}
+
+/// The table the GPU's buffers, bindings and per-frame offsets are laid out from: one row a
+/// list of the scene. (Offset words 6 and 7 are a frame's first pixel and its noise's key.)
+pub const SCENE_LISTS: [ListLayout; 7] = [
+    ListLayout {
+        list: SceneList::Boxes,
+        binding: 2,
+        offset_word: 0,
+        initial_room: 64,
+    },
+    ListLayout {
+        list: SceneList::Cylinders,
+        binding: 3,
+        offset_word: 1,
+        initial_room: 16,
+    },
+    ListLayout {
+        list: SceneList::Boards,
+        binding: 4,
+        offset_word: 2,
+        initial_room: 4,
+    },
+    ListLayout {
+        list: SceneList::StripeEdges,
+        binding: 5,
+        offset_word: 3,
+        initial_room: 64,
+    },
+    ListLayout {
+        list: SceneList::FloorRects,
+        binding: 6,
+        offset_word: 4,
+        initial_room: 8,
+    },
+    ListLayout {
+        list: SceneList::Quads,
+        binding: 8,
+        offset_word: 5,
+        initial_room: 16,
+    },
+    ListLayout {
+        list: SceneList::Spheres,
+        binding: 11,
+        offset_word: 8,
+        initial_room: 16,
+    },
+];
+
+/// The primitives a ray may meet, in the order of their ranks: a pixel's code is its
+/// primitive's rank, from 1 for the first box (0 is the floor). Every kernel (the reference,
+/// the packets, AVX2, `trace.wgsl`) and the legend ([`Scene::objects`]) follow it.
+pub const RANKED: [SceneList; 4] = [
+    SceneList::Boxes,
+    SceneList::Quads,
+    SceneList::Cylinders,
+    SceneList::Spheres,
+];
+
+/// Where `list` is in [`RANKED`] (`RANKED.len()` for a list a ray does not meet).
+pub const fn rank_slot(list: SceneList) -> usize {
+    let mut i = 0;
+    while i < RANKED.len() {
+        if RANKED[i] as u8 == list as u8 {
+            return i;
+        }
+        i += 1;
+    }
+    RANKED.len()
+}
+
 /// Everything about the scene that is not a list.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -214,15 +358,20 @@ fn floor_rects(layout: &Layout) -> (Vec<FloorRectPrim>, bool) {
     (floor_rects, any_region)
 }
 
-/// What each solid is, in the order of the primitives' ranks: boxes, quad prisms, cylinders.
+/// The list a solid's primitive goes in.
+fn list_of(shape: &SolidShape) -> SceneList {
+    match shape {
+        SolidShape::Box { .. } => SceneList::Boxes,
+        SolidShape::Quad { .. } => SceneList::Quads,
+        SolidShape::Cylinder { .. } => SceneList::Cylinders,
+    }
+}
+
+/// What each solid is, in the order of the primitives' ranks ([`RANKED`]).
 fn objects_by_rank(solids: &[&Solid]) -> Vec<ObjectId> {
-    let rank = |s: &&&Solid| match s.shape {
-        SolidShape::Box { .. } => 0,
-        SolidShape::Quad { .. } => 1,
-        SolidShape::Cylinder { .. } => 2,
-    };
-    (0..3)
-        .flat_map(|k| solids.iter().filter(move |s| rank(s) == k))
+    RANKED
+        .iter()
+        .flat_map(|&list| solids.iter().filter(move |s| list_of(&s.shape) == list))
         .map(|s| s.object)
         .collect()
 }
@@ -364,8 +513,95 @@ impl Scene {
         self
     }
 
+    /// A list's elements, as the bytes the GPU reads, and how many there are.
+    pub fn list(&self, list: SceneList) -> (&[u8], usize) {
+        fn bytes<T: Pod>(v: &[T]) -> (&[u8], usize) {
+            (bytemuck::cast_slice(v), v.len())
+        }
+        match list {
+            SceneList::Boxes => bytes(&self.boxes),
+            SceneList::Cylinders => bytes(&self.cylinders),
+            SceneList::Boards => bytes(&self.boards),
+            SceneList::StripeEdges => bytes(&self.stripe_edges),
+            SceneList::FloorRects => bytes(&self.floor_rects),
+            SceneList::Quads => bytes(&self.quads),
+            SceneList::Spheres => bytes(&self.spheres),
+        }
+    }
+
+    /// The rank of the first primitive of each list of [`RANKED`] (from 1; 0 is the floor).
+    pub fn first_ranks(&self) -> [u32; RANKED.len()] {
+        let mut next = 1;
+        RANKED.map(|list| {
+            let first = next;
+            next += self.list(list).1 as u32;
+            first
+        })
+    }
+
     /// The legend of the labels of this scene's things.
     pub fn legend(&self) -> Legend {
         Legend::new(self.objects.iter().copied())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Cube, Pillar};
+
+    #[test]
+    fn the_lists_table_gives_each_list_its_own_binding_and_offset_word() {
+        let mut bindings: Vec<u32> = SCENE_LISTS.iter().map(|r| r.binding).collect();
+        // Frames 0, pixels 7, the noise table 9 and the truth 10 are bound beside the lists.
+        bindings.extend([0, 7, 9, 10]);
+        bindings.sort_unstable();
+        bindings.dedup();
+        assert_eq!(bindings.len(), SCENE_LISTS.len() + 4);
+        let mut words: Vec<usize> = SCENE_LISTS.iter().map(|r| r.offset_word).collect();
+        words.extend([6, 7]);
+        words.sort_unstable();
+        words.dedup();
+        assert_eq!(words.len(), SCENE_LISTS.len() + 2);
+        assert!(words.iter().all(|&w| w < 12));
+        for list in RANKED {
+            assert!(SCENE_LISTS.iter().any(|r| r.list == list), "{list:?}");
+            assert_eq!(RANKED[rank_slot(list)], list);
+        }
+        assert_eq!(rank_slot(SceneList::Boards), RANKED.len());
+    }
+
+    #[test]
+    fn a_primitives_rank_finds_its_object_in_the_legend_order() {
+        let layout = Layout {
+            cubes: vec![Cube {
+                center_mm: [500.0, 0.0],
+                size_mm: 100.0,
+                angle_deg: 0.0,
+                rgb: Rgb([40, 40, 40]),
+            }],
+            pillars: vec![Pillar {
+                center_mm: [0.0, 500.0],
+                radius_mm: 50.0,
+                height_mm: 300.0,
+                rgb: Rgb([200, 0, 0]),
+            }],
+            ..Layout::default()
+        };
+        let sphere = Sphere {
+            center_mm: [0.0, -500.0, 21.5],
+            radius_mm: 21.5,
+            rgb: Rgb([255, 120, 0]),
+            object: ObjectId::of(crate::labels::Class::Ball),
+        };
+        let scene = Scene::new(&layout, &[]).with_spheres(&[sphere]);
+        let first = scene.first_ranks();
+        // Ranks count from 1; the objects are listed from rank 1 on.
+        let at = |list: SceneList| scene.objects[first[rank_slot(list)] as usize - 1];
+        assert_eq!(at(SceneList::Boxes).class, crate::labels::Class::Cube);
+        assert_eq!(at(SceneList::Cylinders).class, crate::labels::Class::Pillar);
+        assert_eq!(at(SceneList::Spheres).class, crate::labels::Class::Ball);
+        let (bytes, n) = scene.list(SceneList::Spheres);
+        assert_eq!((bytes.len(), n), (SceneList::Spheres.element_bytes(), 1));
     }
 }

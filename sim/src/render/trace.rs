@@ -2,7 +2,10 @@
 //! operation: floor colouring, box, quad, cylinder, sphere and floor intersections, stripe lookup,
 //! shading and packing. The CPU renderer calls these; the GPU runs the WGSL twin.
 
-use super::scene::{BoxPrim, CylinderPrim, FLOOR_REGION, QuadPrim, SQUARE_MARK, Scene, SpherePrim};
+use super::scene::{
+    BoxPrim, CylinderPrim, FLOOR_REGION, QuadPrim, RANKED, SQUARE_MARK, Scene, SceneList,
+    SpherePrim,
+};
 
 /// A 3-vector in `f32`.
 pub type V3 = [f32; 3];
@@ -560,27 +563,37 @@ pub fn trace_ray(s: &Scene, o: V3, d: V3) -> Traced {
         }
         *rank += 1;
     };
-    for b in &s.boxes {
-        keep(hit_box(s, b, o, d, t_max), &mut t_max, &mut best, &mut rank);
-    }
-    for q in &s.quads {
-        keep(hit_quad(q, o, d, t_max), &mut t_max, &mut best, &mut rank);
-    }
-    for c in &s.cylinders {
-        keep(
-            hit_cylinder(c, o, d, t_max),
-            &mut t_max,
-            &mut best,
-            &mut rank,
-        );
-    }
-    for sp in &s.spheres {
-        keep(
-            hit_sphere(sp, o, d, t_max),
-            &mut t_max,
-            &mut best,
-            &mut rank,
-        );
+    // Each list in the order of the ranks, so that a primitive's code is its rank.
+    for list in RANKED {
+        match list {
+            SceneList::Boxes => {
+                for b in &s.boxes {
+                    keep(hit_box(s, b, o, d, t_max), &mut t_max, &mut best, &mut rank);
+                }
+            }
+            SceneList::Quads => {
+                for q in &s.quads {
+                    keep(hit_quad(q, o, d, t_max), &mut t_max, &mut best, &mut rank);
+                }
+            }
+            SceneList::Cylinders => {
+                for c in &s.cylinders {
+                    let hit = hit_cylinder(c, o, d, t_max);
+                    keep(hit, &mut t_max, &mut best, &mut rank);
+                }
+            }
+            SceneList::Spheres => {
+                for sp in &s.spheres {
+                    keep(
+                        hit_sphere(sp, o, d, t_max),
+                        &mut t_max,
+                        &mut best,
+                        &mut rank,
+                    );
+                }
+            }
+            _ => {}
+        }
     }
     let colour = match best {
         Some(h) => pack(shade(s, &h)),

@@ -43,32 +43,30 @@ struct SpherePrim { geom: vec4<f32>, color: vec4<f32> };
 struct Frame {
     g: Globals,
     sensor: SensorParams,
-    offsets: vec4<u32>,     // first box, cylinder, board, stripe edge
-    offsets2: vec4<u32>,    // first floor rect, quad, pixel; noise key
-    offsets3: vec4<u32>,    // first sphere, unused
+    // Where the frame's first element of each scene list is, at that list's word (FIRST_BOXES,
+    // ...: gpu.rs lays them out from SCENE_LISTS); its first pixel, its noise key.
+    offsets: array<vec4<u32>, 3>,
 };
 
+// The scene lists (boxes, cylinders, boards, stripe_edges, floor_rects, quads, spheres) are
+// bound by the declarations gpu.rs puts before this file, from SCENE_LISTS.
 @group(0) @binding(0) var<storage, read> frames: array<Frame>;
-@group(0) @binding(2) var<storage, read> boxes: array<BoxPrim>;
-@group(0) @binding(3) var<storage, read> cylinders: array<CylinderPrim>;
-@group(0) @binding(4) var<storage, read> boards: array<BoardPrim>;
-@group(0) @binding(5) var<storage, read> stripe_edges: array<f32>;
-@group(0) @binding(6) var<storage, read> floor_rects: array<FloorRectPrim>;
 @group(0) @binding(7) var<storage, read_write> pixels: array<u32>;
-@group(0) @binding(8) var<storage, read> quads: array<QuadPrim>;
 // Standard normal quantiles (sim/src/render/noise.rs: gauss_table).
 @group(0) @binding(9) var<storage, read> gauss: array<f32>;
 // Per pixel of the frames that ask for their truth: the distance t along the scene ray (f32
 // bits) and what the ray meets (a code, as trace.rs's Code), the frames one after the other.
 @group(0) @binding(10) var<storage, read_write> truth: array<vec2<u32>>;
-@group(0) @binding(11) var<storage, read> spheres: array<SpherePrim>;
 
 // The invocation's frame (global_invocation_id.z), read once in main.
 var<private> g: Globals;
 var<private> sensor: SensorParams;
-var<private> off: vec4<u32>;
-var<private> off2: vec4<u32>;
-var<private> off3: vec4<u32>;
+var<private> offsets: array<vec4<u32>, 3>;
+
+// The frame's offset word `word`: the first element of a list, its first pixel, its noise key.
+fn first(word: u32) -> u32 {
+    return offsets[word / 4u][word % 4u];
+}
 
 const T_EPS: f32 = 1e-3;
 const BIG: f32 = 3.0e38;
@@ -333,7 +331,7 @@ fn floor_paint(x: f32, y: f32) -> u32 {
     var inside = g.flags.y == 0u;
     var mark = -1;
     for (var i = 0u; i < n; i = i + 1u) {
-        let r = floor_rects[off2.x + i];
+        let r = floor_rects[first(FIRST_FLOOR_RECTS) + i];
         let dx = x - r.geom.x;
         let dy = y - r.geom.y;
         let lx = r.frame.x * dx + r.frame.y * dy;
@@ -368,7 +366,7 @@ fn floor_paint(x: f32, y: f32) -> u32 {
 // The colour of floor paint `k` (floor_paint's index).
 fn paint_color(k: u32) -> vec3<f32> {
     let n = g.counts.x;
-    if (k < n) { return floor_rects[off2.x + k].color.xyz; }
+    if (k < n) { return floor_rects[first(FIRST_FLOOR_RECTS) + k].color.xyz; }
     if (k == n) { return g.outside_rgb.xyz; }
     if (k == n + 1u) { return g.line_rgb.xyz; }
     return g.floor_rgb.xyz;
@@ -420,14 +418,14 @@ fn hit_box(b: BoxPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> Hit {
     }
     var rgb = b.color.xyz;
     if (b.color.w >= 0.0 && tn != sx.x) {
-        let board = boards[off.z + u32(b.color.w)];
+        let board = boards[first(FIRST_BOARDS) + u32(b.color.w)];
         let f = (lox + tn * ldx + hx) / (2.0 * hx);
-        let first = board.range.x;
+        let first_edge = board.range.x;
         let count = board.range.y;
         var k = 0u;
         if (count > 0u) { k = count - 1u; }
         for (var i = 0u; i < count; i = i + 1u) {
-            if (f <= stripe_edges[off.w + first + i]) { k = i; break; }
+            if (f <= stripe_edges[first(FIRST_STRIPE_EDGES) + first_edge + i]) { k = i; break; }
         }
         if (k % 2u == 0u) { rgb = board.color_a.xyz; } else { rgb = board.color_b.xyz; }
     }
@@ -556,7 +554,7 @@ fn noisy(level: u32, sigma: f32, z: f32) -> u32 {
 fn with_noise(p: u32, i: u32) -> u32 {
     let sigma = sensor.intr.w;
     if (sigma <= 0.0) { return p; }
-    let m = mix32(i) ^ off2.w;
+    let m = mix32(i) ^ first(NOISE_KEY);
     let h1 = mix32(m);
     let h2 = mix32(m ^ 0x9e3779b9u);
     let r = noisy(p & 0xffu, sigma, gauss[h1 & 0xffffu]);
@@ -582,25 +580,25 @@ fn trace_scene(o: vec3<f32>, d: vec3<f32>) -> Seen {
             t_max = t;
         }
     }
-    // Ranks from 1: boxes, then quads, then cylinders, then spheres.
+    // Ranks from 1 in the order of RANKED (scene.rs): boxes, then quads, cylinders, spheres.
     var rank = 1u;
     for (var i = 0u; i < g.flags.z; i = i + 1u) {
-        let hb = hit_box(boxes[off.x + i], o, d, t_max);
+        let hb = hit_box(boxes[first(FIRST_BOXES) + i], o, d, t_max);
         if (hb.ok) { best = hb; t_max = hb.t; code = rank + i; }
     }
     rank = rank + g.flags.z;
     for (var i = 0u; i < g.counts.z; i = i + 1u) {
-        let hq = hit_quad(quads[off2.y + i], o, d, t_max);
+        let hq = hit_quad(quads[first(FIRST_QUADS) + i], o, d, t_max);
         if (hq.ok) { best = hq; t_max = hq.t; code = rank + i; }
     }
     rank = rank + g.counts.z;
     for (var i = 0u; i < g.flags.w; i = i + 1u) {
-        let hc = hit_cylinder(cylinders[off.y + i], o, d, t_max);
+        let hc = hit_cylinder(cylinders[first(FIRST_CYLINDERS) + i], o, d, t_max);
         if (hc.ok) { best = hc; t_max = hc.t; code = rank + i; }
     }
     rank = rank + g.flags.w;
     for (var i = 0u; i < g.counts.w; i = i + 1u) {
-        let hs = hit_sphere(spheres[off3.x + i], o, d, t_max);
+        let hs = hit_sphere(spheres[first(FIRST_SPHERES) + i], o, d, t_max);
         if (hs.ok) { best = hs; t_max = hs.t; code = rank + i; }
     }
     return Seen(best, code);
@@ -620,14 +618,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let fr = frames[id.z];
     g = fr.g;
     sensor = fr.sensor;
-    off = fr.offsets;
-    off2 = fr.offsets2;
-    off3 = fr.offsets3;
+    offsets = fr.offsets;
     let w = sensor.size.x;
     let h = sensor.size.y;
     if (id.x >= w || id.y >= h) { return; }
     let local = id.y * w + id.x;
-    let index = off2.z + local;
+    let index = first(FIRST_PIXEL) + local;
     let x = f32(id.x) + 0.5 - sensor.intr.x;
     let y = sensor.intr.y - (f32(id.y) + 0.5);
     let ray = scene_ray(x, y);
