@@ -1,6 +1,8 @@
 //! Closed-loop benchmark: control cycles per second of the E1 corner runs (render, free space,
 //! controller, physics, recording) with the CPU renderer on one core and on all cores and, when
-//! an adapter exists, the GPU.
+//! an adapter exists, the GPU; the goal-direction run also with a ball on the floor far from
+//! the robot's path (behind its start), which every frame renders and every physics step
+//! moves.
 //!
 //!     cargo bench --bench closed_loop
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a benchmark: a broken fixture stops it where it breaks
@@ -27,11 +29,29 @@ fn main() {
     measure(RendererChoice::Gpu);
 }
 
-/// Best of three runs of each E1 scenario with `choice`, a line each.
-fn measure(choice: RendererChoice) {
+/// The E1 scenarios, and the first with a ball behind the robot's start (at rest in the
+/// corridor's end, 350 mm behind the start and 350 mm aside).
+fn scenarios() -> Vec<(String, omniloop::Scenario)> {
+    let mut out = Vec::new();
     for name in ["corner55_goal_direction", "corner55_velocity_aware"] {
         let path = common::scenario_path(&format!("{name}.toml"));
-        let s = load_scenario(&path).expect("scenario loads");
+        out.push((
+            name.to_string(),
+            load_scenario(&path).expect("scenario loads"),
+        ));
+    }
+    let mut with_ball = out[0].1.clone();
+    with_ball.world.ball = Some(omniloop_sim::BallSpec {
+        center_mm: [-2850.0, 350.0],
+        ..omniloop_sim::BallSpec::default()
+    });
+    out.push(("corner55_goal_direction+ball".to_string(), with_ball));
+    out
+}
+
+/// Best of three runs of each E1 scenario with `choice`, a line each.
+fn measure(choice: RendererChoice) {
+    for (name, s) in scenarios() {
         let options = RunOptions {
             renderer: choice,
             ..RunOptions::default()
