@@ -398,11 +398,15 @@ class VectorSimulation:
         self,
         commands: Sequence[_Command] | npt.NDArray[Any] | None = None,
         active: Sequence[bool] | npt.NDArray[np.bool_] | None = None,
+        actuators: Sequence[_Actuators | None] | None = None,
     ) -> list[Observation]:
         """One control cycle of every run whose `active` flag is true (default: all), in
         parallel: `commands` holds a command a run (a sequence or an `N x 3` / `N x 2` array;
-        `None` with `robot="builtin"`). A finished run that is active raises
-        `RunFinishedError`. Returns every run's observation."""
+        `None` with `robot="builtin"`); `actuators` optionally an entry a run, `None` or a list
+        as `Simulation.step` takes it (pan commands; with a kicker, `{"kick_mm_s": S,
+        "angle_rad": A}` and `{"dribbler_rpm": R}`). A finished run that is active raises
+        `RunFinishedError`; a command a run cannot take, `ValueError`, before any run steps.
+        Returns every run's observation."""
 
     def truth(self) -> list[Truth]:
         """Every run's truth now (see `Simulation.truth`)."""

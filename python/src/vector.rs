@@ -139,16 +139,20 @@ impl PyVectorSimulation {
 
     /// One control cycle of every run whose `active` flag is true (default: all), in
     /// parallel: `commands` holds a command a run (a sequence or an `N x 3` / `N x 2` array;
-    /// `None` with `robot="builtin"`). A finished run that is active raises `RunFinishedError`.
+    /// `None` with `robot="builtin"`); `actuators` optionally an entry a run, `None` or a list
+    /// as `Simulation.step` takes it (pan commands; with a kicker, `{"kick_mm_s": S,
+    /// "angle_rad": A}` and `{"dribbler_rpm": R}`). A finished run that is active raises
+    /// `RunFinishedError`; a command a run cannot take, `ValueError`, before any run steps.
     /// Returns every run's observation.
-    #[pyo3(signature = (commands = None, active = None))]
+    #[pyo3(signature = (commands = None, active = None, actuators = None))]
     fn step(
         &self,
         py: Python<'_>,
         commands: Option<&Bound<'_, PyAny>>,
         active: Option<Vec<bool>>,
+        actuators: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Vec<Observation>> {
-        let cmds = self.commands(commands, active)?;
+        let cmds = self.commands(commands, active, actuators)?;
         let result = py.detach(|| {
             let mut states = self.lock();
             states
@@ -203,13 +207,33 @@ impl PyVectorSimulation {
     }
 }
 
+/// `what`, one entry a run of `n` (`None` when not given).
+fn per_run<'py>(
+    what: &str,
+    v: Option<&Bound<'py, PyAny>>,
+    n: usize,
+) -> PyResult<Option<Vec<Bound<'py, PyAny>>>> {
+    let Some(v) = v.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    let rows: Vec<Bound<'py, PyAny>> = v.try_iter()?.collect::<PyResult<_>>()?;
+    if rows.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "{} {what} for {n} runs: one a run",
+            rows.len()
+        )));
+    }
+    Ok(Some(rows))
+}
+
 impl PyVectorSimulation {
-    /// Each run's checked command: `None` for a run left as it is; `Some(None)` for the
-    /// built-in robot's step.
+    /// Each run's checked command (with its actuators' commands): `None` for a run left as it
+    /// is; `Some(None)` for the built-in robot's step.
     fn commands(
         &self,
         commands: Option<&Bound<'_, PyAny>>,
         active: Option<Vec<bool>>,
+        actuators: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Vec<Option<Option<Command>>>> {
         let states = self.lock();
         let n = states.len();
@@ -220,27 +244,17 @@ impl PyVectorSimulation {
                 active.len()
             )));
         }
-        let rows: Option<Vec<Bound<'_, PyAny>>> = match (self.driver, commands) {
-            (Driver::Builtin, Some(c)) if !c.is_none() => {
-                return Err(PyValueError::new_err(
-                    "robot=\"builtin\" decides its own commands: call step() without any",
-                ));
-            }
-            (Driver::Builtin, _) => None,
-            (Driver::Python, Some(c)) if !c.is_none() => {
-                let rows: Vec<Bound<'_, PyAny>> = c.try_iter()?.collect::<PyResult<_>>()?;
-                if rows.len() != n {
-                    return Err(PyValueError::new_err(format!(
-                        "{} commands for {n} runs: one a run",
-                        rows.len()
-                    )));
-                }
-                Some(rows)
-            }
-            (Driver::Python, _) => {
-                return Err(PyValueError::new_err("step() needs a command a run"));
-            }
-        };
+        let given = |v: Option<&Bound<'_, PyAny>>| v.is_some_and(|v| !v.is_none());
+        if self.driver == Driver::Builtin && (given(commands) || given(actuators)) {
+            return Err(PyValueError::new_err(
+                "robot=\"builtin\" decides its own commands: call step() without any",
+            ));
+        }
+        let rows = per_run("commands", commands, n)?;
+        if self.driver == Driver::Python && rows.is_none() {
+            return Err(PyValueError::new_err("step() needs a command a run"));
+        }
+        let acts = per_run("actuators", actuators, n)?;
         let mut out = Vec::with_capacity(n);
         for (i, (state, on)) in states.iter().zip(active).enumerate() {
             if !on {
@@ -255,7 +269,7 @@ impl PyVectorSimulation {
             let cmd = match &rows {
                 Some(rows) => Some(
                     state
-                        .command(&rows[i], None, None)
+                        .command(&rows[i], acts.as_ref().map(|a| &a[i]), None)
                         .map_err(|e| PyValueError::new_err(format!("run {i}: {e}")))?,
                 ),
                 None => None,

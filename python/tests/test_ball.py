@@ -115,3 +115,24 @@ def test_the_world_holds_every_robot_to_its_top_speed_by_the_norm(smoke):
         sim.step((400.0, 400.0, 0.0))
     t = sim.truth()
     assert math.hypot(t["vx_mm_s"], t["vy_mm_s"]) == pytest.approx(400.0, abs=1.0)
+
+
+def test_vector_simulation_checks_each_runs_kicker_commands(rollout, smoke):
+    import numpy as np
+
+    still = np.zeros((2, 3))
+    vec = omniloop.VectorSimulation(rollout, 2, seed=1)
+    with pytest.raises(ValueError, match="run 1: .*over the kicker's limit"):
+        vec.step(still, actuators=[None, [{"kick_mm_s": 7000.0}]])
+    with pytest.raises(ValueError, match="1 actuators for 2 runs"):
+        vec.step(still, actuators=[None])
+    assert vec.observe()[0].t_s == 0.0, "a refused command steps no run"
+    obs = vec.step(still, actuators=[[{"dribbler_rpm": 3000.0}], [{"kick_mm_s": 1000.0}]])
+    assert [o.ball_in_dribbler for o in obs] == [True, False]
+    assert [t["ball"]["vx_mm_s"] > 500.0 for t in vec.truth()] == [False, True]
+    no_kicker = omniloop.VectorSimulation(smoke, 2)
+    with pytest.raises(ValueError, match="run 0: .*no kicker"):
+        no_kicker.step(still, actuators=[[{"kick_mm_s": 1000.0}], None])
+    builtin = omniloop.VectorSimulation(rollout, 2, robot="builtin")
+    with pytest.raises(ValueError, match="decides its own commands"):
+        builtin.step(actuators=[None, None])
