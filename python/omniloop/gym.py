@@ -20,7 +20,7 @@ Importing this module registers ``omniloop/Scenario-v0``::
   (``[robot.kicker]``) takes two more: ``kick_mm_s`` (0 to its kicker's limit: above 0 arms a
   flat kick that fires when the ball is at the dribbler, 0 disarms) and ``dribbler_rpm`` (0 to
   its full pull's speed), and its observation has ``"ball_in_dribbler"`` (``float32[1]``: the
-  light barrier, 1 when it sees the ball); the vector environment drives the wheels alone.
+  light barrier, 1 when it sees the ball); the vector environment's runs take them alike.
   Actions outside are clipped to the box; the world then scales a velocity over the top speed
   down to it by its norm (a diagonal at the box's corner runs at the top speed, not 1.41 times it).
 - Reward: progress toward the goal over the step in metres (the true distance before minus
@@ -106,7 +106,6 @@ class _Task:
         robot: RobotInfo,
         contact_penalty: float,
         max_omega_rad_s: Optional[float],
-        ball_actions: bool = True,
     ) -> None:
         if not (math.isfinite(contact_penalty) and contact_penalty >= 0.0):
             raise ValueError(f"contact_penalty={contact_penalty}: a finite number >= 0")
@@ -125,7 +124,7 @@ class _Task:
         if not (math.isfinite(wmax) and wmax > 0.0):
             raise ValueError(f"max_omega_rad_s={max_omega_rad_s}: a finite number > 0")
         low = -high
-        self.kicker = robot["kicker"] if ball_actions else None
+        self.kicker = robot["kicker"]
         #: How many of the action's numbers drive the wheels (the rest: kick, dribbler).
         self.motion = len(high)
         if self.kicker is not None:
@@ -271,9 +270,7 @@ class OmniloopVectorEnv(VectorEnv):
         truth_frames: bool = False,
     ) -> None:
         self.scenario = _one_robot(_scenario(scenario))
-        self._task = _Task(
-            self.scenario.robot, contact_penalty, max_omega_rad_s, ball_actions=False
-        )
+        self._task = _Task(self.scenario.robot, contact_penalty, max_omega_rad_s)
         self.num_envs = int(num_envs)
         self.single_observation_space = self._task.observation_space
         self.single_action_space = self._task.action_space
@@ -320,12 +317,14 @@ class OmniloopVectorEnv(VectorEnv):
         n = self.num_envs
         if actions.shape[0] != n:
             raise ValueError(f"{actions.shape[0]} actions for {n} runs")
-        commands = np.stack([self._task.command(a) for a in actions])
+        split = [self._task.split(self._task.command(a)) for a in actions]
+        motions = np.stack([m for m, _ in split])
+        kicks = None if self._task.kicker is None else [k for _, k in split]
         resetting = self._autoreset.copy()
         for k in np.flatnonzero(resetting):
             self._seeds[k] += n
             self.vec.reset(int(k), self._seeds[k])
-        obs = self.vec.step(commands, active=[not r for r in resetting])
+        obs = self.vec.step(motions, active=[not r for r in resetting], actuators=kicks)
         truths = self.vec.truth()
         rewards = np.zeros(n, dtype=np.float64)
         terminated = np.zeros(n, dtype=bool)

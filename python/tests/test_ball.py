@@ -1,6 +1,7 @@
 """The ball from Python: a kick through `Simulation.step`'s actuators, the light barrier in the
 observation, the ball in the truth, placing it, refused kicks; the Gymnasium and PettingZoo
-checks on a scenario with a ball."""
+checks on a scenario with a ball; kicks through `VectorSimulation` and the vector
+environment."""
 
 import math
 
@@ -80,9 +81,10 @@ def test_gymnasium_and_pettingzoo_checks_pass_with_a_ball():
     assert env.action_space.shape == (5,)
     assert list(env.action_space.high[3:]) == [6500.0, 5000.0]
     assert env.observation_space["ball_in_dribbler"].shape == (1,)
-    # The vector environment drives the wheels alone.
+    # The vector environment's runs take the same actions and observe the same.
     vec = omniloop.gym.OmniloopVectorEnv(scenario, num_envs=2)
-    assert vec.single_action_space.shape == (3,)
+    assert vec.single_action_space == env.action_space
+    assert vec.single_observation_space == env.observation_space
     vec.close()
     pytest.importorskip("pettingzoo")
     from pettingzoo.test import parallel_api_test
@@ -115,6 +117,49 @@ def test_the_world_holds_every_robot_to_its_top_speed_by_the_norm(smoke):
         sim.step((400.0, 400.0, 0.0))
     t = sim.truth()
     assert math.hypot(t["vx_mm_s"], t["vy_mm_s"]) == pytest.approx(400.0, abs=1.0)
+
+
+def test_a_vector_env_kicks_and_dribbles_through_its_actions(rollout):
+    """Three runs of ball_rollout.toml, the ball at each robot's dribbler: run 0 kicks at 2 m/s,
+    run 1 at the limit, run 2 spins its dribbler alone. Each run's ball goes as the single
+    environment's does with the same seed and action; the batched observations and sampled
+    actions stay in their spaces."""
+    import numpy as np
+
+    pytest.importorskip("gymnasium")
+    import omniloop.gym
+
+    vec = omniloop.gym.make_vec(rollout, num_envs=3)
+    assert vec.single_action_space.shape == (5,)
+    assert vec.action_space.shape == (3, 5)
+    assert vec.observation_space["ball_in_dribbler"].shape == (3, 1)
+    obs, _ = vec.reset(seed=1)
+    assert vec.observation_space.contains(obs)
+    assert (obs["ball_in_dribbler"] == 1.0).all()
+    actions = np.zeros((3, 5), dtype=np.float32)
+    actions[0, 3], actions[1, 3], actions[2, 4] = 2000.0, 6500.0, 3000.0
+    obs_kick, _, _, _, info = vec.step(actions)
+    assert vec.observation_space.contains(obs_kick)
+    assert list(obs_kick["ball_in_dribbler"][:, 0]) == [0.0, 0.0, 1.0]
+    vx = [ball["vx_mm_s"] for ball in info["ball"]]
+    assert vx[0] == pytest.approx(2000.0 - 3900.0 * 0.04, abs=10.0)
+    assert vx[1] == pytest.approx(6500.0 - 3900.0 * 0.04, abs=10.0)
+    assert vx[2] == 0.0
+    # The same as one environment alone, to the bit.
+    for i, action in enumerate(actions):
+        env = omniloop.gym.OmniloopEnv(rollout)
+        env.reset(seed=1 + i)
+        assert env.step(action)[4]["ball"] == info["ball"][i]
+    for _ in range(5):
+        obs = vec.step(vec.action_space.sample())[0]
+        assert vec.observation_space.contains(obs)
+    # Gymnasium's determinism check, on the vector: the same seed and actions, the same step.
+    from gymnasium.utils.env_checker import data_equivalence
+
+    vec.reset(seed=1)
+    again = vec.step(actions)
+    assert data_equivalence(again[0], obs_kick) and data_equivalence(again[4], info, exact=True)
+    vec.close()
 
 
 def test_vector_simulation_checks_each_runs_kicker_commands(rollout, smoke):
