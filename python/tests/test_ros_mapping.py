@@ -181,3 +181,63 @@ def test_the_written_out_covariance_update_is_the_matrix_form():
         g = np.array([[c * dt, -s * dt, 0], [s * dt, c * dt, 0], [0, 0, dt]])
         p = f @ p @ f.T + g @ q @ g.T
     assert np.abs(cov.pose - p).max() < 1e-12 * np.abs(p).max()
+
+
+KICKER = {"max_kick_mm_s": 6500.0, "full_pull_rpm": 5000.0, "front_mm": 75.0}
+
+
+def test_a_kick_is_its_velocity_in_base_link_and_a_bad_one_refused():
+    assert mapping.kick_command(5.0, 0.0, 0.0, KICKER) == {"kick_mm_s": 5000.0, "angle_rad": 0.0}
+    chip = mapping.kick_command(3.0, 0.0, 3.0, KICKER)
+    assert chip["kick_mm_s"] == pytest.approx(3000.0 * math.sqrt(2.0))
+    assert chip["angle_rad"] == pytest.approx(math.pi / 4)
+    assert mapping.kick_command(0.0, 0.0, 0.0, KICKER) == {"kick_mm_s": 0.0, "angle_rad": 0.0}
+    # The limit itself is taken; a hair over it by rounding is taken as the limit.
+    assert mapping.kick_command(6.5, 0.0, 0.0, KICKER)["kick_mm_s"] == 6500.0
+    assert mapping.kick_command(6.5 + 1e-12, 0.0, 0.0, KICKER)["kick_mm_s"] == 6500.0
+    for bad, why in [
+        ((7.0, 0.0, 0.0), "over the kicker's limit of 6.5 m/s"),
+        ((5.0, 0.0, 5.0), "over the kicker's limit"),
+        ((float("nan"), 0.0, 0.0), "not finite"),
+        ((1.0, 0.0, float("inf")), "not finite"),
+        ((-1.0, 0.0, 0.0), "never back"),
+        ((1.0, 0.0, -0.5), "never back, down"),
+        ((1.0, 0.5, 0.0), "aside"),
+        ((0.0, 0.0, 2.0), "straight up"),
+        ((1e-300, 0.0, 2.0), "straight up"),
+    ]:
+        with pytest.raises(mapping.CommandError, match=why):
+            mapping.kick_command(*bad, KICKER)
+    with pytest.raises(mapping.CommandError, match="no kicker"):
+        mapping.kick_command(1.0, 0.0, 0.0, None)
+
+
+def test_a_dribbler_speed_is_in_rpm_and_a_bad_one_refused():
+    assert mapping.dribbler_command(3000.0, KICKER) == {"dribbler_rpm": 3000.0}
+    assert mapping.dribbler_command(0.0, KICKER) == {"dribbler_rpm": 0.0}
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(mapping.CommandError, match="finite number >= 0"):
+            mapping.dribbler_command(bad, KICKER)
+    with pytest.raises(mapping.CommandError, match="no dribbler"):
+        mapping.dribbler_command(100.0, None)
+
+
+def test_every_kick_the_mapping_takes_is_one_the_simulation_takes():
+    """What ``kick_command`` lets through, ``Simulation.step`` fires without a ValueError (the
+    node would stop on one), at the limit and just under straight up included."""
+    scenario = omniloop.Scenario.load(SCENARIOS / "ball_rollout.toml")
+    kicker = scenario.robot["kicker"]
+    assert kicker is not None and kicker["max_kick_mm_s"] == 6500.0
+    sim = omniloop.Simulation(scenario)
+    sim.reset(seed=1)
+    for v in [(6.5, 0.0, 0.0), (6.5 + 1e-12, 0.0, 0.0), (1e-9, 0.0, 6.5), (0.0, 0.0, 0.0)]:
+        sim.step((0.0, 0.0, 0.0), actuators=[mapping.kick_command(*v, kicker)])
+    sim.step((0.0, 0.0, 0.0), actuators=[mapping.dribbler_command(0.0, kicker)])
+
+
+def test_the_balls_truth_is_in_metres():
+    ball = {"x_mm": 1500.0, "y_mm": -250.0, "z_mm": 21.5, "vx_mm_s": 3000.0, "vy_mm_s": -40.0,
+            "vz_mm_s": 0.0}
+    state = mapping.ball_state(ball)
+    assert state.position == pytest.approx((1.5, -0.25, 0.0215))
+    assert state.velocity == pytest.approx((3.0, -0.04, 0.0))

@@ -1,6 +1,7 @@
 """What omniloop's values become on ROS 2 topics, with no ROS import: SI units and REP-103 axes,
 stamps, the odometry's covariance, the free space as a laser scan, a camera model as
-``camera_info`` fields, and ``cmd_vel`` checked and clipped to the robot's limits.
+``camera_info`` fields, ``cmd_vel`` checked and clipped to the robot's limits, the kicker's and
+the dribbler's commands checked, and the ball's truth.
 
 omniloop works in millimetres, seconds and radians, x forward, y left, z up (REP-103's body
 axes); ROS in metres. Every function here is plain arithmetic, tested without ROS 2.
@@ -13,6 +14,8 @@ from dataclasses import dataclass, field
 from typing import Any, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
+
+from ..types import Ball, Dribble, Kick
 
 MM = 1e-3
 """Metres in a millimetre."""
@@ -238,7 +241,9 @@ def command_at(
 
 
 class CommandError(ValueError):
-    """A ``cmd_vel`` the robot cannot take (a number that is not finite)."""
+    """A command the robot cannot take: a ``cmd_vel`` with a number that is not finite, a kick
+    its kicker cannot fire, a dribbler speed below 0, a kick or dribbler command to a robot
+    without them."""
 
 
 def body_command(
@@ -269,3 +274,69 @@ def body_command(
         wmax = float(diff["max_turn_rate_rad_s"])
         return vx, max(-wmax, min(wmax, angular_z))
     return vx, vy, angular_z
+
+
+KICK_ASIDE_M_S = 1e-6
+"""The most a kick's ``y`` (m/s) may differ from 0: the kicker fires along the robot's
+heading, so a kick aside is a command it cannot take, rounding aside."""
+
+
+def kick_command(
+    x_m_s: float, y_m_s: float, z_m_s: float, kicker: Optional[Mapping[str, Any]]
+) -> Kick:
+    """A ``kick`` (``geometry_msgs/Vector3``: the velocity the kicker gives the ball in
+    ``base_link``, m/s: ``x`` forward, ``z`` up, ``y`` 0) as the actuator command
+    ``Simulation.step`` takes: ``{"kick_mm_s": S, "angle_rad": A}``, ``S`` its norm in mm/s and
+    ``A`` its angle above the floor (``z = 0``: a flat kick; ``z > 0``: a chip; all 0: disarm).
+    ``kicker`` is the robot's (``Scenario.robot["kicker"]``). Raises :class:`CommandError`
+    without a kicker, for a number that is not finite, a kick backward, down or aside, or
+    one over ``max_kick_mm_s`` (a speed over it by rounding alone is taken as the limit)."""
+    if kicker is None:
+        raise CommandError("kick: the robot has no kicker ([robot.kicker])")
+    if not all(math.isfinite(v) for v in (x_m_s, y_m_s, z_m_s)):
+        raise CommandError(f"kick is not finite: ({x_m_s}, {y_m_s}, {z_m_s}) m/s")
+    if x_m_s < 0.0 or z_m_s < 0.0 or abs(y_m_s) > KICK_ASIDE_M_S:
+        raise CommandError(
+            f"kick ({x_m_s}, {y_m_s}, {z_m_s}) m/s: the kicker fires forward (x > 0) and up "
+            "(z >= 0), never back, down or aside (y = 0)"
+        )
+    speed = math.hypot(x_m_s, z_m_s) / MM
+    if speed == 0.0:
+        return Kick(kick_mm_s=0.0, angle_rad=0.0)
+    angle = math.atan2(z_m_s, x_m_s)
+    if not angle < 0.5 * math.pi:
+        raise CommandError(f"kick ({x_m_s}, {y_m_s}, {z_m_s}) m/s: straight up is no kick")
+    limit = float(kicker["max_kick_mm_s"])
+    if speed > limit * (1.0 + 1e-9):
+        raise CommandError(
+            f"kick speed {speed * MM:g} m/s is over the kicker's limit of {limit * MM:g} m/s"
+        )
+    return Kick(kick_mm_s=min(speed, limit), angle_rad=angle)
+
+
+def dribbler_command(rpm: float, kicker: Optional[Mapping[str, Any]]) -> Dribble:
+    """A ``dribbler`` speed (``std_msgs/Float32``, rpm; 0 stops it) as the actuator command
+    ``Simulation.step`` takes: ``{"dribbler_rpm": R}``. Raises :class:`CommandError` without
+    a dribbler, or for a speed that is not a finite number >= 0."""
+    if kicker is None:
+        raise CommandError("dribbler: the robot has no dribbler ([robot.kicker])")
+    if not (math.isfinite(rpm) and rpm >= 0.0):
+        raise CommandError(f"dribbler speed {rpm} rpm: it must be a finite number >= 0")
+    return Dribble(dribbler_rpm=float(rpm))
+
+
+@dataclass(frozen=True)
+class BallState:
+    """The ball's truth as the ``/ground_truth/ball`` odometry takes it: metres, m/s, in
+    ``map`` (the ball's frame parallel to it, so the velocity is the same in both)."""
+
+    position: Tuple[float, float, float]
+    velocity: Tuple[float, float, float]
+
+
+def ball_state(ball: Ball) -> BallState:
+    """``Simulation.truth()["ball"]`` (mm, mm/s; ``z_mm`` its centre's height) in metres."""
+    return BallState(
+        position=(ball["x_mm"] * MM, ball["y_mm"] * MM, ball["z_mm"] * MM),
+        velocity=(ball["vx_mm_s"] * MM, ball["vy_mm_s"] * MM, ball["vz_mm_s"] * MM),
+    )
