@@ -2,6 +2,7 @@
 node that sees only `odom`; what it publishes checked against `omniloop.Simulation` run here
 with the same seed and commands."""
 
+import json
 import math
 import os
 import random
@@ -26,12 +27,13 @@ if sys.version_info < (3, 10):
 os.environ["ROS_DOMAIN_ID"] = str(random.Random(os.getpid()).randint(1, 100))
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 import rclpy  # noqa: E402
-from geometry_msgs.msg import PoseStamped, Twist, TwistStamped  # noqa: E402
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped, Vector3  # noqa: E402
 from nav_msgs.msg import Odometry  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from rclpy.qos import DurabilityPolicy, QoSProfile  # noqa: E402
 from rosgraph_msgs.msg import Clock  # noqa: E402
 from sensor_msgs.msg import CameraInfo, Image, LaserScan  # noqa: E402
+from std_msgs.msg import Bool, Float32  # noqa: E402
 from std_srvs.srv import SetBool, Trigger  # noqa: E402
 
 SCENARIO = SCENARIOS / "ros_smoke.toml"
@@ -442,3 +444,87 @@ def test_a_robot_without_a_camera_publishes_its_odometry(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "no scan" in r.stderr and "run over at t = " in r.stderr
     assert (tmp_path / "trajectory.csv").read_text().count("\n") > 100
+
+
+class Kicker(Node):
+    """Plays ball_rollout.toml's robot in lockstep, one answer an odom: bad kicker and dribbler
+    commands first, then the dribbler on while backing off, then a 3 m/s kick standing."""
+
+    # Backing off for a second at 0.3 m/s (300 mm/s^2: a second to speed, a second to stop).
+    BAD, DRIBBLE, BACK, KICK = 1, 2, range(3, 28), 60
+
+    def __init__(self) -> None:
+        super().__init__("omniloop_kick_client")
+        self.odoms, self.barrier, self.balls = [], [], []
+        self.create_subscription(Odometry, f"{NS}/odom", self.on_odom, 10)
+        self.create_subscription(Bool, f"{NS}/ball_in_dribbler", self.barrier.append, 10)
+        self.create_subscription(Odometry, "/ground_truth/ball", self.balls.append, 10)
+        self.cmd = self.create_publisher(Twist, f"{NS}/cmd_vel", 10)
+        self.kick = self.create_publisher(Vector3, f"{NS}/kick", 10)
+        self.dribbler = self.create_publisher(Float32, f"{NS}/dribbler", 10)
+        self.last = time.monotonic()
+
+    def on_odom(self, msg: Odometry) -> None:
+        self.last = time.monotonic()
+        self.odoms.append(msg)
+        cycle, cmd = len(self.odoms) - 1, Twist()
+        # The kicker's commands go before the cmd_vel that answers the frame.
+        if cycle == self.BAD:
+            self.kick.publish(Vector3(x=7.0))  # over the rules' 6.5 m/s
+            self.dribbler.publish(Float32(data=float("nan")))
+        if cycle == self.BAD + 1:
+            self.kick.publish(Vector3(x=-1.0))  # refused too (the warning held back: throttled)
+        if cycle == self.DRIBBLE:
+            self.dribbler.publish(Float32(data=3000.0))
+        if cycle in self.BACK:
+            cmd.linear.x = -0.3
+        if cycle == self.KICK:
+            self.kick.publish(Vector3(x=3.0))
+        self.cmd.publish(cmd)
+
+
+def test_a_kicker_dribbles_and_kicks_through_ros_and_bad_commands_are_refused(tmp_path):
+    """ball_rollout.toml: the ball lies at the robot's dribbler. A kick over the limit and a
+    NaN dribbler speed are refused with a warning and the node goes on; with the dribbler on,
+    the robot backs off drawing the ball with it (the light barrier on throughout); a 3 m/s kick
+    sends it off: the barrier goes off and /ground_truth/ball has it rolling away at ~3 m/s."""
+    script = Path(sys.executable).parent / "omniloop-ros"
+    scenario = SCENARIOS / "ball_rollout.toml"
+    cmd = [str(script), str(scenario), "--lockstep", "--exit-at-end", "--out", str(tmp_path)]
+    rclpy.init()
+    node = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        client = Kicker()
+        while node.poll() is None and time.monotonic() - client.last < 60:
+            rclpy.spin_once(client, timeout_sec=0.05)
+        for _ in range(20):
+            rclpy.spin_once(client, timeout_sec=0.01)
+        client.destroy_node()
+    finally:
+        if node.poll() is None:
+            node.kill()
+        rclpy.shutdown()
+    log = node.stdout.read()
+    assert node.returncode == 0, log
+    assert "over the kicker's limit of 6.5 m/s: refused" in log, log
+    assert "dribbler speed nan rpm" in log and "refused" in log, log
+    n = len(client.odoms)
+    assert n == 376 and len(client.barrier) == n and len(client.balls) == n, log
+    barrier = [m.data for m in client.barrier]
+    balls = [(stamp_s(m), m.pose.pose.position, m.twist.twist.linear) for m in client.balls]
+    assert balls[0][0] == 0.0 and balls[-1][0] == pytest.approx(15.0)
+    assert all(m.header.frame_id == "map" and m.child_frame_id == "ball" for m in client.balls)
+    # The first frame after the kick fired: the kick's own cycle (sent before the cmd_vel
+    # that answered it, it arrives first on one machine), or the next should DDS reorder them.
+    kick = barrier.index(False)
+    assert kick in (Kicker.KICK + 1, Kicker.KICK + 2)
+    # Held until the kick: the refused kicks did not fire; backing off drew the ball back.
+    assert balls[Kicker.KICK][1].x < balls[0][1].x - 0.2
+    assert all(abs(v.x) < 0.35 for _, _, v in balls[:kick])
+    # The kick: off the dribbler at 3 m/s less a cycle's sliding, rolling away along +x.
+    assert not any(barrier[kick:])
+    assert balls[kick][2].x == pytest.approx(3.0 - 3.9 * 0.04, abs=0.05)
+    assert balls[-1][1].x > balls[kick][1].x + 2.0
+    events = [json.loads(line) for line in (tmp_path / "events.jsonl").read_text().splitlines()]
+    kicks = [e for e in events if e["event"] == "kick"]
+    assert len(kicks) == 1 and kicks[0]["speed_mm_s"] == pytest.approx(3000.0)

@@ -4,7 +4,9 @@
 Per robot, under its name (``NS``): ``SENSOR/image_raw`` and ``SENSOR/camera_info`` of each
 camera, ``odom`` (wheel odometry, integrated), ``scan`` (the floor's free space as a
 ``LaserScan``), ``goal_pose`` (latched), ``ground_truth/odom`` (for scoring only) and
-``cmd_vel`` in; ``/clock``. docs/ros.md has the table, the frames and the camera model.
+``cmd_vel`` in; with a kicker (``[robot.kicker]``) also ``ball_in_dribbler`` (the light
+barrier) and ``kick`` and ``dribbler`` in; ``/clock``, and with a ball ``/ground_truth/ball``
+(for scoring only). docs/ros.md has the table, the frames and the camera model.
 
 A cycle's messages share its stamp; ``odom`` is the last of the robot's (the truth follows it),
 so that a node answering it answers the cycle. The odometry's frame ``odom`` coincides with
@@ -22,13 +24,13 @@ import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, cast
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union, cast
 
 import numpy as np
 import numpy.typing as npt
 import rclpy
 from builtin_interfaces.msg import Time
-from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped, Vector3
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.executors import SingleThreadedExecutor
@@ -39,11 +41,12 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, LaserScan
+from std_msgs.msg import Bool, Float32
 from std_srvs.srv import SetBool, Trigger
 
 import omniloop
 from omniloop._omniloop import FreeSpaceDetector
-from omniloop.types import FreeSpace, Truth
+from omniloop.types import Ball, Dribble, FreeSpace, Kick, KickerInfo, Truth
 
 from . import mapping
 from .mapping import MM, CommandError, OdometryCovariance
@@ -53,6 +56,9 @@ try:  # tf2_msgs has no wheel on the package index: /tf only with a ROS 2 instal
     from tf2_msgs.msg import TFMessage
 except ImportError:
     TFMessage = None
+
+Actuator = Union[Kick, Dribble]
+"""A kicker's or dribbler's command as ``Simulation.step`` takes it."""
 
 RELIABLE = QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(
@@ -92,8 +98,9 @@ def time_msg(t_s: float) -> Time:
 
 
 class RobotPort:
-    """One robot's publishers, its ``cmd_vel`` and what the robot's side keeps between
-    cycles (its detector, its odometry's covariance, its last command)."""
+    """One robot's publishers, its ``cmd_vel`` (with a kicker, its ``kick`` and ``dribbler``)
+    and what the robot's side keeps between cycles (its detector, its odometry's covariance,
+    its last command, the kicker's and dribbler's commands not yet applied)."""
 
     def __init__(self, bridge: "Bridge", name: str, ns: str, prefix: str) -> None:
         node, scenario = bridge.node, bridge.scenario
@@ -141,6 +148,23 @@ class RobotPort:
             self.cmd_vel = node.create_subscription(
                 kind, topic("cmd_vel"), self.on_cmd_vel, RELIABLE
             )
+        self.kicker: Optional[KickerInfo] = self.spec["kicker"]
+        self.barrier: Optional[Publisher[Bool]] = None
+        self.ball_subs: List[Subscription[Any]] = []
+        self.pending: Dict[str, Actuator] = {}
+        if self.kicker is not None:
+            self.ball_topics(node, topic)
+
+    def ball_topics(self, node: Node, topic: Callable[[str], str]) -> None:
+        """A kicker's topics: the light barrier out, and (where Python drives) the kick and the
+        dribbler's speed in."""
+        self.barrier = node.create_publisher(Bool, topic("ball_in_dribbler"), RELIABLE)
+        if self.bridge.options.robot != "python":
+            return
+        self.ball_subs = [
+            node.create_subscription(Vector3, topic("kick"), self.on_kick, RELIABLE),
+            node.create_subscription(Float32, topic("dribbler"), self.on_dribbler, RELIABLE),
+        ]
 
     def frame(self, name: str) -> str:
         return self.prefix + name
@@ -153,6 +177,7 @@ class RobotPort:
         detector of its free space."""
         self.covariance.reset()
         self.command, self.command_t_s, self.command_stamp = self.stop(), -math.inf, -math.inf
+        self.pending = {}
         try:
             detector = sim.free_space_detector(robot=self.name)
         except ValueError as e:
@@ -189,6 +214,35 @@ class RobotPort:
             self.awaiting_t_s = None
             self.bridge.answered()
 
+    def on_kick(self, msg: Vector3) -> None:
+        """A kick, checked (a bad one refused with a warning, at most one a second): armed at
+        the next cycle (the last kick of a cycle counts)."""
+        try:
+            self.pending["kick"] = mapping.kick_command(msg.x, msg.y, msg.z, self.kicker)
+        except CommandError as e:
+            self.bridge.node.get_logger().warning(
+                f"{self.ns}: {e}: refused", throttle_duration_sec=1.0
+            )
+
+    def on_dribbler(self, msg: Float32) -> None:
+        """The dribbler's speed, checked (a bad one refused with a warning, at most one a
+        second): from the next cycle until told otherwise."""
+        try:
+            self.pending["dribbler"] = mapping.dribbler_command(msg.data, self.kicker)
+        except CommandError as e:
+            self.bridge.node.get_logger().warning(
+                f"{self.ns}: {e}: refused", throttle_duration_sec=1.0
+            )
+
+    def take_actuators(self) -> Optional[List[Actuator]]:
+        """The kicker's and dribbler's commands come since the last cycle (``None``: none),
+        for ``Simulation.step``'s ``actuators``."""
+        if not self.pending:
+            return None
+        out = list(self.pending.values())
+        self.pending = {}
+        return out
+
     def command_now(self, t_s: float) -> Tuple[float, ...]:
         """The command to apply at ``t_s``: the last, unless older than the timeout."""
         timeout = self.bridge.options.cmd_vel_timeout_s
@@ -203,6 +257,8 @@ class RobotPort:
         if self.detector is not None and self.scan_sensor in obs.frames:
             self.publish_scan(self.detector.detect(obs.frames[self.scan_sensor]), stamp)
         self.bridge.publish_tf(self, obs, stamp)
+        if self.barrier is not None:
+            self.barrier.publish(Bool(data=bool(obs.ball_in_dribbler)))
         # The odometry last: answering it answers the cycle.
         o = obs.odometry
         x, y, theta = obs.odometry_pose
@@ -328,6 +384,10 @@ class Bridge:
         for name in names:
             ns = name if team or name != "robot" else "omniloop"
             self.ports.append(RobotPort(self, name, ns, f"{ns}/" if team else ""))
+        # /ground_truth/ball: made with the simulation, where the scenario has a ball.
+        self.ball: Optional[Publisher[Odometry]] = None
+        self.ball_msg = odometry_frames("map", "ball")
+        self.ball_msg.pose.pose.orientation.w = 1.0
         self.sim: Optional[omniloop.Simulation] = None
         self.paused = False
         self.steps_asked = 0
@@ -339,7 +399,11 @@ class Bridge:
         self.node.create_service(SetBool, "~/pause", self.on_pause)
         self.node.create_service(Trigger, "~/step", self.on_step)
         subs = [p.cmd_vel for p in self.ports if p.cmd_vel is not None]
-        self.commands = CommandWait.of(self.node, subs) if options.lockstep and subs else None
+        kicks = [s for p in self.ports for s in p.ball_subs]
+        self.kicks = bool(kicks)
+        self.commands = (
+            CommandWait.of(self.node, subs + kicks) if options.lockstep and subs else None
+        )
         mode = "lockstep" if options.lockstep else f"realtime x{options.realtime_factor:g}"
         log.info(
             f"scenario {scenario.name!r}, seed {self.seed()}, {mode}, robots driven by {options.robot}: "
@@ -441,6 +505,19 @@ class Bridge:
             port.publish(o, t, self.t_s)
             if port.cmd_vel is not None:
                 port.awaiting_t_s = self.t_s
+        if self.ball is not None:
+            self.publish_ball(self.ball, (truth[self.ports[0].name] if team else truth)["ball"])
+
+    def publish_ball(self, pub: Publisher[Odometry], ball: Ball) -> None:
+        """The ball's truth (the simulator's side, for scoring): its centre and velocity in
+        ``map``, metres, stamped with the cycle."""
+        state = mapping.ball_state(ball)
+        msg = self.ball_msg
+        msg.header.stamp = self.clock_msg.clock
+        p, v = msg.pose.pose.position, msg.twist.twist.linear
+        p.x, p.y, p.z = state.position
+        v.x, v.y, v.z = state.velocity
+        pub.publish(msg)
 
     @property
     def running(self) -> omniloop.Simulation:
@@ -458,6 +535,10 @@ class Bridge:
             self.sim = omniloop.Simulation(
                 self.scenario, seed=seed, renderer=o.renderer, robot=o.robot, frames=frames
             )
+            truth: Any = self.sim.truth()
+            if "ball" in (next(iter(truth.values())) if self.scenario.is_team else truth):
+                # Made before the first frame, so that a node started with it sees that frame.
+                self.ball = self.node.create_publisher(Odometry, "/ground_truth/ball", RELIABLE)
         else:
             self.sim.reset(seed=seed)
         for port in self.ports:
@@ -496,6 +577,8 @@ class Bridge:
         while rclpy.ok() and not self.reset_asked:
             waiting = [p for p in self.ports if p.awaiting_t_s is not None]
             if not waiting:
+                if self.kicks and self.commands is not None:
+                    self.commands.take(0.0)  # a kick sent with the answer, just behind it
                 return
             left = deadline - time.monotonic()
             if left <= 0:
@@ -512,13 +595,18 @@ class Bridge:
                 self.executor.spin_once(timeout_sec=0.0 if self.commands else min(left, 0.1))
 
     def step(self) -> None:
-        """One control cycle with each robot's command, then its observation published."""
+        """One control cycle with each robot's command (and the kicker's and dribbler's
+        commands come since the last), then its observation published."""
         if self.options.robot == "builtin":
             obs = self.running.step()
         elif self.scenario.is_team:
-            obs = self.running.step({p.name: p.command_now(self.t_s) for p in self.ports})
+            kicks = {p.name: a for p in self.ports if (a := p.take_actuators()) is not None}
+            obs = self.running.step(
+                {p.name: p.command_now(self.t_s) for p in self.ports}, actuators=kicks or None
+            )
         else:
-            obs = self.running.step(self.ports[0].command_now(self.t_s))
+            port = self.ports[0]
+            obs = self.running.step(port.command_now(self.t_s), actuators=port.take_actuators())
         self.publish(obs)
 
     def finish(self) -> None:

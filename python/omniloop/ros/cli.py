@@ -16,8 +16,9 @@ def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="omniloop-ros",
         description="Run an omniloop scenario as a ROS 2 node: each robot's cameras, odometry, "
-        "free space (scan) and ground truth on topics under its name, driven by cmd_vel, "
-        "/clock on simulation time.",
+        "free space (scan) and ground truth on topics under its name, driven by cmd_vel (with "
+        "a kicker also kick and dribbler in, ball_in_dribbler out), the ball's truth on "
+        "/ground_truth/ball, /clock on simulation time.",
         epilog="ROS arguments go after --ros-args, e.g. --ros-args -p seed:=3",
     )
     p.add_argument("scenario", type=Path, help="the scenario file")
