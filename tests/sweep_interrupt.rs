@@ -2,6 +2,7 @@
 //! processes.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
+#[path = "suite/common/mod.rs"]
 mod common;
 
 use common::{bin, scenario_path, tmp};

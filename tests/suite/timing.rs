@@ -4,7 +4,7 @@
 //! reaches its goal without contact.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, scenario};
 use nalgebra::{Isometry2, Vector2};

@@ -2,7 +2,7 @@
 //! cycles as a whole run, commands from outside through `Remote`, refusals with reasons.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common;
+use crate::common;
 
 use common::{cpu, scenario};
 use omniloop::robot::{BodyCommand, Remote, RobotSoftware};

@@ -2,7 +2,7 @@
 // Tests: a broken fixture stops the test where it breaks.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-mod common;
+use crate::common;
 
 use common::scenario;
 use nalgebra::Vector3;
@@ -304,7 +304,7 @@ fn the_first_cpu_frame_with_truth_marks_the_pixels_that_see_no_mirror() {
 }
 
 /// The render examples at their start, and the corner of `corner55_velocity_aware` near its
-/// tip (its quad prisms in view), as `tests/renderer.rs` compares their images.
+/// tip (its quad prisms in view), as `tests/suite/renderer.rs` compares their images.
 fn compared_frames() -> Vec<(omniloop::Scenario, Option<nalgebra::Isometry2<f64>>)> {
     let examples = ["hyperbolic", "conical", "spherical", "pinhole"];
     let mut v: Vec<_> = (examples.iter())

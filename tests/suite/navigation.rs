@@ -2,7 +2,7 @@
 //! velocity-aware controller, on the traps of `scenarios/` and the clutter generator.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, omniloop, scenario, tmp};
 use omniloop::run_scenario;

@@ -2,7 +2,7 @@
 //! distance ray-cast in the world, and the labelling and counting variants of eq. (5).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::scenario;
 use nalgebra::{Isometry2, Point2, Vector2};

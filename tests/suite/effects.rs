@@ -4,7 +4,7 @@
 //! and the CPU renderer give the same frames with the effects on.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{assert_alike, gpu_or_skip, paper_f, paper_f_inverse, scenario};
 use image::RgbaImage;

@@ -3,7 +3,7 @@
 //! run).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use omniloop::robustness::{
     GridOptions, Outcome, Selection, estimator, knob, report, run_grid, write_outputs,

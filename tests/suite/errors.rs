@@ -2,7 +2,7 @@
 //! the command line with each of its causes named once, not once per layer it passed through.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 /// A scenario the check accepts whose robot's software cannot be built: its planner's grid of
 /// 5 mm cells over a 12 x 8 m field has more cells than the planner allows (found when the

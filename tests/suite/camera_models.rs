@@ -4,7 +4,7 @@
 //! stops a scenario with its file, line and field.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{assert_alike, bin, cpu, gpu_or_skip, scenario, scenario_path, tmp};
 use nalgebra::{Isometry2, Matrix3, Vector2};

@@ -3,7 +3,7 @@
 //! on rendered frames, and the saved frame set.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, omniloop, scenario, scenario_path, tmp};
 use nalgebra::{Isometry2, Vector2};

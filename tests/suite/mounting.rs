@@ -3,7 +3,7 @@
 //! tracing every primitive, and the GPU and the CPU agree.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{assert_alike, gpu_or_skip, scenario};
 use nalgebra::{Isometry2, Vector2, Vector3};

@@ -3,7 +3,7 @@
 //! a Small-Size robot's, and to waypoints 150 mm from the walls in every corner of the field.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, scenario, scenario_path};
 use omniloop::{Summary, parse_scenario, run_scenario};

@@ -4,7 +4,7 @@
 //! the same file from the same scenario and seed.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{omniloop, scenario_path, tmp};
 use foxglove::Decode;

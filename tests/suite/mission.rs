@@ -2,7 +2,7 @@
 //! estimate says a target is reached, never where the truth does.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, scenario};
 use nalgebra::{Point2, Vector2};

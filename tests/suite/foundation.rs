@@ -2,7 +2,7 @@
 //! and contacts.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{bin, omniloop, scenario, scenario_path, tmp};
 use omniloop::run::record::write_trajectory_csv;

@@ -3,7 +3,7 @@
 //! one omnidirectional image; a place where a cabinet hides a mark; scenario errors.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{omniloop, tmp};
 use serde_json::Value;

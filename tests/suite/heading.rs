@@ -2,7 +2,7 @@
 //! the checkpoint of the room and off it.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, scenario};
 use nalgebra::{Isometry2, Vector2};

@@ -2,7 +2,7 @@
 //! in their trajectories and whatever `--jobs` is; a bad `--set` stops it before anything runs.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{bin, omniloop, scenario_path, tmp};
 use std::collections::BTreeMap;

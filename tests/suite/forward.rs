@@ -4,7 +4,7 @@
 //! scenario errors.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{omniloop, tmp};
 use serde_json::Value;

@@ -2,18 +2,18 @@
 //! the `RobotSoftware` trait alone) drives E1's corner through the library's `Runner`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
-#[path = "../examples/custom_robot.rs"]
+#[path = "../../examples/custom_robot.rs"]
 #[allow(dead_code)]
-mod custom_robot;
+mod example;
 
 use common::{scenario_path, tmp};
 
 #[test]
 fn the_example_robot_reaches_the_e1_goal_without_contact_and_writes_its_run() {
     let out = tmp("custom_robot");
-    let s = custom_robot::run(&scenario_path("corner55_velocity_aware.toml"), &out).unwrap();
+    let s = example::run(&scenario_path("corner55_velocity_aware.toml"), &out).unwrap();
     assert!(s.reached_goal, "{s:?}");
     assert_eq!(s.wall_contacts, 0, "{s:?}");
     assert!(s.min_clearance_mm > 20.0, "{s:?}");

@@ -3,7 +3,7 @@
 //! corners.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, omniloop, scenario, tmp};
 use omniloop::experiments::localization_map::{Mode, mode_stats};

@@ -3,6 +3,7 @@
 //! Spacek and Burbridge), GPU/CPU agreement and golden images of the render examples.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
+use crate::common;
 use nalgebra::{Isometry2, Vector2};
 use omniloop::load_scenario;
 use omniloop::run::render_snapshot;
@@ -14,7 +15,6 @@ use omniloop_sim::{
     FloorRect, FrameRequest, Layout, Pillar, Renderer, RendererChoice, Rgb, Scene, SensorNoise,
     SensorSpec, Sphere, Wall,
 };
-mod common;
 
 use common::{
     gpu_or_skip, omniloop, paper_f, paper_f_inverse, scenario_path as scenario, share_within,

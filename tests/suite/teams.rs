@@ -5,7 +5,7 @@
 //! field.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{bin, cpu, omniloop, scenario, scenario_path, tmp};
 use omniloop::robot::{BodyCommand, Estimates, Observation, OdometryReading, Outputs};

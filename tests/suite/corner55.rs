@@ -1,7 +1,7 @@
 //! E1 end to end: the 55-degree corner with both controllers, on vision alone.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{cpu, omniloop, scenario, tmp};
 use omniloop::Summary;

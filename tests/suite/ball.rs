@@ -2,7 +2,7 @@
 //! wall's bounce, the dribbler through a turn; and the shipped ball scenarios.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
-mod common;
+use crate::common;
 
 use common::{check_variant, cpu, omniloop, scenario, tmp};
 
