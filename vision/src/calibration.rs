@@ -151,6 +151,18 @@ impl RadialCalibration {
         Some(a[0] + u * (b[0] - a[0]))
     }
 
+    /// The elevation (rad above the horizontal) of the scene ray at image radius `R`, linear
+    /// in the elevation column; `None` without one or beyond it.
+    pub fn elevation_rad(&self, r_px: f64) -> Option<f64> {
+        let e = &self.elevation;
+        if e.len() < 2 || r_px.is_nan() || r_px < e[0][0] || r_px > e[e.len() - 1][0] {
+            return None;
+        }
+        let k = e.partition_point(|p| p[0] <= r_px).clamp(1, e.len() - 1);
+        let (a, b) = (e[k - 1], e[k]);
+        Some(a[1] + (r_px - a[0]) / (b[0] - a[0]) * (b[1] - a[1]))
+    }
+
     /// The image radius whose scene rays are at `elevation_rad` above the horizontal (the
     /// first crossing outward, interpolated in the elevation column); `None` when the table
     /// has no elevation column or never reaches it.

@@ -3,6 +3,7 @@
 //! Everything here takes images (`image::RgbaImage`) and a calibration of the image-to-floor
 //! map, never a simulated world, so it works the same on a real camera's PNG.
 
+pub mod ball;
 pub mod calibration;
 pub mod camera_model;
 pub mod floor_localization;
@@ -15,6 +16,7 @@ pub mod mask;
 pub mod omnistereo;
 pub mod resection;
 
+pub use ball::{BallColor, BallConfig, BallMiss, BallSighting};
 pub use calibration::{HyperbolicFit, RadialCalibration};
 pub use floor_localization::{
     ColorClass, FieldModel, FloorLocalizer, Localization, LocalizationConfig, LocalizationMethod,
