@@ -168,8 +168,17 @@ pub struct BodySpec {
     pub accel_limit_mm_s2: f64,
     /// Rotational acceleration limit, rad/s^2.
     pub angular_accel_limit_rad_s2: f64,
-    /// Its kicker's fastest kick, mm/s, when it has a kicker.
-    pub max_kick_mm_s: Option<f64>,
+    /// Its kicker and dribbler, when it has them.
+    pub kicker: Option<KickerBody>,
+}
+
+/// What the robot knows of its kicker and dribbler.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KickerBody {
+    /// Distance of the flat front (where the dribbler holds the ball) from the centre, mm.
+    pub front_mm: f64,
+    /// The fastest kick, mm/s.
+    pub max_kick_mm_s: f64,
 }
 
 /// A landmark of the robot's map: an upright cylinder of one colour.
@@ -218,6 +227,38 @@ pub struct WorldMap {
     pub bounds: Vec<MapSegment>,
     /// Striped marks.
     pub marks: Vec<MapMark>,
+    /// The Small-Size field's figures, when the floor is one.
+    pub field: Option<FieldMap>,
+}
+
+/// The figures of a Small-Size field the robot is told (the league publishes them): centred on
+/// the world origin, its long axis the world x axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldMap {
+    /// Half the length of the playing area, to the goal lines, mm.
+    pub half_length_mm: f64,
+    /// Half its width, mm.
+    pub half_width_mm: f64,
+    /// Width of each goal's mouth, mm.
+    pub goal_width_mm: f64,
+    /// Depth of each defense area from its goal line, mm (0: none).
+    pub defense_depth_mm: f64,
+    /// Width of each defense area, mm.
+    pub defense_width_mm: f64,
+}
+
+impl FieldMap {
+    /// The centre of the goal at `+x` (`side` 1) or `-x` (`side` -1).
+    pub fn goal_centre(&self, side: f64) -> Point2<f64> {
+        Point2::new(side.signum() * self.half_length_mm, 0.0)
+    }
+
+    /// Whether `p` lies in either defense area grown by `margin_mm`.
+    pub fn in_defense_area(&self, p: Point2<f64>, margin_mm: f64) -> bool {
+        self.defense_depth_mm > 0.0
+            && p.x.abs() >= self.half_length_mm - self.defense_depth_mm - margin_mm
+            && p.y.abs() <= 0.5 * self.defense_width_mm + margin_mm
+    }
 }
 
 /// The design of a conical omnistereo rig (two coaxial 90-degree cones), as built.
@@ -279,7 +320,7 @@ impl RobotConfig {
                 max_speed_mm_s: 400.0,
                 accel_limit_mm_s2: 300.0,
                 angular_accel_limit_rad_s2: 10.0,
-                max_kick_mm_s: None,
+                kicker: None,
             },
             control_period_s: 0.04,
             cameras: Vec::new(),

@@ -16,6 +16,7 @@
 //!   *own estimate* says a target is reached;
 //! - the controller ([`controllers`], registered by name) chooses the command.
 
+pub mod ball_tracker;
 pub mod boundary;
 pub mod config;
 pub mod controller;
@@ -37,8 +38,8 @@ pub use boundary::{
     RobotSoftware,
 };
 pub use config::{
-    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, ODOMETRY, RobotConfig,
-    StereoRig, VisionSpec, WorldMap,
+    BodySpec, ControlSpec, FieldMap, GoalSpec, KickerBody, MapLandmark, MapMark, MapSegment,
+    ODOMETRY, RobotConfig, StereoRig, VisionSpec, WorldMap,
 };
 pub use controller::{Controller, ControllerEntry};
 pub use controllers::CONTROLLERS;

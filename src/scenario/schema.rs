@@ -8,8 +8,8 @@ use omniloop_control::DifferentialDrive;
 use omniloop_problem::Problem;
 use omniloop_robot::perception::CameraNeed;
 use omniloop_robot::{
-    BodySpec, ControlSpec, GoalSpec, MapLandmark, MapMark, MapSegment, RobotConfig, StageEntry,
-    StereoRig, Tables, VisionSpec, WorldMap, stages_of,
+    BodySpec, ControlSpec, GoalSpec, KickerBody, MapLandmark, MapMark, MapSegment, RobotConfig,
+    StageEntry, StereoRig, Tables, VisionSpec, WorldMap, stages_of,
 };
 use omniloop_sim::{Layout, MapFeature, Rgb, SensorSpec};
 use omniloop_vision::RadialCalibration;
@@ -557,7 +557,10 @@ impl Scenario {
                 max_speed_mm_s: r.max_speed_mm_s,
                 accel_limit_mm_s2: r.accel_limit_mm_s2,
                 angular_accel_limit_rad_s2: r.angular_accel_limit_rad_s2,
-                max_kick_mm_s: r.kicker.as_ref().map(|k| k.max_kick_mm_s),
+                kicker: r.kicker.as_ref().map(|k| KickerBody {
+                    front_mm: k.front_mm,
+                    max_kick_mm_s: k.max_kick_mm_s,
+                }),
             },
             control_period_s: self.run.control_period_s,
             cameras: r.sensors.iter().map(|s| s.name.clone()).collect(),
@@ -603,6 +606,13 @@ impl Scenario {
             boxes: Vec::new(),
             bounds: Vec::new(),
             marks: Vec::new(),
+            field: self.world.field.as_ref().map(|f| omniloop_robot::FieldMap {
+                half_length_mm: f.half_length_mm,
+                half_width_mm: f.half_width_mm,
+                goal_width_mm: f.goal_width_mm,
+                defense_depth_mm: 0.0,
+                defense_width_mm: 0.0,
+            }),
         };
         for feature in self.world.map_features() {
             match feature {
@@ -738,7 +748,7 @@ impl Scenario {
         let pinhole = self.vision_is_pinhole();
         let mirror = |s: &&StageEntry| match s.camera {
             CameraNeed::Mirror | CameraNeed::MirrorFloor => true,
-            CameraNeed::MirrorOrPinhole => !pinhole,
+            CameraNeed::MirrorOrPinhole | CameraNeed::MirrorOrForward => !pinhole,
             CameraNeed::None | CameraNeed::Forward => false,
         };
         self.stages().iter().any(mirror)

@@ -11,6 +11,7 @@ pub mod observe;
 pub mod optical_flow;
 pub mod script;
 pub mod segmentation;
+pub mod striker;
 pub mod velocity_aware;
 pub mod wall_follow;
 pub mod wander;
@@ -32,6 +33,7 @@ pub const CONTROLLERS: &[ControllerEntry] = &[
     optical_flow::ENTRY,
     script::ENTRY,
     wall_follow::ENTRY,
+    striker::ENTRY,
 ];
 
 /// The controller called `name`.

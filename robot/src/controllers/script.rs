@@ -43,7 +43,7 @@ fn check_kicks(config: &RobotConfig) -> Vec<Problem> {
     let mut p = Problems::under("control.script");
     for (i, m) in script.moves.iter().enumerate() {
         let at = format!("moves[{i}]");
-        match (*m, config.body.max_kick_mm_s) {
+        match (*m, config.body.kicker.map(|k| k.max_kick_mm_s)) {
             (Move::Kick(_), None) => p.fail(at, "a kick needs a kicker: add [robot.kicker]"),
             (Move::Kick(k), Some(limit)) => {
                 if !(k.speed_mm_s.is_finite() && (0.0..=limit).contains(&k.speed_mm_s)) {

@@ -227,7 +227,7 @@ mod tests {
                 max_speed_mm_s: 300.0,
                 accel_limit_mm_s2: 1000.0,
                 angular_accel_limit_rad_s2: 8.0,
-                max_kick_mm_s: None,
+                kicker: None,
             },
             control_period_s: 0.05,
             map: WorldMap {

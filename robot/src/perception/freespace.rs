@@ -147,7 +147,10 @@ pub const MAX_AGE_S: f64 = 0.5;
 
 /// The odometry pose at `t_s` from `history` (linear between the cycles around it; the
 /// oldest or newest beyond them).
-fn pose_at(history: &VecDeque<(f64, Isometry2<f64>)>, t_s: f64) -> Option<Isometry2<f64>> {
+pub(crate) fn pose_at(
+    history: &VecDeque<(f64, Isometry2<f64>)>,
+    t_s: f64,
+) -> Option<Isometry2<f64>> {
     let after = history.iter().position(|(t, _)| *t >= t_s - 1e-9)?;
     let (t1, p1) = history[after];
     if after == 0 || (t1 - t_s).abs() < 1e-9 {

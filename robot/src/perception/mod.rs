@@ -5,6 +5,7 @@
 //! [`STAGES`]; a controller reads it by naming it in its entry's `stages`, or a pose source
 //! selects it through the entry's `pose_source`.
 
+pub mod ball;
 pub mod floor_localization;
 pub mod forward;
 pub mod freespace;
@@ -13,6 +14,7 @@ pub mod omnistereo;
 pub mod resection;
 pub mod stage;
 
+pub use ball::{BallEstimate, BallSource, BallStage};
 pub use floor_localization::FloorLocalizationStage;
 pub use forward::GroundReading;
 pub use forward::{FlowStage, GroundStage, VisualOdometryStage};
@@ -38,6 +40,7 @@ pub const STAGES: &[StageEntry] = &[
     freespace::ENTRY,
     floor_localization::ENTRY,
     luminance_heading::ENTRY,
+    ball::ENTRY,
 ];
 
 /// The stages a robot runs, in order: those its controller reads (`read`, by name) and those

@@ -97,6 +97,8 @@ pub enum CameraNeed {
     MirrorOrPinhole,
     /// A forward pinhole camera (its intrinsics, height and tilt).
     Forward,
+    /// A mirror camera's calibration, or a forward pinhole camera's model.
+    MirrorOrForward,
 }
 
 /// What a stage needs of the world beyond the robot's own map, so that the scenario's check
