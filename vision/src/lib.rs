@@ -10,6 +10,7 @@ pub mod floor_localization;
 pub mod forward;
 pub mod freespace;
 pub mod geometry;
+pub mod goal;
 pub mod image_centre;
 pub mod luminance_heading;
 pub mod mask;

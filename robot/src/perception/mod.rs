@@ -9,6 +9,7 @@ pub mod ball;
 pub mod floor_localization;
 pub mod forward;
 pub mod freespace;
+pub mod goal;
 pub mod luminance_heading;
 pub mod omnistereo;
 pub mod resection;
@@ -19,6 +20,7 @@ pub use floor_localization::FloorLocalizationStage;
 pub use forward::GroundReading;
 pub use forward::{FlowStage, GroundStage, VisualOdometryStage};
 pub use freespace::FreeSpaceStage;
+pub use goal::{GoalStage, GoalsSeen};
 pub use luminance_heading::LuminanceHeadingStage;
 pub use omnistereo::OmnistereoStage;
 pub use omnistereo::{LandmarkSighting, Landmarks, MotionReading};
@@ -41,6 +43,7 @@ pub const STAGES: &[StageEntry] = &[
     floor_localization::ENTRY,
     luminance_heading::ENTRY,
     ball::ENTRY,
+    goal::ENTRY,
 ];
 
 /// The stages a robot runs, in order: those its controller reads (`read`, by name) and those

@@ -18,6 +18,7 @@ use crate::controller::{
     ControlTable, Controller, ControllerEntry, Situation, check_table, settings,
 };
 use crate::perception::ball::BallEstimate;
+use crate::perception::goal::GoalsSeen;
 use geometry::{allowed_point, approach_point, intercept_point, keep_out, open_aim, unit, wrap};
 use nalgebra::{Isometry2, Point2};
 use omniloop_problem::{Problem, Problems};
@@ -37,6 +38,7 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     stages: &[
         crate::perception::ball::NAME,
         crate::perception::freespace::NAME,
+        crate::perception::goal::NAME,
     ],
     check_use,
     build: |c| Ok(Box::new(Striker::new(c, settings(c, TABLE)?))),
@@ -283,14 +285,23 @@ impl Striker {
             self.aim,
         );
         self.aim = Some(aim);
+        // The goal the camera shows, where it shows it: the middle of its widest open part;
+        // else where the map and the pose estimate put the open part.
+        let seen = s
+            .percept::<GoalsSeen>()
+            .and_then(|g| g.of(self.config.attack_side).first().copied());
         let to = pose.inverse() * aim;
-        let err = to.y.atan2(to.x);
+        let (err, tol) = match seen {
+            Some(run) => (
+                wrap(run.centre_rad),
+                (0.3 * run.width_rad).clamp(
+                    0.5f64.to_radians(),
+                    self.config.aim_tolerance_deg.to_radians(),
+                ),
+            ),
+            None => (to.y.atan2(to.x), self.config.aim_tolerance_deg.to_radians()),
+        };
         let dribbled = (Point2::from(s.odometry_pose.translation.vector) - at).norm();
-        let tol = self.config.aim_tolerance_deg.to_radians();
-        eprintln!(
-            "with_ball err {err:.4} tol {tol:.4} aim {aim} kick {}",
-            self.config.kick_speed_mm_s
-        );
         if err.abs() < tol || dribbled > self.config.dribble_limit_mm {
             self.commands.push(ActuatorCommand::Kick {
                 speed_mm_s: self.config.kick_speed_mm_s,
