@@ -24,8 +24,11 @@ pub struct TrackerConfig {
     pub accel_noise_mm2_s3: f64,
     /// Position sigma of the first sighting's velocity guess: its speed sigma, mm/s.
     pub initial_speed_sigma_mm_s: f64,
-    /// Sightings farther than this many sigmas from the prediction restart the track.
+    /// Sightings farther than this many sigmas from the prediction are outliers; this many in a
+    /// row (or one after the track went unseen for `max_unseen_s` / 4) restart the track there.
     pub gate_sigmas: f64,
+    /// Outliers in a row that restart the track.
+    pub outliers_to_restart: u32,
     /// The track is dropped after this long without a sighting, s.
     pub max_unseen_s: f64,
 }
@@ -37,6 +40,7 @@ impl Default for TrackerConfig {
             accel_noise_mm2_s3: 4.0e6,
             initial_speed_sigma_mm_s: 2000.0,
             gate_sigmas: 6.0,
+            outliers_to_restart: 3,
             max_unseen_s: 4.0,
         }
     }
@@ -82,6 +86,8 @@ impl BallTrack {
 pub struct BallTracker {
     config: TrackerConfig,
     track: Option<BallTrack>,
+    /// Outliers in a row.
+    outliers: u32,
 }
 
 impl BallTracker {
@@ -90,6 +96,7 @@ impl BallTracker {
         Self {
             config,
             track: None,
+            outliers: 0,
         }
     }
 
@@ -181,10 +188,16 @@ impl BallTracker {
             return;
         };
         if (innovation.transpose() * s_inv * innovation)[(0, 0)] > cfg.gate_sigmas.powi(2) {
-            let v = velocity.unwrap_or_else(Vector2::zeros);
-            self.track = Some(fresh(v, cfg.initial_speed_sigma_mm_s));
+            self.outliers += 1;
+            let stale = t_s - tr.last_seen_s > 0.25 * cfg.max_unseen_s;
+            if velocity.is_some() || stale || self.outliers >= cfg.outliers_to_restart {
+                let v = velocity.unwrap_or_else(Vector2::zeros);
+                self.track = Some(fresh(v, cfg.initial_speed_sigma_mm_s));
+                self.outliers = 0;
+            }
             return;
         }
+        self.outliers = 0;
         let k = tr.p * h.transpose() * s_inv;
         tr.x += k * innovation;
         tr.p = (Matrix4::identity() - k * h) * tr.p;
@@ -273,6 +286,15 @@ mod tests {
         t.update(0.0, Point2::new(0.0, 0.0), r, None);
         t.predict(0.04);
         t.update(0.04, Point2::new(3000.0, 0.0), r, None);
+        assert_eq!(
+            t.track().unwrap().position(),
+            Point2::new(0.0, 0.0),
+            "one outlier"
+        );
+        for k in 2..4 {
+            t.predict(0.04 * k as f64);
+            t.update(0.04 * k as f64, Point2::new(3000.0, 0.0), r, None);
+        }
         assert_eq!(t.track().unwrap().position(), Point2::new(3000.0, 0.0));
         t.predict(10.0);
         assert!(t.track().is_none());

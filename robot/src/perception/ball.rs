@@ -94,6 +94,9 @@ fn check_values(s: &BallSettings, p: &mut Problems) {
     p.positive("tracker.accel_noise_mm2_s3", s.tracker.accel_noise_mm2_s3);
     p.positive("tracker.gate_sigmas", s.tracker.gate_sigmas);
     p.positive("tracker.max_unseen_s", s.tracker.max_unseen_s);
+    if s.tracker.outliers_to_restart == 0 {
+        p.fail("tracker.outliers_to_restart", "must be >= 1");
+    }
     if s.tracker.roll_decel_mm_s2.is_nan() || s.tracker.roll_decel_mm_s2 < 0.0 {
         p.fail("tracker.roll_decel_mm_s2", "must be >= 0");
     }

@@ -360,7 +360,8 @@ impl Striker {
         let lined_up = (here - behind).norm() < 60.0 || {
             let r = here - b;
             let across = (r - toward * r.dot(&toward)).norm();
-            r.dot(&-toward) > contact && across < 25.0
+            let along = r.dot(&-toward);
+            along > contact && along < contact + self.config.standoff_mm + 60.0 && across < 25.0
         };
         let facing = wrap(heading - pose.rotation.angle()).abs() < 10f64.to_radians();
         if lined_up && facing {
