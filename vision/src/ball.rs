@@ -55,13 +55,13 @@ impl Default for BallColor {
 impl BallColor {
     /// Whether pixel `p` is ball-coloured.
     pub fn contains(&self, p: [u8; 3]) -> bool {
-        let r = f64::from(p[0]);
-        let g = f64::from(p[1]) / r.max(1.0);
-        let b = f64::from(p[2]) / r.max(1.0);
-        p[0] >= self.min_red
-            && g >= self.green_over_red[0]
-            && g <= self.green_over_red[1]
-            && b <= self.max_blue_over_red
+        if p[0] < self.min_red {
+            return false;
+        }
+        let (r, g, b) = (f32::from(p[0]), f32::from(p[1]), f32::from(p[2]));
+        g >= self.green_over_red[0] as f32 * r
+            && g <= self.green_over_red[1] as f32 * r
+            && b <= self.max_blue_over_red as f32 * r
     }
 }
 

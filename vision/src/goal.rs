@@ -43,12 +43,14 @@ impl Chroma {
         let Some(&lead) = p.get(self.lead) else {
             return false;
         };
-        let l = f64::from(lead).max(1.0);
-        lead >= self.min_lead
-            && (0..3).all(|k| {
-                let r = f64::from(p[k]) / l;
-                r >= self.over_lead[k][0] && r <= self.over_lead[k][1]
-            })
+        if lead < self.min_lead {
+            return false;
+        }
+        let l = f32::from(lead);
+        (0..3).all(|k| {
+            let c = f32::from(p[k]);
+            c >= self.over_lead[k][0] as f32 * l && c <= self.over_lead[k][1] as f32 * l
+        })
     }
 }
 
