@@ -174,7 +174,13 @@ pub struct BallStage {
     dribbler_mm: Option<Point2<f64>>,
     /// `(t_s, odometry pose)` at the start of recent cycles.
     history: VecDeque<(f64, Isometry2<f64>)>,
+    /// Cycles in a row the track put the ball in the light barrier and it saw nothing.
+    empty_barrier: u32,
 }
+
+/// Cycles the track may put the ball in the light barrier while the barrier sees nothing
+/// before the track is dropped.
+const EMPTY_BARRIER_CYCLES: u32 = 5;
 
 impl BallStage {
     /// The stage on vision's camera of `config`: its mirror calibration, or its forward
@@ -209,6 +215,7 @@ impl BallStage {
             detector,
             dribbler_mm,
             history: VecDeque::new(),
+            empty_barrier: 0,
         })
     }
 
@@ -284,6 +291,20 @@ impl BallStage {
         }
     }
 
+    /// Whether the track has put the ball where the light barrier would see it for
+    /// [`EMPTY_BARRIER_CYCLES`] cycles in a row while it saw nothing.
+    fn missed_at_dribbler(&mut self, now: &Isometry2<f64>) -> bool {
+        let inside = match (self.dribbler_mm, self.tracker.track()) {
+            (Some(at), Some(track)) => {
+                let p = now.inverse() * track.position();
+                p.x <= at.x + 1.0 && p.x > at.x - 20.0 && p.y.abs() < 15.0
+            }
+            _ => false,
+        };
+        self.empty_barrier = if inside { self.empty_barrier + 1 } else { 0 };
+        self.empty_barrier >= EMPTY_BARRIER_CYCLES
+    }
+
     /// The light barrier's measurement: the ball at the dribbler, moving with it.
     fn take_dribbler(&mut self, t_s: f64, now: &Isometry2<f64>) {
         let Some(at) = self.dribbler_mm else {
@@ -337,6 +358,14 @@ impl Stage for BallStage {
         let held = obs.ball_in_dribbler();
         if held {
             self.take_dribbler(obs.t_s, &now);
+        } else if self.missed_at_dribbler(&now) {
+            // Predicted on the dribbler, yet the light barrier sees nothing: it is not there.
+            self.tracker.reset();
+            out.not_found.push(NotFound {
+                source: NAME,
+                reason: "not at the dribbler where predicted".to_string(),
+            });
+            return Ok(());
         }
         if let Some(reason) = missed.filter(|_| !held) {
             out.not_found.push(NotFound {

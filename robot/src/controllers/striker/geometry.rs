@@ -23,14 +23,16 @@ pub fn approach_point(
 ) -> Point2<f64> {
     let behind = ball - toward * standoff_mm;
     let r = robot - ball;
-    // Already on the near side of the ball: nothing to go round.
-    if r.dot(&-toward) > 0.0 && distance_to_segment(ball, robot, behind) >= clear_mm {
-        return behind;
-    }
-    // Round the ball on the side the robot is on, a third of the way to behind it each time.
     let from = r.y.atan2(r.x);
     let to = (-toward).y.atan2((-toward).x);
     let turn = wrap(to - from);
+    // Behind the ball already (within 30 degrees of the line), or the way there clear of it.
+    if turn.abs() < 0.5
+        || (r.dot(&-toward) > 0.0 && distance_to_segment(ball, robot, behind) >= clear_mm)
+    {
+        return behind;
+    }
+    // Round the ball on the side the robot is on, a step of at most a radian at a time.
     let step = turn.signum() * turn.abs().min(1.0);
     ball + Rotation2::new(step) * unit(r) * clear_mm.max(r.norm().min(clear_mm * 1.5))
 }

@@ -70,7 +70,8 @@ pub struct StrikerConfig {
     pub speed_mm_s: f64,
     /// Speed onto the ball, mm/s.
     pub capture_speed_mm_s: f64,
-    /// How far behind the ball it lines up before moving onto it, mm.
+    /// How far behind the ball it lines up before moving onto it, mm (E1's robot: the ball
+    /// still in view there, just beyond the body's blind zone).
     pub standoff_mm: f64,
     /// The dribbler's speed near the ball, rpm.
     pub dribbler_rpm: f64,
@@ -96,7 +97,7 @@ impl Default for StrikerConfig {
             attack_side: 1.0,
             speed_mm_s: 1500.0,
             capture_speed_mm_s: 350.0,
-            standoff_mm: 180.0,
+            standoff_mm: 260.0,
             dribbler_rpm: 5000.0,
             kick_speed_mm_s: 5000.0,
             aim_tolerance_deg: 2.0,
@@ -158,6 +159,8 @@ pub struct Striker {
     max_speed_mm_s: f64,
     accel_mm_s2: f64,
     ball_radius_mm: f64,
+    /// Within this distance the body hides the ball: it goes round the ball beyond it.
+    blind_radius_mm: f64,
     roll_decel_mm_s2: f64,
     /// Where (odometry frame) the ball was taken onto the dribbler.
     captured_at: Option<Point2<f64>>,
@@ -186,6 +189,7 @@ impl Striker {
             max_speed_mm_s: c.body.max_speed_mm_s,
             accel_mm_s2: c.body.accel_limit_mm_s2,
             ball_radius_mm: ball.radius_mm,
+            blind_radius_mm: ball.blind_radius_mm,
             roll_decel_mm_s2: TrackerConfig::default().roll_decel_mm_s2,
             captured_at: None,
             search: 0,
@@ -372,7 +376,7 @@ impl Striker {
                 self.config.capture_speed_mm_s,
             );
         }
-        let clear = self.radius_mm + self.ball_radius_mm + 80.0;
+        let clear = (self.radius_mm + self.ball_radius_mm + 80.0).max(self.blind_radius_mm + 60.0);
         let next = approach_point(here, b, toward, contact + self.config.standoff_mm, clear);
         self.go(pose, next, heading, self.config.speed_mm_s)
     }
