@@ -25,7 +25,11 @@ Importing this module registers ``omniloop/Scenario-v0``::
   down to it by its norm (a diagonal at the box's corner runs at the top speed, not 1.41 times it).
 - Reward: progress toward the goal over the step in metres (the true distance before minus
   after), minus ``contact_penalty`` (default 1.0) for each new contact with a wall, cube,
-  pillar or robot; without a goal, the contact penalty alone.
+  pillar or robot. A ball task (a scenario with a ball and no goal: the vision-blackout
+  challenge's first stage) rewards the robot's progress toward the ball in metres (the true
+  distance between their centres before minus after) and 1.0 each
+  time its dribbler's light barrier starts to see the ball, less the contact penalty; without
+  a goal or a ball, the contact penalty alone.
 - ``terminated`` when the goal is reached (on the truth, within its tolerance);
   ``truncated`` when ``run.duration_s`` is up.
 - ``info``: the truth (``t_s``, ``x_mm``, ``y_mm``, ``theta_rad``, ``contacts``,
@@ -113,6 +117,7 @@ class _Task:
         goal = robot["goal"]
         self.goal = None if goal is None else (goal["x_mm"], goal["y_mm"])
         self.contact_penalty = float(contact_penalty)
+        self.hold_bonus = 1.0
         vmax = robot["max_speed_mm_s"]
         diff = robot["differential"]
         if diff is not None:
@@ -167,7 +172,17 @@ class _Task:
 
     def reward(self, before: Truth, after: Truth) -> float:
         progress = self.distance_m(before) - self.distance_m(after)
+        if self.goal is None and "ball" in after and "ball" in before:
+            progress = self.to_ball_m(before) - self.to_ball_m(after)
+            took = after.get("ball_in_dribbler", False) and not before.get("ball_in_dribbler", False)
+            progress += self.hold_bonus if took else 0.0
         return progress - self.contact_penalty * (after["contacts"] - before["contacts"])
+
+    @staticmethod
+    def to_ball_m(truth: Truth) -> float:
+        """The true distance from the robot's centre to the ball's, m."""
+        b = truth["ball"]
+        return math.hypot(b["x_mm"] - truth["x_mm"], b["y_mm"] - truth["y_mm"]) / 1000.0
 
     def command(self, action: Any) -> np.ndarray:
         a = np.asarray(action, dtype=np.float64).reshape(-1)

@@ -18,7 +18,10 @@ in its body frame, where its own dead reckoning puts it; absent without a goal);
 ``dribbler_rpm``, and ``"ball_in_dribbler"`` in its observation, as ``omniloop.gym`` has them);
 its reward its progress toward its goal
 over the step in metres, minus ``contact_penalty`` for each new contact of its (a wall, a
-cube, a pillar or another robot). The other robots are what its cameras show: no agent sees
+cube, a pillar or another robot). Without a goal, in a scenario with a ball (a ball task), its
+progress toward the ball in metres and 1.0 each time its dribbler's light barrier starts to see
+the ball, less the contact penalty: every robot goes for the same ball, so the first to hold it
+earns the bonus. The other robots are what its cameras show: no agent sees
 another's state or the truth. ``infos[agent]`` holds its truth (for scoring, never in an
 observation).
 

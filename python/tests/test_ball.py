@@ -181,3 +181,52 @@ def test_vector_simulation_checks_each_runs_kicker_commands(rollout, smoke):
     builtin = omniloop.VectorSimulation(rollout, 2, robot="builtin")
     with pytest.raises(ValueError, match="decides its own commands"):
         builtin.step(actuators=[None, None])
+
+
+def test_a_ball_task_rewards_going_for_the_ball_and_taking_it():
+    """Stage 1 of the vision blackout from Gymnasium: moving toward the ball earns its progress
+    in metres, the light barrier's first sight of the ball 1.0 more."""
+    import numpy as np
+
+    pytest.importorskip("gymnasium")
+    import omniloop.gym
+
+    env = omniloop.gym.OmniloopEnv(SCENARIOS / "blackout_stage1.toml", renderer="cpu")
+    _, info = env.reset(seed=1)
+
+    def to_ball(t):
+        return math.hypot(t["ball"]["x_mm"] - t["x_mm"], t["ball"]["y_mm"] - t["y_mm"])
+
+    before = to_ball(info)
+    _, reward, _, _, info = env.step(np.array([0.0, 1000.0, 0.0, 0.0, 0.0], dtype=np.float32))
+    assert reward == pytest.approx((before - to_ball(info)) / 1000.0, abs=1e-9)
+    assert reward != 0.0
+    # Placed at the front of the dribbler, the ball is taken: the bonus on top.
+    c, s = math.cos(info["theta_rad"]), math.sin(info["theta_rad"])
+    env.sim.place_ball(info["x_mm"] + 130.0 * c, info["y_mm"] + 130.0 * s, -200.0 * c, -200.0 * s)
+    total = 0.0
+    for _ in range(10):
+        _, reward, _, _, info = env.step(np.array([0.0, 0.0, 0.0, 0.0, 5000.0], dtype=np.float32))
+        total += reward
+        if info["ball_in_dribbler"]:
+            break
+    assert info["ball_in_dribbler"], "the rolling ball reached the dribbler"
+    assert total > 0.9
+
+
+def test_the_python_striker_example_grabs_the_ball():
+    """python/examples/grab_ball.py plays stage 1 from the mirror image alone."""
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+
+    out = subprocess.run(
+        [sys.executable, "python/examples/grab_ball.py", "1"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=True,
+    ).stdout
+    assert "held the ball: True" in out, out
