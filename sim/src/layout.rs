@@ -189,6 +189,59 @@ mod tests {
     }
 
     #[test]
+    fn a_run_off_is_floor_to_the_walls_and_the_goals_stand_free_on_it() {
+        // Division B: floor to x = +-4800, y = +-3300; goals from the goal line at 4500 to
+        // their backs' inner faces at 4680, 500 mm either side of the axis, walls 50 mm thick.
+        let f = crate::FieldPreset::DivisionB.spec();
+        let layout = Layout {
+            field: Some(f.clone()),
+            ..Layout::default()
+        };
+        for p in [
+            [4790.0, 3290.0],
+            [-4790.0, 0.0],
+            [4600.0, 0.0],
+            [4760.0, 0.0],
+        ] {
+            assert!(layout.is_floor(Point2::from(p)), "{p:?}");
+        }
+        for p in [[4810.0, 0.0], [0.0, -3310.0]] {
+            assert!(!layout.is_floor(Point2::from(p)), "{p:?}");
+        }
+        let solids = layout.solids();
+        let solid_at = |p: [f64; 2]| {
+            solids
+                .iter()
+                .any(|s| s.shape.distance_mm(Point2::from(p)) <= 0.0)
+        };
+        // In a wall: beyond the floor, the goal's back and sides.
+        for p in [
+            [4801.0, 0.0],
+            [4801.0, 3000.0],
+            [0.0, 3301.0],
+            [-4801.0, -3301.0],
+            [4705.0, 0.0],
+            [4600.0, 525.0],
+            [-4600.0, -525.0],
+        ] {
+            assert!(solid_at(p), "{p:?} not in a wall");
+        }
+        // Free: the run-off beside and behind the goals, the goal mouth and inside.
+        for p in [
+            [4799.0, 0.0],
+            [4740.0, 0.0],
+            [4799.0, 3299.0],
+            [4600.0, 0.0],
+            [4500.0, 499.0],
+            [4600.0, 551.0],
+            [0.0, 3299.0],
+        ] {
+            assert!(!solid_at(p), "{p:?} in a wall");
+        }
+        assert_eq!(f.walls().len(), 2 + 2 * 4);
+    }
+
+    #[test]
     fn lines_are_ten_mm_wide() {
         let f = FieldSpec::default();
         assert!(f.on_line(Point2::new(0.0, 100.0)));

@@ -31,7 +31,7 @@ pub use game::{BallEvent, BallFigures, GoalSide, Release};
 pub use kicker::{BallCommand, Kick, KickerSpec};
 pub use kinds::board::Board;
 pub use kinds::cube::Cube;
-pub use kinds::field::FieldSpec;
+pub use kinds::field::{FieldPreset, FieldSpec};
 pub use kinds::pillar::Pillar;
 pub use kinds::wall::Wall;
 pub use kinds::{FieldLines, Kind, KindVisitor, MapFeature, Stripes, Surroundings};

@@ -321,6 +321,18 @@ fn draw_floor(
             circle_points(Point2::origin(), f.centre_circle_radius_mm, 72),
             line,
         ))?;
+        if f.has_defense_areas() {
+            let (front, side) = (a - f.defense_area_depth_mm, 0.5 * f.defense_area_width_mm);
+            for s in [1.0, -1.0] {
+                let outline = vec![
+                    (s * a, -side),
+                    (s * front, -side),
+                    (s * front, side),
+                    (s * a, side),
+                ];
+                plot.draw(&PathElement::new(outline, line))?;
+            }
+        }
     }
     Ok(())
 }

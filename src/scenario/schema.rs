@@ -598,7 +598,7 @@ impl Scenario {
     /// The map the robot is given: what each kind of thing on the floor puts in it (the
     /// pillars as landmarks by colour, walls and boards as straight obstacles, the cubes as
     /// boxes which may be moved, the field's walls and the corridors' faces as the floor's
-    /// bounds, the named boards as marks).
+    /// bounds, the named boards as marks, the field's figures with its defense areas).
     pub fn robot_map(&self) -> WorldMap {
         let mut map = WorldMap {
             landmarks: Vec::new(),
@@ -656,6 +656,14 @@ impl Scenario {
                     centre_mm,
                     pattern: StripePattern::new(&name, &stripes),
                 }),
+                // The robot's field map holds the defense areas of the painted lines (it has no
+                // place yet for the centre circle and the halfway line).
+                MapFeature::Lines(lines) => {
+                    if let Some(f) = map.field.as_mut() {
+                        f.defense_depth_mm = lines.defense_area_depth_mm;
+                        f.defense_width_mm = lines.defense_area_width_mm;
+                    }
+                }
             }
         }
         map

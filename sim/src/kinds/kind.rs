@@ -55,21 +55,71 @@ pub enum MapFeature {
         /// Relative stripe widths.
         stripes: Vec<f64>,
     },
+    /// The lines painted on a Small-Size field: its outer lines, the halfway line, the centre
+    /// circle and the defense areas.
+    Lines(FieldLines),
 }
 
-/// Lines painted on the floor region after the Small-Size field's markings (its boundary, the
-/// centre line and the centre circle), which the renderers and the top view paint from these
-/// figures.
+/// Lines painted on the floor region after the Small-Size field's markings (its outer lines,
+/// the halfway line, the centre circle and the defense areas), which the renderers and the top
+/// view paint from these figures. Each line lies inside what it bounds: the outer lines inside
+/// the playing area, a defense area's lines inside the area.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FieldLines {
-    /// Half-length of the boundary.
+    /// Half-length of the playing area: its goal lines' outer edges at x = +-A1.
     pub half_length_mm: f64,
-    /// Half-width of the boundary.
+    /// Half-width of the playing area: its touchlines' outer edges at y = +-B.
     pub half_width_mm: f64,
     /// Width of each line.
     pub line_width_mm: f64,
-    /// Radius of the centre circle.
+    /// Radius of the centre circle (the line's middle).
     pub centre_circle_radius_mm: f64,
+    /// Depth of each defense area from its goal line (0: no defense areas).
+    pub defense_area_depth_mm: f64,
+    /// Width of each defense area, centred on the goal (0: none).
+    pub defense_area_width_mm: f64,
+}
+
+impl FieldLines {
+    /// Whether the field has defense areas.
+    pub fn has_defense_areas(&self) -> bool {
+        self.defense_area_depth_mm > 0.0 && self.defense_area_width_mm > 0.0
+    }
+
+    /// Is `p` on one of the lines? With A1, B, w the half length, half width and line width,
+    /// W and D a defense area's width and depth: the outer lines are `|x| in [A1 - w, A1]` or
+    /// `|y| in [B - w, B]` within the playing area, the halfway line `|x| <= w / 2`, the centre
+    /// circle `|r - radius| <= w / 2`; a defense area's lines are `|y| in [W/2 - w, W/2]` for
+    /// `|x| in [A1 - D, A1]` and `|x| in [A1 - D, A1 - D + w]` for `|y| <= W/2`.
+    pub fn on_line(&self, p: Point2<f64>) -> bool {
+        let w = self.line_width_mm;
+        let a1 = self.half_length_mm;
+        let b = self.half_width_mm;
+        let (ax, ay) = (p.x.abs(), p.y.abs());
+        if ax > a1 || ay > b {
+            return false;
+        }
+        let boundary = ax >= a1 - w || ay >= b - w;
+        let centre_line = ax <= w / 2.0;
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        let circle = (r - self.centre_circle_radius_mm).abs() <= w / 2.0;
+        let [front, front_in, side, side_in] = self.defense_edges_mm();
+        let defense = ax >= front && ay <= side && (ax <= front_in || ay >= side_in);
+        boundary || centre_line || circle || defense
+    }
+
+    /// The edges of the defense areas' lines: `|x|` of the front line's outer and inner edges
+    /// (A1 - D, A1 - D + w), `|y|` of the side lines' outer and inner edges (W/2, W/2 - w). With
+    /// no defense areas the sides' edges are -1, which no `|y|` reaches.
+    pub fn defense_edges_mm(&self) -> [f64; 4] {
+        if !self.has_defense_areas() {
+            return [0.0, 0.0, -1.0, -1.0];
+        }
+        let w = self.line_width_mm;
+        let front = self.half_length_mm - self.defense_area_depth_mm;
+        let side = 0.5 * self.defense_area_width_mm;
+        [front, front + w, side, side - w]
+    }
 }
 
 /// The vertical stripes on a striped solid (a board), from one end to the other.

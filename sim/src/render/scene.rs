@@ -283,6 +283,10 @@ pub struct SceneGlobals {
     pub light: [f32; 4],
     /// Diffuse term, normalisation so the floor shows its own colour, unused, unused.
     pub light2: [f32; 4],
+    /// Defense areas' lines: |x| of the front line's outer and inner edges, |y| of the side
+    /// lines' outer and inner edges ([`crate::FieldLines::defense_edges_mm`]; the sides' -1
+    /// when there are none).
+    pub field2: [f32; 4],
 }
 
 /// The scene of one frame.
@@ -404,6 +408,9 @@ impl SceneGlobals {
             sky_rgb: rgb4(SKY_RGB, 0.0),
             light: [l[0], l[1], l[2], AMBIENT],
             light2: [DIFFUSE, 1.0 / (AMBIENT + DIFFUSE * l[2]), 0.0, 0.0],
+            field2: field.map_or([0.0, 0.0, -1.0, -1.0], |f| {
+                f.defense_edges_mm().map(|v| v as f32)
+            }),
         }
     }
 }

@@ -42,7 +42,8 @@ pub enum FloorPaint {
 }
 
 /// What covers the floor at `(x, y)`: a mark painted on it (the last that covers the point),
-/// floor region, field lines or outside.
+/// floor region, field lines (outer lines, halfway line, centre circle, defense areas) or
+/// outside.
 #[inline]
 pub fn floor_paint(s: &Scene, x: f32, y: f32) -> FloorPaint {
     let g = &s.globals;
@@ -76,11 +77,13 @@ pub fn floor_paint(s: &Scene, x: f32, y: f32) -> FloorPaint {
         let ax = x.abs();
         let ay = y.abs();
         let [a1, b, w, cr] = g.field;
+        let [front, front_in, side, side_in] = g.field2;
         if ax <= a1 && ay <= b {
             let boundary = ax >= a1 - w || ay >= b - w;
             let centre = ax <= 0.5 * w;
             let circle = ((x * x + y * y).sqrt() - cr).abs() <= 0.5 * w;
-            if boundary || centre || circle {
+            let defense = ax >= front && ay <= side && (ax <= front_in || ay >= side_in);
+            if boundary || centre || circle || defense {
                 return FloorPaint::Line;
             }
         }

@@ -15,6 +15,7 @@ struct Globals {
     sky_rgb: vec4<f32>,
     light: vec4<f32>,       // direction xyz, ambient
     light2: vec4<f32>,      // diffuse, normalisation
+    field2: vec4<f32>,      // defense lines: |x| of the front's edges, |y| of the sides' (< 0: none)
 };
 
 struct SensorParams {
@@ -357,7 +358,9 @@ fn floor_paint(x: f32, y: f32) -> u32 {
             let boundary = ax >= a1 - w || ay >= b - w;
             let centre = ax <= 0.5 * w;
             let circle = abs(sqrt(x * x + y * y) - g.field.w) <= 0.5 * w;
-            if (boundary || centre || circle) { return n + 1u; }
+            let d = g.field2;
+            let defense = ax >= d.x && ay <= d.z && (ax <= d.y || ay >= d.w);
+            if (boundary || centre || circle || defense) { return n + 1u; }
         }
     }
     return n + 2u;

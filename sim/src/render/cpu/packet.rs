@@ -594,6 +594,7 @@ fn floor_paint(scene: &Scene, o: &[F; 3], d: &[F; 3], t: &F) -> U {
     }
     let n = scene.floor_rects.len() as u32;
     let [a1, b, w, cr] = g.field;
+    let [front, front_in, side, side_in] = g.field2;
     let lines = g.flags[0] != 0;
     let mut paint = [0; LANES];
     for i in 0..LANES {
@@ -602,7 +603,8 @@ fn floor_paint(scene: &Scene, o: &[F; 3], d: &[F; 3], t: &F) -> U {
         let boundary = ax >= a1 - w || ay >= b - w;
         let centre = ax <= 0.5 * w;
         let circle = ((x[i] * x[i] + y[i] * y[i]).sqrt() - cr).abs() <= 0.5 * w;
-        let line = lines && ax <= a1 && ay <= b && (boundary || centre || circle);
+        let defense = ax >= front && ay <= side && (ax <= front_in || ay >= side_in);
+        let line = lines && ax <= a1 && ay <= b && (boundary || centre || circle || defense);
         paint[i] = if mark[i] != u32::MAX {
             mark[i]
         } else if !inside[i] {

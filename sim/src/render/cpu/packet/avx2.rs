@@ -641,8 +641,14 @@ fn floor_paint(scene: &Scene, r: &Rays, t: V) -> I {
         let centre = le(ax, splat(0.5 * w));
         let rho = _mm256_sqrt_ps(add(mul(x, x), mul(y, y)));
         let circle = le(abs(sub(rho, splat(cr))), splat(0.5 * w));
+        let [front, front_in, side, side_in] = g.field2;
+        let defense = and(
+            and(ge(ax, splat(front)), le(ay, splat(side))),
+            or(le(ax, splat(front_in)), ge(ay, splat(side_in))),
+        );
         let on_field = and(le(ax, splat(a1)), le(ay, splat(b)));
-        let line = and(and(inside, on_field), or(or(boundary, centre), circle));
+        let marks = or(or(boundary, centre), or(circle, defense));
+        let line = and(and(inside, on_field), marks);
         paint = select_u(line, splat_u(n + 1), paint);
     }
     let marked = not(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
