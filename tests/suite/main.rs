@@ -13,6 +13,7 @@ mod corner55;
 mod custom_robot;
 mod effects;
 mod errors;
+mod field_presets;
 mod forward;
 mod foundation;
 mod freespace;
