@@ -13,6 +13,7 @@ pub const REPLAYS: &[Replay] = &[
     resection::REPLAY,
     forward::REPLAY,
     robustness::REPLAY,
+    crate::blackout::REPLAY,
 ];
 
 /// The replay called `name`.

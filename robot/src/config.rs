@@ -253,10 +253,12 @@ impl FieldMap {
         Point2::new(side.signum() * self.half_length_mm, 0.0)
     }
 
-    /// Whether `p` lies in either defense area grown by `margin_mm`.
+    /// Whether `p` lies in either defense area (between its front line and the goal line)
+    /// grown by `margin_mm`.
     pub fn in_defense_area(&self, p: Point2<f64>, margin_mm: f64) -> bool {
         self.defense_depth_mm > 0.0
             && p.x.abs() >= self.half_length_mm - self.defense_depth_mm - margin_mm
+            && p.x.abs() <= self.half_length_mm + margin_mm
             && p.y.abs() <= 0.5 * self.defense_width_mm + margin_mm
     }
 }

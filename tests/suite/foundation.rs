@@ -179,7 +179,7 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             format!("{BASE}\n[vision.freespce]\ndirections = 8\n"),
             ":10:9: field `vision.freespce`: unknown field `freespce`, expected one of sensor, \
              calibration_file, omnistereo, resection, forward, freespace, localization, \
-             luminance_heading",
+             luminance_heading, ball, goal",
         ),
         (
             "vision_value",
@@ -195,7 +195,7 @@ fn broken_scenarios_exit_2_with_file_line_column_and_field() {
             "unknown_control_table",
             format!("{BASE}\n[control.avodance]\nmargin_mm = 1.0\n"),
             ":10:10: field `control.avodance`: unknown field `avodance`, expected one of kind, \
-             pose_source, localization_gain, avoidance, planner, wander, forward, script, wall_follow, \
+             pose_source, localization_gain, avoidance, planner, wander, forward, script, wall_follow, striker, \
              resection",
         ),
     ];

@@ -8,6 +8,7 @@ mod common;
 
 mod avoidance;
 mod ball;
+mod blackout;
 mod camera_models;
 mod corner55;
 mod custom_robot;

@@ -77,18 +77,28 @@ pub fn defense_normal(field: &FieldMap, p: Point2<f64>, margin_mm: f64) -> Optio
     })
 }
 
-/// `v` (world frame) with any part that would take the robot at `p` into a defense area
-/// removed; inside one, straight out of it at `v`'s speed.
-pub fn keep_out(field: &FieldMap, p: Point2<f64>, v: Vector2<f64>, margin_mm: f64) -> Vector2<f64> {
-    if let Some(n) = defense_normal(field, p, 0.5 * margin_mm) {
-        if field.in_defense_area(p, 0.0) {
-            return n * v.norm().max(300.0);
-        }
-        let into = v.dot(&n);
-        return if into < 0.0 { v - n * into } else { v };
+/// `v` (world frame) with any part that would take the body (radius `radius_mm`, centre at
+/// `p`) within `margin_mm` of a defense area removed, looking as far ahead as the robot needs to
+/// stop at `accel_mm_s2`; a body already over the area's line leaves it straight out at `v`'s
+/// speed.
+pub fn keep_out(
+    field: &FieldMap,
+    p: Point2<f64>,
+    v: Vector2<f64>,
+    radius_mm: f64,
+    margin_mm: f64,
+    accel_mm_s2: f64,
+) -> Vector2<f64> {
+    if let Some(n) =
+        defense_normal(field, p, radius_mm).filter(|_| field.in_defense_area(p, radius_mm))
+    {
+        return n * v.norm().max(300.0);
     }
-    let ahead = p + v * 0.3;
-    match defense_normal(field, ahead, margin_mm) {
+    let speed = v.norm();
+    let ahead = p + v * (speed / (2.0 * accel_mm_s2.max(1.0)) + 0.1);
+    let grown = radius_mm + margin_mm;
+    let normal = defense_normal(field, p, grown).or_else(|| defense_normal(field, ahead, grown));
+    match normal {
         Some(n) if v.dot(&n) < 0.0 => v - n * v.dot(&n),
         _ => v,
     }
@@ -225,15 +235,21 @@ mod tests {
     fn a_command_into_the_defense_area_slides_along_it() {
         let f = field();
         let p = Point2::new(1000.0, 0.0);
-        let v = keep_out(&f, p, Vector2::new(1000.0, 0.0), 150.0);
+        let v = keep_out(&f, p, Vector2::new(1000.0, 0.0), 90.0, 60.0, 2000.0);
         assert!(v.x <= 1e-9, "{v}");
-        let inside = keep_out(
+        // Far enough to stop before the line: left alone.
+        let far = keep_out(
             &f,
-            Point2::new(1800.0, 0.0),
-            Vector2::new(500.0, 0.0),
-            150.0,
+            Point2::origin(),
+            Vector2::new(1000.0, 0.0),
+            90.0,
+            60.0,
+            2000.0,
         );
-        assert!(inside.x < 0.0);
+        assert_eq!(far, Vector2::new(1000.0, 0.0));
+        let over = Point2::new(1150.0, 0.0);
+        let inside = keep_out(&f, over, Vector2::new(500.0, 0.0), 90.0, 60.0, 2000.0);
+        assert!(inside.x < 0.0, "the body over the line leaves");
         let q = allowed_point(&f, Point2::new(1900.0, 100.0), 150.0, 100.0);
         assert!(!f.in_defense_area(q, 149.0), "{q}");
     }

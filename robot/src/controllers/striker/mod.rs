@@ -248,7 +248,14 @@ impl Striker {
             .min(4.0 * d.norm());
         let mut v = unit(d) * speed;
         if let Some(f) = &self.field {
-            v = keep_out(f, here, v, self.radius_mm + self.config.defense_margin_mm);
+            v = keep_out(
+                f,
+                here,
+                v,
+                self.radius_mm,
+                self.config.defense_margin_mm,
+                self.accel_mm_s2,
+            );
         }
         let err = wrap(heading - pose.rotation.angle());
         BodyCommand {
