@@ -20,6 +20,9 @@ use omniloop_vision::goal::{Chroma, goal_runs_mirror};
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector};
 use std::time::Instant;
 
+/// A row of the table: its name and the work it times.
+type Row<'a> = (&'static str, Box<dyn FnMut() + 'a>);
+
 /// Median milliseconds of `f` over `n` runs, after 20 to warm up.
 fn median_ms(n: usize, mut f: impl FnMut()) -> f64 {
     (0..20).for_each(|_| f());
@@ -55,7 +58,7 @@ fn main() {
         "256x220 frame", "median ms", "per second"
     );
     let mut fs = FreeSpaceDetector::new(FreeSpaceConfig::default(), &cal).expect("detector");
-    let rows: [(&str, Box<dyn FnMut()>); 3] = [
+    let rows: [Row<'_>; 3] = [
         (
             "free-space stage (baseline)",
             Box::new(|| {
