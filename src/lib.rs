@@ -20,6 +20,7 @@
 //! The robot's software is anything that implements [`robot::RobotSoftware`]; the world lives
 //! in `omniloop-sim`, image processing in [`vision`], motion and avoidance in [`control`].
 
+pub mod ball_map;
 pub mod blackout;
 pub mod camera_export;
 pub mod dataset;

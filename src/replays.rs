@@ -14,6 +14,7 @@ pub const REPLAYS: &[Replay] = &[
     forward::REPLAY,
     robustness::REPLAY,
     crate::blackout::REPLAY,
+    crate::ball_map::REPLAY,
 ];
 
 /// The replay called `name`.

@@ -15,6 +15,7 @@ pub const EXPERIMENTS: &[ExperimentEntry] = &[
     resection::ENTRY,
     forward::ENTRY,
     clutter::ENTRY,
+    crate::ball_map::ENTRY,
 ];
 
 /// The experiment called `name`.
