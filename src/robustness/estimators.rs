@@ -3,6 +3,7 @@
 //! A new estimator is one more entry in [`ESTIMATORS`]. Each reads its experiment's typed metrics ([`crate::experiments::Metrics`]) from the run's
 //! summary, so that a metric renamed there fails to compile here.
 
+use crate::ball_map::BallMapMetrics;
 use crate::experiments::heading::HeadingMetrics;
 use crate::experiments::omnistereo::OmnistereoMetrics;
 use crate::experiments::resection::ResectionMetrics;
@@ -227,6 +228,34 @@ pub const ESTIMATORS: &[Estimator] = &[
             Some(Score::new(worst, &[(worst > 7.2, "over 7.2%".into())]))
         },
     },
+    Estimator {
+        name: "ball",
+        title: "Ball detection (E1)",
+        scenario: crate::ball_map::ROBUSTNESS,
+        error_label: "median range error within 1 m, %",
+        target: "the ball detected in >= 95% of frames within 1 m, median range error <= 3%, \
+                 median bearing error <= 1 degree (ball map)",
+        bound: Some(3.0),
+        score: |s| {
+            let w = BallMapMetrics::of(s)?.ball_map.map?.within_target;
+            let (median, rate) = (w.median_range_error_pct?, w.detection_rate?);
+            let bearing = w.median_bearing_error_deg?;
+            Some(Score::new(
+                median,
+                &[
+                    (median > 3.0, "median over 3%".into()),
+                    (
+                        rate < 0.95,
+                        format!("detected in {:.0}% of frames", 100.0 * rate),
+                    ),
+                    (
+                        bearing > 1.0,
+                        format!("median bearing error {bearing:.2} deg"),
+                    ),
+                ],
+            ))
+        },
+    },
 ];
 
 /// The estimator called `name`.
@@ -237,6 +266,7 @@ pub fn estimator(name: &str) -> Option<&'static Estimator> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ball_map::stats::{BallMapFigures, CameraMap, Rates};
     use crate::experiments::MetricKeys;
     use crate::experiments::experiment::tests::summary_with;
     use crate::experiments::forward::{ForwardMetrics, MoveResult};
@@ -355,6 +385,38 @@ mod tests {
         let s = score("odometry_legs", &forward).unwrap();
         assert_eq!(s.error, 10.0);
         assert_eq!(s.missed.as_deref(), Some("over 7.2%"));
+
+        let within = Rates {
+            frames: 20,
+            detected: 18,
+            detection_rate: Some(0.9),
+            median_range_error_pct: Some(1.5),
+            p90_range_error_pct: Some(2.5),
+            median_range_bias_mm: Some(2.0),
+            median_bearing_error_deg: Some(0.2),
+            misses: vec![("too small".into(), 2)],
+        };
+        let map = CameraMap {
+            camera: "omni".into(),
+            image_px: [256, 220],
+            shadow: None,
+            rings: Vec::new(),
+            all: within.clone(),
+            unoccluded: within.clone(),
+            target_range_mm: 1000.0,
+            within_target: within,
+            lost_from_mm: None,
+            reaches_90: true,
+        };
+        let ball = BallMapMetrics {
+            ball_map: BallMapFigures {
+                map: Some(map),
+                false_balls: None,
+            },
+        };
+        let s = score("ball", &ball).unwrap();
+        assert_eq!(s.error, 1.5);
+        assert_eq!(s.missed.as_deref(), Some("detected in 90% of frames"));
     }
 
     #[test]
@@ -368,6 +430,7 @@ mod tests {
             "resection",
             "odometry_turn",
             "odometry_legs",
+            "ball",
         ] {
             assert_eq!((estimator(name).unwrap().score)(&none), None, "{name}");
         }
