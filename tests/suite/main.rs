@@ -8,6 +8,7 @@ mod common;
 
 mod avoidance;
 mod ball;
+mod ball_map;
 mod blackout;
 mod camera_models;
 mod corner55;
