@@ -3,8 +3,7 @@
 //! ([`crate::ball_tracker`]), which keeps it through frames where it is not seen and takes the
 //! dribbler's light barrier when the body hides it.
 
-use super::freespace::pose_at;
-use super::stage::{Belief, CameraNeed, Perceived, Stage, StageEntry, vision_camera};
+use super::stage::{Belief, CameraNeed, FloorOptics, Perceived, PoseHistory, Stage, StageEntry};
 use crate::RobotError;
 use crate::ball_tracker::{BallTracker, TrackerConfig, sighting_covariance};
 use crate::boundary::Observation;
@@ -14,13 +13,10 @@ use crate::percept::Percept;
 use image::RgbaImage;
 use nalgebra::{Isometry2, Matrix2, Point2, Vector2};
 use omniloop_problem::Problems;
-use omniloop_vision::RadialCalibration;
 use omniloop_vision::ball::{
     BallColor, BallConfig, BallMiss, BallSighting, detect_forward, detect_mirror,
 };
-use omniloop_vision::forward::ForwardCamera;
 use serde::{Deserialize, Serialize};
-use std::collections::VecDeque;
 
 /// The stage's name, in the estimates record and the registry.
 pub const NAME: &str = "ball";
@@ -55,8 +51,9 @@ pub struct BallSettings {
     /// The fewest pixels taken for the ball.
     pub min_pixels: usize,
     /// Within this distance of the robot's centre the body hides the ball from its camera, mm
-    /// (E1's robot: a 150 mm body of radius 90 mm under a viewpoint 205 mm up hides the ball's
-    /// top within about 290 mm).
+    /// (E1's robot: its 150 mm body of radius 90 mm hides the ball's top within 265 mm and its
+    /// lower part to 341 mm, where sightings read a few per cent long: `omniloop replay
+    /// ball_map`).
     pub blind_radius_mm: f64,
     /// The tracker.
     pub tracker: TrackerConfig,
@@ -157,23 +154,17 @@ impl Percept for BallEstimate {
     }
 }
 
-/// How the stage's camera maps pixels to the floor.
-enum Optics {
-    Mirror(RadialCalibration),
-    Forward(ForwardCamera),
-}
-
 /// Finds and tracks the ball on vision's camera.
 pub struct BallStage {
     camera: String,
-    optics: Optics,
+    optics: FloorOptics,
     settings: BallSettings,
     detector: BallConfig,
     tracker: BallTracker,
     /// Where the ball sits when the light barrier sees it, robot frame.
     dribbler_mm: Option<Point2<f64>>,
-    /// `(t_s, odometry pose)` at the start of recent cycles.
-    history: VecDeque<(f64, Isometry2<f64>)>,
+    /// The odometry poses of recent cycles.
+    history: PoseHistory,
     /// Cycles in a row the track put the ball in the light barrier and it saw nothing.
     empty_barrier: u32,
 }
@@ -186,17 +177,7 @@ impl BallStage {
     /// The stage on vision's camera of `config`: its mirror calibration, or its forward
     /// pinhole model.
     pub fn new(config: &RobotConfig) -> Result<Self, RobotError> {
-        let camera = vision_camera(config, "ball perception")?;
-        let optics = match (config.calibration(camera), &config.forward_camera) {
-            (Some(cal), _) => Optics::Mirror(cal.clone()),
-            (None, Some(f)) if f.sensor == camera => Optics::Forward(f.clone()),
-            _ => {
-                return Err(RobotError::Missing(format!(
-                    "ball perception needs camera {camera:?}'s image-to-floor calibration or \
-                     its forward pinhole model"
-                )));
-            }
-        };
+        let (camera, optics) = FloorOptics::of(config, "ball perception")?;
         let settings: BallSettings = config.vision.table(TABLE)?;
         let detector = BallConfig {
             color: settings.color.clone(),
@@ -208,13 +189,13 @@ impl BallStage {
             .kicker
             .map(|k| Point2::new(k.front_mm + settings.radius_mm, 0.0));
         Ok(Self {
-            camera: camera.to_string(),
+            camera,
             optics,
             tracker: BallTracker::new(settings.tracker),
             settings,
             detector,
             dribbler_mm,
-            history: VecDeque::new(),
+            history: PoseHistory::default(),
             empty_barrier: 0,
         })
     }
@@ -222,16 +203,16 @@ impl BallStage {
     /// The ball in one image, robot frame when it was taken.
     fn detect(&self, img: &RgbaImage) -> Result<BallSighting, BallMiss> {
         match &self.optics {
-            Optics::Mirror(cal) => detect_mirror(img, cal, &self.detector),
-            Optics::Forward(cam) => detect_forward(img, cam, &self.detector),
+            FloorOptics::Mirror(cal) => detect_mirror(img, cal, &self.detector),
+            FloorOptics::Forward(cam) => detect_forward(img, cam, &self.detector),
         }
     }
 
     /// How far the camera sees the floor, mm.
     fn view_range_mm(&self) -> f64 {
         match &self.optics {
-            Optics::Mirror(cal) => cal.samples.last().map_or(0.0, |s| s[1]),
-            Optics::Forward(_) => f64::INFINITY,
+            FloorOptics::Mirror(cal) => cal.samples.last().map_or(0.0, |s| s[1]),
+            FloorOptics::Forward(_) => f64::INFINITY,
         }
     }
 
@@ -266,7 +247,7 @@ impl BallStage {
         };
         match self.detect(frame.image) {
             Ok(s) => {
-                let taken = pose_at(&self.history, frame.t_s).unwrap_or(*now);
+                let taken = self.history.at(frame.t_s).unwrap_or(*now);
                 let z = taken * s.position_mm;
                 let r = sighting_covariance(
                     &taken,
@@ -311,8 +292,8 @@ impl BallStage {
             return;
         };
         let z = now * at;
-        let v = match self.history.iter().rev().nth(1) {
-            Some((t0, p0)) if t_s > *t0 => (z - p0 * at) / (t_s - t0),
+        let v = match self.history.back(1) {
+            Some((t0, p0)) if t_s > t0 => (z - p0 * at) / (t_s - t0),
             _ => Vector2::zeros(),
         };
         self.tracker
@@ -345,14 +326,7 @@ impl Stage for BallStage {
         out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let now = belief.odometry_pose;
-        self.history.push_back((obs.t_s, now));
-        while self
-            .history
-            .front()
-            .is_some_and(|(t, _)| *t < obs.t_s - 1.0)
-        {
-            self.history.pop_front();
-        }
+        self.history.push(obs.t_s, now, 1.0);
         self.tracker.predict(obs.t_s);
         let (sighting, missed) = self.take_frame(obs, &now);
         let held = obs.ball_in_dribbler();

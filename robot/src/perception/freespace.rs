@@ -2,7 +2,8 @@
 //! floor-colour mask, eqs. (5)-(7).
 
 use super::stage::{
-    Belief, CameraNeed, Perceived, Stage, StageEntry, calibration, vision_camera, vision_settings,
+    Belief, CameraNeed, Perceived, PoseHistory, Stage, StageEntry, calibration, vision_camera,
+    vision_settings,
 };
 use crate::RobotError;
 use crate::boundary::Observation;
@@ -16,7 +17,6 @@ use omniloop_vision::FreeSpace;
 use omniloop_vision::freespace::PolarTemplate;
 use omniloop_vision::image_centre::dark_disc_centre;
 use omniloop_vision::{FreeSpaceConfig, FreeSpaceDetector, RadialCalibration};
-use std::collections::VecDeque;
 
 /// Free space around the robot (eqs. (5)-(7)). The estimates record writes it itself, as
 /// `free_mm` beside the true free distances (`null` in a cycle without it), so it gives no
@@ -139,27 +139,11 @@ pub struct FreeSpaceStage {
     /// The last free space and the odometry pose when its frame was taken.
     last: Option<(FreeSpace, Isometry2<f64>, f64)>,
     /// `(t_s, odometry pose)` at the start of recent cycles.
-    history: VecDeque<(f64, Isometry2<f64>)>,
+    history: PoseHistory,
 }
 
 /// The oldest free space the stage gives (s after its frame was taken); older, none.
 pub const MAX_AGE_S: f64 = 0.5;
-
-/// The odometry pose at `t_s` from `history` (linear between the cycles around it; the
-/// oldest or newest beyond them).
-pub(crate) fn pose_at(
-    history: &VecDeque<(f64, Isometry2<f64>)>,
-    t_s: f64,
-) -> Option<Isometry2<f64>> {
-    let after = history.iter().position(|(t, _)| *t >= t_s - 1e-9)?;
-    let (t1, p1) = history[after];
-    if after == 0 || (t1 - t_s).abs() < 1e-9 {
-        return Some(p1);
-    }
-    let (t0, p0) = history[after - 1];
-    let k = (t_s - t0) / (t1 - t0);
-    Some(p0.lerp_slerp(&p1, k))
-}
 
 impl FreeSpaceStage {
     /// A stage for `camera`, calibrated by `cal`.
@@ -174,7 +158,7 @@ impl FreeSpaceStage {
             cal: cal.clone(),
             centred: false,
             last: None,
-            history: VecDeque::new(),
+            history: PoseHistory::default(),
         })
     }
 
@@ -248,14 +232,7 @@ impl Stage for FreeSpaceStage {
         out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let now = belief.odometry_pose;
-        self.history.push_back((obs.t_s, now));
-        while self
-            .history
-            .front()
-            .is_some_and(|(t, _)| *t < obs.t_s - 2.0 * MAX_AGE_S)
-        {
-            self.history.pop_front();
-        }
+        self.history.push(obs.t_s, now, 2.0 * MAX_AGE_S);
         if let Some(frame) = obs.frame(&self.camera).filter(|_| !self.centred) {
             self.recentre(frame.image)?;
         }
@@ -268,7 +245,7 @@ impl Stage for FreeSpaceStage {
                 return Ok(());
             }
             Some(frame) => {
-                let taken = pose_at(&self.history, frame.t_s).unwrap_or(now);
+                let taken = self.history.at(frame.t_s).unwrap_or(now);
                 self.last = Some((self.detector.detect(frame.image)?, taken, frame.t_s));
             }
             None => out.not_found.push(NotFound {

@@ -3,20 +3,15 @@
 //! moved by the turn odometry measured since it was taken). The widest run of a goal is the
 //! widest open part of its mouth.
 
-use super::freespace::pose_at;
-use super::stage::{Belief, CameraNeed, Perceived, Stage, StageEntry, vision_camera};
+use super::stage::{Belief, CameraNeed, FloorOptics, Perceived, PoseHistory, Stage, StageEntry};
 use crate::RobotError;
 use crate::boundary::Observation;
 use crate::config::RobotConfig;
 use crate::estimates::NotFound;
 use crate::percept::Percept;
-use nalgebra::Isometry2;
 use omniloop_problem::Problems;
-use omniloop_vision::RadialCalibration;
-use omniloop_vision::forward::ForwardCamera;
 use omniloop_vision::goal::{Chroma, GoalRun, goal_runs_forward, goal_runs_mirror};
 use serde::{Deserialize, Serialize};
-use std::collections::VecDeque;
 
 /// The stage's name, in the estimates record and the registry.
 pub const NAME: &str = "goal";
@@ -100,47 +95,31 @@ impl Percept for GoalsSeen {
     }
 }
 
-/// How the stage's camera maps pixels to azimuths.
-enum Optics {
-    Mirror(RadialCalibration),
-    Forward(ForwardCamera),
-}
-
 /// Finds the goals on vision's camera.
 pub struct GoalStage {
     camera: String,
-    optics: Optics,
+    optics: FloorOptics,
     settings: GoalSettings,
-    history: VecDeque<(f64, Isometry2<f64>)>,
+    history: PoseHistory,
 }
 
 impl GoalStage {
     /// The stage on vision's camera of `config`.
     pub fn new(config: &RobotConfig) -> Result<Self, RobotError> {
-        let camera = vision_camera(config, "goal perception")?;
-        let optics = match (config.calibration(camera), &config.forward_camera) {
-            (Some(cal), _) => Optics::Mirror(cal.clone()),
-            (None, Some(f)) if f.sensor == camera => Optics::Forward(f.clone()),
-            _ => {
-                return Err(RobotError::Missing(format!(
-                    "goal perception needs camera {camera:?}'s image-to-floor calibration or \
-                     its forward pinhole model"
-                )));
-            }
-        };
+        let (camera, optics) = FloorOptics::of(config, "goal perception")?;
         Ok(Self {
-            camera: camera.to_string(),
+            camera,
             optics,
             settings: config.vision.table(TABLE)?,
-            history: VecDeque::new(),
+            history: PoseHistory::default(),
         })
     }
 
     /// The runs of `color` in `img`.
     fn runs(&self, img: &image::RgbaImage, color: &Chroma) -> Vec<GoalRun> {
         match &self.optics {
-            Optics::Mirror(cal) => goal_runs_mirror(img, cal, color, self.settings.inner_px),
-            Optics::Forward(cam) => goal_runs_forward(img, cam, color),
+            FloorOptics::Mirror(cal) => goal_runs_mirror(img, cal, color, self.settings.inner_px),
+            FloorOptics::Forward(cam) => goal_runs_forward(img, cam, color),
         }
     }
 }
@@ -174,18 +153,11 @@ impl Stage for GoalStage {
         out: &mut Perceived,
     ) -> Result<(), RobotError> {
         let now = belief.odometry_pose;
-        self.history.push_back((obs.t_s, now));
-        while self
-            .history
-            .front()
-            .is_some_and(|(t, _)| *t < obs.t_s - 1.0)
-        {
-            self.history.pop_front();
-        }
+        self.history.push(obs.t_s, now, 1.0);
         let Some(frame) = obs.frame(&self.camera) else {
             return Ok(());
         };
-        let taken = pose_at(&self.history, frame.t_s).unwrap_or(now);
+        let taken = self.history.at(frame.t_s).unwrap_or(now);
         let turn = now.rotation.angle() - taken.rotation.angle();
         let seen = GoalsSeen {
             pos_x: self

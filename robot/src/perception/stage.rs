@@ -187,3 +187,68 @@ pub fn image<'a>(
 ) -> Result<&'a RgbaImage, RobotError> {
     obs.image(sensor, stage)
 }
+
+/// The odometry poses at the start of recent cycles, to place a late frame's findings where the
+/// robot was when it was taken.
+#[derive(Debug, Clone, Default)]
+pub struct PoseHistory(std::collections::VecDeque<(f64, Isometry2<f64>)>);
+
+impl PoseHistory {
+    /// Keeps `pose` at `t_s`, forgetting poses older than `keep_s` before it.
+    pub fn push(&mut self, t_s: f64, pose: Isometry2<f64>, keep_s: f64) {
+        self.0.push_back((t_s, pose));
+        while self.0.front().is_some_and(|(t, _)| *t < t_s - keep_s) {
+            self.0.pop_front();
+        }
+    }
+
+    /// The pose at `t_s` (linear between the cycles around it; the oldest or newest beyond).
+    pub fn at(&self, t_s: f64) -> Option<Isometry2<f64>> {
+        let h = &self.0;
+        let after = h.iter().position(|(t, _)| *t >= t_s - 1e-9)?;
+        let (t1, p1) = h[after];
+        if after == 0 || (t1 - t_s).abs() < 1e-9 {
+            return Some(p1);
+        }
+        let (t0, p0) = h[after - 1];
+        Some(p0.lerp_slerp(&p1, (t_s - t0) / (t1 - t0)))
+    }
+
+    /// The pose `n` cycles back (0: the newest).
+    pub fn back(&self, n: usize) -> Option<(f64, Isometry2<f64>)> {
+        self.0.iter().rev().nth(n).copied()
+    }
+
+    /// Forgets every pose.
+    pub fn clear(&mut self) {
+        self.0.clear();
+    }
+}
+
+/// How vision's camera maps pixels to the floor: a mirror's image-to-floor calibration, or a
+/// forward pinhole's model.
+#[derive(Debug, Clone)]
+pub enum FloorOptics {
+    /// A mirror camera (calibrated ones too).
+    Mirror(RadialCalibration),
+    /// A forward pinhole camera.
+    Forward(omniloop_vision::forward::ForwardCamera),
+}
+
+impl FloorOptics {
+    /// Vision's camera of `config` and its optics, or the error naming `what` needs them.
+    pub fn of(config: &RobotConfig, what: &str) -> Result<(String, Self), RobotError> {
+        let camera = vision_camera(config, what)?;
+        let optics = match (config.calibration(camera), &config.forward_camera) {
+            (Some(cal), _) => Self::Mirror(cal.clone()),
+            (None, Some(f)) if f.sensor == camera => Self::Forward(f.clone()),
+            _ => {
+                return Err(RobotError::Missing(format!(
+                    "{what} needs camera {camera:?}'s image-to-floor calibration or its forward \
+                     pinhole model"
+                )));
+            }
+        };
+        Ok((camera.to_string(), optics))
+    }
+}
