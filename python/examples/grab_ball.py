@@ -12,6 +12,7 @@ import sys
 import numpy as np
 
 import omniloop
+from omniloop.types import Dribble
 
 scenario = omniloop.Scenario.load("scenarios/blackout_stage1.toml")
 sim = omniloop.Simulation(scenario)  # this script is the robot's software
@@ -38,7 +39,7 @@ last_bearing, held_for = 0.0, 0
 while not obs.done and held_for < 15:
     img = obs.frames["omni"]
     seen = find_ball(img)
-    dribble = {"dribbler_rpm": 5000.0}
+    dribble: Dribble = {"dribbler_rpm": 5000.0}
     if obs.ball_in_dribbler:  # the light barrier: the ball is ours, stop and hold it
         held_for += 1
         obs = sim.step((0.0, 0.0, 0.0), [dribble])

@@ -201,17 +201,19 @@ def test_a_ball_task_rewards_going_for_the_ball_and_taking_it():
     _, reward, _, _, info = env.step(np.array([0.0, 1000.0, 0.0, 0.0, 0.0], dtype=np.float32))
     assert reward == pytest.approx((before - to_ball(info)) / 1000.0, abs=1e-9)
     assert reward != 0.0
-    # Placed at the front of the dribbler, the ball is taken: the bonus on top.
+    # Rolled onto the front of the dribbler, the ball is taken: the bonus on top of the progress
+    # (both from the truth before the step, as the environment keeps it).
     c, s = math.cos(info["theta_rad"]), math.sin(info["theta_rad"])
-    env.sim.place_ball(info["x_mm"] + 130.0 * c, info["y_mm"] + 130.0 * s, -200.0 * c, -200.0 * s)
-    total = 0.0
+    env.sim.place_ball(info["x_mm"] + 105.0 * c, info["y_mm"] + 105.0 * s, -400.0 * c, -400.0 * s)
+    before = info
     for _ in range(10):
         _, reward, _, _, info = env.step(np.array([0.0, 0.0, 0.0, 0.0, 5000.0], dtype=np.float32))
-        total += reward
         if info["ball_in_dribbler"]:
             break
+        before = info
     assert info["ball_in_dribbler"], "the rolling ball reached the dribbler"
-    assert total > 0.9
+    progress = (to_ball(before) - to_ball(info)) / 1000.0
+    assert reward == pytest.approx(progress + 1.0, abs=1e-9)
 
 
 def test_the_python_striker_example_grabs_the_ball():
