@@ -2,7 +2,9 @@
 //! (an azimuth bin about the camera axis) that holds a pixel of the goal's colour, merged into
 //! runs. What stands in front of the goal (a defender) cuts its run in two, so the widest run
 //! is the widest open part of the mouth the camera shows, and its middle the direction to
-//! shoot at. Ours: the papers have no goals.
+//! shoot at. A camera higher than the defender sees the top of the goal's back wall over it,
+//! so a direction counts only where no dark pixel (a robot's black top or body) lies just
+//! nearer than the goal's nearest pixel in it. Ours: the papers have no goals.
 
 use crate::calibration::RadialCalibration;
 use crate::forward::ForwardCamera;
@@ -79,35 +81,75 @@ pub fn goal_runs_mirror(
     inner_px: f64,
 ) -> Vec<GoalRun> {
     let horizon = cal.horizon_px.min(cal.max_radius_px());
-    runs_by(img, color, |u, v| {
+    // The robot's own body (and what it carries) is dark too, about the image centre.
+    let body = cal.image_radius_px(OWN_BODY_MM).unwrap_or(0.0);
+    runs_by(img, color, body, |u, v| {
         let (x, y) = cal.image_coords(f64::from(u), f64::from(v));
         let r = x.hypot(y);
-        (r > inner_px && r < horizon).then(|| y.atan2(x))
+        // Outward from the image centre is farther on the floor.
+        (r > inner_px && r < horizon).then(|| (y.atan2(x), r))
     })
 }
 
 /// The runs of `color` in a forward pinhole camera's image, widest first.
 pub fn goal_runs_forward(img: &RgbaImage, cam: &ForwardCamera, color: &Chroma) -> Vec<GoalRun> {
-    runs_by(img, color, |u, v| {
+    runs_by(img, color, f64::NEG_INFINITY, |u, v| {
         let d = cam.direction(f64::from(u), f64::from(v));
-        Some(d.y.atan2(d.x))
+        // Up the image is farther on the floor.
+        Some((d.y.atan2(d.x), -f64::from(v)))
     })
 }
 
-/// The runs of `color` over the azimuths `azimuth` gives each pixel it keeps.
+/// The brightest channel of a dark pixel at most this: a robot's black top and body (the
+/// floor, the lines, the goals and the ball are all brighter).
+pub const DARK_MAX: u8 = 50;
+
+/// Floor distance within which dark pixels are the robot's own body, mm (a Small-Size robot's
+/// radius is 90 mm; its dribbler and kicker reach a little farther).
+pub const OWN_BODY_MM: f64 = 200.0;
+
+/// How far (in the key of [`runs_by`]: image pixels) nearer than a goal's nearest pixel a dark
+/// pixel hides the goal there: a robot standing in front of it, whose top is just under the
+/// part of the goal seen over it.
+pub const HIDING_GAP: f64 = 4.0;
+
+/// The runs of `color` over the azimuths `place` gives each pixel it keeps (with a key that
+/// grows with the distance on the floor): a bin is full where it holds the colour and no dark
+/// pixel (with a key beyond `dark_from`) lies within [`HIDING_GAP`] nearer than the colour's
+/// nearest.
 fn runs_by(
     img: &RgbaImage,
     color: &Chroma,
-    azimuth: impl Fn(u32, u32) -> Option<f64>,
+    dark_from: f64,
+    place: impl Fn(u32, u32) -> Option<(f64, f64)>,
 ) -> Vec<GoalRun> {
-    let mut bins = vec![false; BINS];
+    let mut goal = vec![f64::INFINITY; BINS];
     for (u, v, p) in img.enumerate_pixels() {
         if color.contains([p[0], p[1], p[2]])
-            && let Some(a) = azimuth(u, v)
+            && let Some((a, key)) = place(u, v)
         {
-            bins[bin_of(a)] = true;
+            let b = bin_of(a);
+            goal[b] = goal[b].min(key);
         }
     }
+    let mut hidden = vec![false; BINS];
+    for (u, v, p) in img.enumerate_pixels() {
+        if p[0].max(p[1]).max(p[2]) > DARK_MAX {
+            continue;
+        }
+        if let Some((a, key)) = place(u, v).filter(|&(_, key)| key > dark_from) {
+            let b = bin_of(a);
+            hidden[b] |= key < goal[b] && key >= goal[b] - HIDING_GAP;
+        }
+    }
+    // A bin between two hidden ones is hidden too: a near robot's top is a few pixels deep,
+    // under one a degree near the image centre.
+    let bins: Vec<bool> = (0..BINS)
+        .map(|k| {
+            let between = hidden[(k + BINS - 1) % BINS] && hidden[(k + 1) % BINS];
+            goal[k].is_finite() && !hidden[k] && !between
+        })
+        .collect();
     // A single empty bin between two full ones is noise, not a gap.
     let filled: Vec<bool> = (0..BINS)
         .map(|k| bins[k] || (bins[(k + BINS - 1) % BINS] && bins[(k + 1) % BINS]))
@@ -192,9 +234,9 @@ mod tests {
         for v in 45..56 {
             img.put_pixel(95, v, Rgba([235, 200, 20, 255]));
         }
-        let runs = runs_by(&img, &Chroma::YELLOW, |u, v| {
+        let runs = runs_by(&img, &Chroma::YELLOW, 0.0, |u, v| {
             let (x, y) = (f64::from(u) - 50.0, 50.0 - f64::from(v));
-            Some(y.atan2(x))
+            Some((y.atan2(x), x.hypot(y)))
         });
         assert_eq!(runs.len(), 1);
         assert!(runs[0].centre_rad.abs() < 0.02, "{runs:?}");
@@ -203,5 +245,60 @@ mod tests {
             "the ball is not the goal"
         );
         assert!(!Chroma::YELLOW.contains([240, 240, 240]), "nor a line");
+    }
+}
+
+#[cfg(test)]
+mod over_a_defender {
+    use super::*;
+    use image::Rgba;
+
+    #[test]
+    fn a_dark_robot_in_front_of_the_goal_cuts_its_run_though_the_goal_shows_over_it() {
+        // The goal's back wall at 40 to 44 px out, 20 degrees either side of ahead; a robot's
+        // black top nearer (at 36 to 38 px) over 2 to 8 degrees; a dark wall beyond the goal
+        // elsewhere changes nothing.
+        let mut img = RgbaImage::from_pixel(121, 121, Rgba([30, 130, 55, 255]));
+        let put = |img: &mut RgbaImage, r: f64, deg: f64, c: [u8; 3]| {
+            let a = deg.to_radians();
+            let (u, v) = (60.0 + r * a.cos(), 60.0 - r * a.sin());
+            img.put_pixel(
+                u.round() as u32,
+                v.round() as u32,
+                Rgba([c[0], c[1], c[2], 255]),
+            );
+        };
+        for k in -200..=200 {
+            let deg = f64::from(k) * 0.1;
+            for r in [40.0, 41.0, 42.0, 43.0, 44.0] {
+                put(&mut img, r, deg, [235, 200, 20]);
+            }
+            put(&mut img, 50.0, deg, [20, 20, 20]);
+            if (2.0..=8.0).contains(&deg) {
+                for r in [36.0, 37.0, 38.0] {
+                    put(&mut img, r, deg, [20, 20, 20]);
+                }
+            }
+        }
+        // The robot's own dark body about the centre is left out.
+        for u in 55..66 {
+            for v in 55..66 {
+                img.put_pixel(u, v, Rgba([10, 10, 10, 255]));
+            }
+        }
+        let runs = runs_by(&img, &Chroma::YELLOW, 8.0, |u, v| {
+            let (x, y) = (f64::from(u) - 60.0, 60.0 - f64::from(v));
+            Some((y.atan2(x), x.hypot(y)))
+        });
+        assert_eq!(runs.len(), 2, "{runs:?}");
+        // The wider part, -20 to 2 degrees, first.
+        assert!(
+            (runs[0].centre_rad.to_degrees() + 9.0).abs() < 1.5,
+            "{runs:?}"
+        );
+        assert!(
+            (runs[1].centre_rad.to_degrees() - 14.0).abs() < 1.5,
+            "{runs:?}"
+        );
     }
 }
