@@ -393,9 +393,12 @@ fn draw_paths<'a, 'b: 'a>(
         } else {
             chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))?
         };
-        series
-            .label(p.label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+        // A path without a label stays out of the legend (many paths, one entry).
+        if !p.label.is_empty() {
+            series.label(p.label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
+            });
+        }
     }
     Ok(())
 }
