@@ -245,6 +245,8 @@ pub struct FieldMap {
     pub defense_depth_mm: f64,
     /// Width of each defense area, mm.
     pub defense_width_mm: f64,
+    /// Floor beyond the outer lines to the field walls, mm (0: the walls stand on the lines).
+    pub run_off_mm: f64,
 }
 
 impl FieldMap {

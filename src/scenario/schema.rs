@@ -612,6 +612,7 @@ impl Scenario {
                 goal_width_mm: f.goal_width_mm,
                 defense_depth_mm: 0.0,
                 defense_width_mm: 0.0,
+                run_off_mm: f.boundary_width_mm,
             }),
         };
         for feature in self.world.map_features() {

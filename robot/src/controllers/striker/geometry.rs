@@ -60,78 +60,199 @@ pub fn wrap(a: f64) -> f64 {
     a
 }
 
-/// The outward normal of the nearest side of the defense area (grown by `margin_mm`) that
-/// `p` is inside of or within `margin_mm` of; `None` when clear of both.
-pub fn defense_normal(field: &FieldMap, p: Point2<f64>, margin_mm: f64) -> Option<Vector2<f64>> {
-    if !field.in_defense_area(p, margin_mm) {
+/// The defense area at `+x` (`side` 1) or `-x` (`side` -1) as its lower and upper corners,
+/// from its front line to the goal line; `None` on a field without defense areas.
+fn defense_rect(field: &FieldMap, side: f64) -> Option<(Point2<f64>, Point2<f64>)> {
+    if field.defense_depth_mm <= 0.0 {
         return None;
     }
-    let front = field.half_length_mm - field.defense_depth_mm - margin_mm;
-    let side = 0.5 * field.defense_width_mm + margin_mm;
-    let to_front = p.x.abs() - front;
-    let to_side = side - p.y.abs();
-    Some(if to_front < to_side {
-        Vector2::new(-p.x.signum(), 0.0)
-    } else {
-        Vector2::new(0.0, p.y.signum())
-    })
+    let (l, d, w) = (
+        field.half_length_mm,
+        field.defense_depth_mm,
+        0.5 * field.defense_width_mm,
+    );
+    let (x0, x1) = if side > 0.0 { (l - d, l) } else { (-l, -l + d) };
+    Some((Point2::new(x0, -w), Point2::new(x1, w)))
 }
 
-/// `v` (world frame) with any part that would take the body (radius `radius_mm`, centre at
-/// `p`) within `margin_mm` of a defense area removed, looking as far ahead as the robot needs to
-/// stop at `accel_mm_s2`; a body already over the area's line leaves it straight out at `v`'s
-/// speed.
+/// How far `p` is from the nearer defense area, mm (negative inside it, by the distance to its
+/// nearest side toward the field), and the way out of it: the unit vector from the area's
+/// nearest point to `p` (inside, out through that side). `None` on a field without them.
+pub fn defense_clearance(field: &FieldMap, p: Point2<f64>) -> Option<(f64, Vector2<f64>)> {
+    [1.0, -1.0]
+        .into_iter()
+        .filter_map(|side| defense_rect(field, side).map(|r| (side, r)))
+        .map(|(side, (lo, hi))| {
+            let q = Point2::new(p.x.clamp(lo.x, hi.x), p.y.clamp(lo.y, hi.y));
+            let d = p - q;
+            if d.norm() > 1e-9 {
+                return (d.norm(), d / d.norm());
+            }
+            // Inside: out through the front line or a side line, whichever is nearer.
+            let front = (p.x - if side > 0.0 { lo.x } else { hi.x }).abs();
+            let lateral = hi.y - p.y.abs();
+            if front <= lateral {
+                (-front, Vector2::new(-side, 0.0))
+            } else {
+                (
+                    -lateral,
+                    Vector2::new(0.0, if p.y >= 0.0 { 1.0 } else { -1.0 }),
+                )
+            }
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// `v` (world frame, mm/s) limited so that the body (radius `radius_mm`, centre at `p`,
+/// moving at `now`) can always stop `margin_mm` short of a defense area: the speed toward the
+/// nearer area is at most `sqrt(2 (a / 2) room)`, where `room` is the distance left to that
+/// margin and `a` the body's acceleration limit (half of it, so the body's lag behind its
+/// command still stops in time). When the body already comes faster than that, the command
+/// keeps its present speed along the area, so that the whole acceleration brakes (the body
+/// changes its velocity toward the command along their difference). Within the margin it is
+/// pushed out at `3 room` mm/s, and a body already over the area's line leaves it straight
+/// out at `v`'s speed (at least 300 mm/s).
 pub fn keep_out(
     field: &FieldMap,
     p: Point2<f64>,
-    v: Vector2<f64>,
+    [v, now]: [Vector2<f64>; 2],
     radius_mm: f64,
     margin_mm: f64,
     accel_mm_s2: f64,
 ) -> Vector2<f64> {
-    if let Some(n) =
-        defense_normal(field, p, radius_mm).filter(|_| field.in_defense_area(p, radius_mm))
-    {
-        return n * v.norm().max(300.0);
+    let Some((distance, out)) = defense_clearance(field, p) else {
+        return v;
+    };
+    if distance < radius_mm {
+        return out * v.norm().max(300.0);
     }
-    let speed = v.norm();
-    let ahead = p + v * (speed / (2.0 * accel_mm_s2.max(1.0)) + 0.1);
-    let grown = radius_mm + margin_mm;
-    let normal = defense_normal(field, p, grown).or_else(|| defense_normal(field, ahead, grown));
-    match normal {
-        Some(n) if v.dot(&n) < 0.0 => v - n * v.dot(&n),
-        _ => v,
+    let room = distance - radius_mm - margin_mm;
+    let allowed = if room > 0.0 {
+        (accel_mm_s2.max(1.0) * room).sqrt()
+    } else {
+        3.0 * room
+    };
+    let toward = -v.dot(&out);
+    if -now.dot(&out) > allowed {
+        // Braking: along the area as it moves now, toward it at no more than allowed.
+        let along = now - out * now.dot(&out);
+        return along - out * toward.min(allowed);
+    }
+    if toward > allowed {
+        v + out * (toward - allowed)
+    } else {
+        v
     }
 }
 
-/// `p` moved out of the defense areas grown by `margin_mm` and into the playing area less
-/// `wall_mm`.
+/// Whether the body may stand at `p`: clear of the defense areas by `margin_mm` (centre to
+/// area) and `wall_mm` in from the field walls, as [`allowed_point`] keeps it.
+pub fn may_stand(field: &FieldMap, p: Point2<f64>, margin_mm: f64, wall_mm: f64) -> bool {
+    (allowed_point(field, p, margin_mm, wall_mm) - p).norm() < 1.0
+}
+
+/// How much nearer a defense area or a wall than a new approach may come the approach under way
+/// may, mm.
+const HOLD_SLACK_MM: f64 = 40.0;
+
+/// How the robot takes the ball from behind: the direction the ball is to leave in (world
+/// frame, unit) and how far from the ball's centre it lines up first, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Approach {
+    /// The direction the ball is to leave in.
+    pub toward: Vector2<f64>,
+    /// Ball centre to the point it lines up at, mm.
+    pub standoff_mm: f64,
+    /// Room from the body's centre to the defense areas it keeps on the way, mm.
+    pub margin_mm: f64,
+}
+
+/// The approach closest to `preferred`: `preferred` itself when the robot can stand behind the
+/// ball (at `standoff_mm` and at `contact_mm` from its centre, both where [`may_stand`]
+/// allows with `margins_mm[0]` from the defense areas), else `preferred` turned by the least
+/// multiple of 15 degrees that makes it so (the side whose standing point is nearer `robot`
+/// first); where no direction fits (a ball in a corner of the floor and a defense area), the
+/// same with the robot lining up nearer the ball, halfway and then 60 mm beyond contact; and
+/// where none of those fits either (a ball right by an area's line), the same again keeping
+/// only `margins_mm[1]` from the areas; `None` when nothing fits. `previous` is kept while it fits within
+/// [`HOLD_SLACK_MM`] and turns at most 20 degrees more than the best. The robot then turns
+/// with the ball on its dribbler.
+#[allow(clippy::too_many_arguments)]
+pub fn approach_direction(
+    field: &FieldMap,
+    ball: Point2<f64>,
+    robot: Point2<f64>,
+    preferred: Vector2<f64>,
+    previous: Option<Approach>,
+    [contact_mm, standoff_mm]: [f64; 2],
+    margins_mm: [f64; 2],
+    wall_mm: f64,
+) -> Option<Approach> {
+    let fits_by = |a: &Approach, slack_mm: f64| {
+        [contact_mm, a.standoff_mm].iter().all(|&d| {
+            may_stand(
+                field,
+                ball - a.toward * d,
+                a.margin_mm - slack_mm,
+                wall_mm - slack_mm,
+            )
+        })
+    };
+    let fits = |a: &Approach| fits_by(a, 0.0);
+    let off = |t: Vector2<f64>| wrap(t.y.atan2(t.x) - preferred.y.atan2(preferred.x)).abs();
+    let standoffs = [
+        standoff_mm,
+        0.5 * (contact_mm + standoff_mm),
+        contact_mm + 60.0,
+    ];
+    let candidates = margins_mm.into_iter().flat_map(|margin_mm| {
+        standoffs.into_iter().flat_map(move |standoff_mm| {
+            (0..=12).flat_map(move |k| {
+                let turn = (k as f64 * 15.0).to_radians();
+                let mut pair = [turn, -turn].map(|a| Approach {
+                    toward: Rotation2::new(a) * preferred,
+                    standoff_mm,
+                    margin_mm,
+                });
+                let nearness = |a: &Approach| (ball - a.toward * a.standoff_mm - robot).norm();
+                pair.sort_by(|a, b| nearness(a).total_cmp(&nearness(b)));
+                pair
+            })
+        })
+    });
+    let best = candidates.into_iter().find(|a| fits(a))?;
+    // The ball's estimate moves a little from frame to frame: the approach under way is kept
+    // while it fits within HOLD_SLACK_MM, lines up no farther and keeps no more room than the
+    // best, and turns little more.
+    match previous {
+        Some(p)
+            if fits_by(&p, HOLD_SLACK_MM)
+                && p.standoff_mm <= best.standoff_mm + 1e-9
+                && p.margin_mm <= best.margin_mm + 1e-9
+                && off(p.toward) <= off(best.toward) + 20f64.to_radians() =>
+        {
+            Some(p)
+        }
+        _ => Some(best),
+    }
+}
+
+/// `p` moved out of the defense areas grown by `margin_mm` and onto the floor `wall_mm` in
+/// from the field walls (the run-off is floor).
 pub fn allowed_point(
     field: &FieldMap,
     p: Point2<f64>,
     margin_mm: f64,
     wall_mm: f64,
 ) -> Point2<f64> {
-    let mut q = Point2::new(
-        p.x.clamp(
-            -field.half_length_mm + wall_mm,
-            field.half_length_mm - wall_mm,
-        ),
-        p.y.clamp(
-            -field.half_width_mm + wall_mm,
-            field.half_width_mm - wall_mm,
-        ),
-    );
-    if let Some(n) = defense_normal(field, q, margin_mm) {
-        let front = field.half_length_mm - field.defense_depth_mm - margin_mm;
-        let side = 0.5 * field.defense_width_mm + margin_mm;
-        if n.x != 0.0 {
-            q.x = q.x.signum() * front;
-        } else {
-            q.y = q.y.signum() * side;
-        }
+    let [x, y] =
+        [field.half_length_mm, field.half_width_mm].map(|h| h + field.run_off_mm - wall_mm);
+    let q = Point2::new(p.x.clamp(-x, x), p.y.clamp(-y, y));
+    match defense_clearance(field, q) {
+        // Out along the way out, to the margin (inside, through the nearest side).
+        Some((d, out)) if d < margin_mm => q + out * (margin_mm - d),
+        _ => q,
     }
-    q
 }
 
 /// The point of the goal mouth at `goal` (its centre; mouth along y, `width_mm` wide) to shoot
@@ -215,6 +336,7 @@ mod tests {
             goal_width_mm: 700.0,
             defense_depth_mm: 800.0,
             defense_width_mm: 2000.0,
+            run_off_mm: 300.0,
         }
     }
 
@@ -232,26 +354,113 @@ mod tests {
     }
 
     #[test]
-    fn a_command_into_the_defense_area_slides_along_it() {
+    fn a_command_into_the_defense_area_slows_to_stop_short_of_it() {
         let f = field();
+        let (r, margin, accel) = (90.0, 60.0, 2000.0);
+        let still = Vector2::zeros();
+        // 200 mm from the front line at x = 1200: 50 mm of room beyond body and margin, so
+        // no faster toward it than stops in half that at the body's acceleration.
         let p = Point2::new(1000.0, 0.0);
-        let v = keep_out(&f, p, Vector2::new(1000.0, 0.0), 90.0, 60.0, 2000.0);
-        assert!(v.x <= 1e-9, "{v}");
+        let v = keep_out(
+            &f,
+            p,
+            [Vector2::new(1000.0, 300.0), still],
+            r,
+            margin,
+            accel,
+        );
+        assert!(
+            v.x > 0.0 && v.x * v.x / (2.0 * accel) <= 0.5 * 50.0 + 1e-9,
+            "{v}"
+        );
+        assert_eq!(v.y, 300.0, "along the line untouched");
         // Far enough to stop before the line: left alone.
         let far = keep_out(
             &f,
             Point2::origin(),
-            Vector2::new(1000.0, 0.0),
-            90.0,
-            60.0,
-            2000.0,
+            [Vector2::new(1000.0, 0.0), still],
+            r,
+            margin,
+            accel,
         );
         assert_eq!(far, Vector2::new(1000.0, 0.0));
+        // Already coming too fast: the command keeps the present speed along the line, so the
+        // whole acceleration brakes, whatever was asked along it.
+        let now = Vector2::new(1000.0, -800.0);
+        let b = keep_out(&f, p, [Vector2::new(800.0, 900.0), now], r, margin, accel);
+        assert_eq!(b.y, -800.0, "{b}");
+        assert!(b.x < 400.0, "{b}");
+        // Near a corner the way out is from the corner.
+        let c = Point2::new(1100.0, 1120.0);
+        let (d, out) = defense_clearance(&f, c).unwrap();
+        assert!((d - (100.0f64).hypot(120.0)).abs() < 1e-9 && out.x < 0.0 && out.y > 0.0);
         let over = Point2::new(1150.0, 0.0);
-        let inside = keep_out(&f, over, Vector2::new(500.0, 0.0), 90.0, 60.0, 2000.0);
+        let inside = keep_out(
+            &f,
+            over,
+            [Vector2::new(500.0, 0.0), still],
+            r,
+            margin,
+            accel,
+        );
         assert!(inside.x < 0.0, "the body over the line leaves");
         let q = allowed_point(&f, Point2::new(1900.0, 100.0), 150.0, 100.0);
         assert!(!f.in_defense_area(q, 149.0), "{q}");
+    }
+
+    #[test]
+    fn a_ball_by_the_defense_area_is_taken_from_the_side_it_can_be_reached_from() {
+        let f = field();
+        let goal = Vector2::new(1.0, 0.0);
+        let robot = Point2::new(0.0, 0.0);
+        let dims = [81.5, 356.5];
+        // In the open: straight at the goal.
+        let open = approach_direction(
+            &f,
+            Point2::new(0.0, 300.0),
+            robot,
+            goal,
+            None,
+            dims,
+            [150.0, 105.0],
+            90.0,
+        )
+        .unwrap();
+        assert_eq!(open.toward, goal);
+        assert_eq!(open.margin_mm, 150.0);
+        assert_eq!(open.standoff_mm, dims[1]);
+        // 100 mm in front of the -x area: behind it is inside the area, so another side.
+        let ball = Point2::new(-1100.0, 300.0);
+        let a =
+            approach_direction(&f, ball, robot, goal, None, dims, [150.0, 105.0], 90.0).unwrap();
+        assert_ne!(a.toward, goal);
+        for d in [dims[0], a.standoff_mm] {
+            assert!(may_stand(&f, ball - a.toward * d, 150.0, 90.0), "{a:?}");
+        }
+        assert_eq!(a.margin_mm, 150.0);
+        // 60 mm from the line: reached from the field side only, keeping the lesser room.
+        let by_line = Point2::new(-1140.0, -513.0);
+        let a =
+            approach_direction(&f, by_line, robot, goal, None, dims, [150.0, 105.0], 90.0).unwrap();
+        assert_eq!(a.margin_mm, 105.0, "{a:?}");
+        assert!(a.toward.x < -0.5, "{a:?}");
+        for d in [dims[0], a.standoff_mm] {
+            assert!(may_stand(&f, by_line - a.toward * d, 105.0, 90.0), "{a:?}");
+        }
+        // 10 mm from the line: out of reach from outside the area.
+        let at_line = Point2::new(-1190.0, 0.0);
+        assert!(
+            approach_direction(&f, at_line, robot, goal, None, dims, [150.0, 105.0], 90.0)
+                .is_none()
+        );
+        // Behind the goal line by the wall (walls at x = 2300): no room to line up far off.
+        let tight = Point2::new(2221.0, 813.0);
+        let a =
+            approach_direction(&f, tight, robot, goal, None, dims, [150.0, 105.0], 105.0).unwrap();
+        assert!(a.standoff_mm < dims[1], "{a:?}");
+        for d in [dims[0], a.standoff_mm] {
+            assert!(may_stand(&f, tight - a.toward * d, 150.0, 105.0), "{a:?}");
+        }
     }
 
     #[test]

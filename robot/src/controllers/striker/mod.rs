@@ -19,8 +19,11 @@ use crate::controller::{
 };
 use crate::perception::ball::BallEstimate;
 use crate::perception::goal::GoalsSeen;
-use geometry::{allowed_point, approach_point, intercept_point, keep_out, open_aim, unit, wrap};
-use nalgebra::{Isometry2, Point2};
+use geometry::{
+    Approach, allowed_point, approach_direction, approach_point, intercept_point, keep_out,
+    open_aim, unit, wrap,
+};
+use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop_problem::{Problem, Problems};
 use omniloop_vision::FreeSpace;
 use serde::{Deserialize, Serialize};
@@ -43,6 +46,21 @@ pub const ENTRY: ControllerEntry = ControllerEntry {
     check_use,
     build: |c| Ok(Box::new(Striker::new(c, settings(c, TABLE)?))),
 };
+
+/// Longest it moves onto the ball before it backs off to see it again, s.
+const CAPTURE_S: f64 = 2.5;
+
+/// How long it backs off, s.
+const BACK_OFF_S: f64 = 1.0;
+
+/// The least room it keeps from a defense area to reach a ball beside it, mm.
+const CLOSEST_MM: f64 = 15.0;
+
+/// Room kept between the body and the field walls, mm.
+const WALL_ROOM_MM: f64 = 15.0;
+
+/// How much farther than its margin from a defense area it waits while the ball lies inside.
+const WAIT_ROOM_MM: f64 = 250.0;
 
 /// Its settings table, `[control.striker]`.
 const TABLE: &str = "striker";
@@ -168,6 +186,17 @@ pub struct Striker {
     search: usize,
     /// The point of the goal it aims at, once it holds the ball.
     aim: Option<Point2<f64>>,
+    /// Since when it has been moving onto the ball, s.
+    capture_since_s: Option<f64>,
+    /// Until when it backs off from a capture that went wrong, s.
+    back_off_until_s: f64,
+    /// Room it keeps from the defense areas beyond the body this cycle, mm: the configured
+    /// margin, less where a ball by an area can only be reached so.
+    margin_mm: f64,
+    /// Its velocity this cycle as odometry measures it, body frame, mm/s.
+    velocity_mm_s: Vector2<f64>,
+    /// The direction it is taking the ball in (world frame), while it goes for it.
+    approach: Option<Approach>,
     /// The actuator commands of this cycle.
     commands: Vec<ActuatorCommand>,
 }
@@ -194,6 +223,11 @@ impl Striker {
             captured_at: None,
             search: 0,
             aim: None,
+            capture_since_s: None,
+            back_off_until_s: f64::NEG_INFINITY,
+            margin_mm: config.defense_margin_mm,
+            velocity_mm_s: Vector2::zeros(),
+            approach: None,
             commands: Vec::new(),
         }
     }
@@ -236,8 +270,8 @@ impl Striker {
             Some(f) => allowed_point(
                 f,
                 target,
-                self.radius_mm + self.config.defense_margin_mm,
-                self.radius_mm,
+                self.radius_mm + self.margin_mm,
+                self.radius_mm + WALL_ROOM_MM,
             ),
             None => target,
         };
@@ -246,22 +280,29 @@ impl Striker {
             .min(self.max_speed_mm_s)
             .min((2.0 * 0.8 * self.accel_mm_s2 * d.norm()).sqrt())
             .min(4.0 * d.norm());
-        let mut v = unit(d) * speed;
-        if let Some(f) = &self.field {
-            v = keep_out(
-                f,
-                here,
-                v,
-                self.radius_mm,
-                self.config.defense_margin_mm,
-                self.accel_mm_s2,
-            );
-        }
+        let v = pose.rotation.inverse() * (unit(d) * speed);
         let err = wrap(heading - pose.rotation.angle());
         BodyCommand {
-            v_mm_s: pose.rotation.inverse() * v,
+            v_mm_s: self.kept_out(pose, v),
             omega_rad_s: (4.0 * err).clamp(-4.0, 4.0),
         }
+    }
+
+    /// `v` (body frame) kept out of the defense areas (see [`keep_out`]).
+    fn kept_out(&self, pose: &Isometry2<f64>, v: Vector2<f64>) -> Vector2<f64> {
+        let Some(f) = &self.field else {
+            return v;
+        };
+        let here = Point2::from(pose.translation.vector);
+        let world = keep_out(
+            f,
+            here,
+            [pose.rotation * v, pose.rotation * self.velocity_mm_s],
+            self.radius_mm,
+            self.margin_mm,
+            self.accel_mm_s2,
+        );
+        pose.rotation.inverse() * world
     }
 
     /// With the ball on the dribbler: stop (grab), or turn to the open goal and kick.
@@ -274,7 +315,10 @@ impl Striker {
         });
         // Slow down gently: a sudden stop pulls the ball off the dribbler.
         let v = s.velocity_body_mm_s;
-        let slowed = v * (1.0 - 1000.0 * 0.05 / v.norm().max(1e-9)).max(0.0);
+        let slowed = self.kept_out(
+            pose,
+            v * (1.0 - 1000.0 * 0.05 / v.norm().max(1e-9)).max(0.0),
+        );
         if self.config.task == Task::Grab {
             return BodyCommand::translate(slowed);
         }
@@ -327,7 +371,7 @@ impl Striker {
     }
 
     /// With the ball known and not held: meet it if it rolls, else go behind it and onto it.
-    fn chase(&mut self, pose: &Isometry2<f64>, ball: &BallEstimate) -> BodyCommand {
+    fn chase(&mut self, pose: &Isometry2<f64>, ball: &BallEstimate, t_s: f64) -> BodyCommand {
         let here = Point2::from(pose.translation.vector);
         let b = pose * ball.body_mm;
         let v = pose.rotation * ball.velocity_body_mm_s;
@@ -337,13 +381,10 @@ impl Striker {
                 rpm: self.config.dribbler_rpm,
             });
         }
-        if self
-            .field
-            .is_some_and(|f| f.in_defense_area(b, self.ball_radius_mm))
-        {
-            // Out of reach by the rules: wait outside, facing it.
-            let heading = unit(b - here);
-            return self.go(pose, b, heading.y.atan2(heading.x), self.config.speed_mm_s);
+        // Wholly inside a defense area: out of reach by the rules.
+        let r = self.ball_radius_mm;
+        if let Some(f) = self.field.filter(|f| f.in_defense_area(b, -r)) {
+            return self.wait_outside(pose, &f, b);
         }
         if v.norm() > 500.0 && v.dot(&(here - b)) > 0.0 {
             let meet = intercept_point(
@@ -362,20 +403,61 @@ impl Striker {
                 self.config.speed_mm_s,
             );
         }
-        let toward = match (self.config.task, &self.field) {
+        let preferred = match (self.config.task, &self.field) {
             (Task::Score, Some(f)) => unit(f.goal_centre(self.config.attack_side) - b),
             _ => unit(b - here),
         };
+        // Where the goal side of the ball is out of bounds (a ball by a defense area or a
+        // line), it takes the ball from another side and turns with it.
+        let full = Approach {
+            toward: preferred,
+            standoff_mm: contact + self.config.standoff_mm,
+            margin_mm: self.radius_mm + self.config.defense_margin_mm,
+        };
+        let approach = match &self.field {
+            Some(f) => match approach_direction(
+                f,
+                b,
+                here,
+                preferred,
+                self.approach,
+                [contact - 15.0, full.standoff_mm],
+                [full.margin_mm, self.radius_mm + CLOSEST_MM],
+                self.radius_mm + WALL_ROOM_MM,
+            ) {
+                Some(a) => a,
+                // By a defense area and out of reach from outside it.
+                None if f.in_defense_area(b, full.margin_mm) => {
+                    return self.wait_outside(pose, f, b);
+                }
+                None => full,
+            },
+            None => full,
+        };
+        self.approach = Some(approach);
+        self.margin_mm = approach.margin_mm - self.radius_mm;
+        let (toward, standoff) = (approach.toward, approach.standoff_mm);
         let heading = toward.y.atan2(toward.x);
-        let behind = b - toward * (contact + self.config.standoff_mm);
+        let behind = b - toward * standoff;
         let lined_up = (here - behind).norm() < 60.0 || {
             let r = here - b;
             let across = (r - toward * r.dot(&toward)).norm();
             let along = r.dot(&-toward);
-            along > contact && along < contact + self.config.standoff_mm + 60.0 && across < 25.0
+            along > contact && along < standoff + 60.0 && across < 25.0
         };
         let facing = wrap(heading - pose.rotation.angle()).abs() < 10f64.to_radians();
+        // A capture that has not taken the ball in CAPTURE_S went wrong (the ball, hidden by the
+        // body, is not where the tracker holds it): back off to see it again.
+        if t_s < self.back_off_until_s {
+            self.capture_since_s = None;
+            let back = b - toward * (self.blind_radius_mm + 100.0);
+            return self.go(pose, back, heading, self.config.capture_speed_mm_s);
+        }
         if lined_up && facing {
+            let since = *self.capture_since_s.get_or_insert(t_s);
+            if t_s - since > CAPTURE_S {
+                self.back_off_until_s = t_s + BACK_OFF_S;
+            }
             return self.go(
                 pose,
                 b - toward * (contact - 15.0),
@@ -383,9 +465,29 @@ impl Striker {
                 self.config.capture_speed_mm_s,
             );
         }
+        self.capture_since_s = None;
         let clear = (self.radius_mm + self.ball_radius_mm + 80.0).max(self.blind_radius_mm + 60.0);
-        let next = approach_point(here, b, toward, contact + self.config.standoff_mm, clear);
+        let next = approach_point(here, b, toward, standoff, clear);
         self.go(pose, next, heading, self.config.speed_mm_s)
+    }
+
+    /// With the ball out of reach in a defense area: wait facing it, well outside (standing at
+    /// the margin, the pose estimate's error would carry the body over the line in time).
+    fn wait_outside(&self, pose: &Isometry2<f64>, f: &FieldMap, b: Point2<f64>) -> BodyCommand {
+        let here = Point2::from(pose.translation.vector);
+        let heading = unit(b - here);
+        let wait = allowed_point(
+            f,
+            b,
+            self.radius_mm + self.config.defense_margin_mm + WAIT_ROOM_MM,
+            self.radius_mm + WALL_ROOM_MM,
+        );
+        self.go(
+            pose,
+            wait,
+            heading.y.atan2(heading.x),
+            self.config.speed_mm_s,
+        )
     }
 
     /// With no ball known: the search points in turn.
@@ -405,6 +507,8 @@ impl Striker {
 impl Controller for Striker {
     fn decide(&mut self, s: &Situation<'_>) -> BodyCommand {
         self.commands.clear();
+        self.velocity_mm_s = s.velocity_body_mm_s;
+        self.margin_mm = self.config.defense_margin_mm;
         let Some(pose) = s.pose else {
             return BodyCommand::STOP;
         };
@@ -422,8 +526,11 @@ impl Controller for Striker {
         }
         self.captured_at = None;
         self.aim = None;
+        if s.percept::<BallEstimate>().is_none() {
+            self.approach = None;
+        }
         match s.percept::<BallEstimate>() {
-            Some(ball) => self.chase(&pose, ball),
+            Some(ball) => self.chase(&pose, ball, s.t_s),
             None => self.searching(&pose),
         }
     }
