@@ -5,7 +5,7 @@
 use super::trials::{Field, Stage};
 use super::{Block, BlockResult};
 use crate::experiments::replay::write_text;
-use crate::report::topview::{Marker, Panel, PathLayer, draw_panels};
+use crate::report::topview::{Marker, Panel, PathLayer, render_panels};
 use anyhow::Context;
 use nalgebra::Point2;
 use omniloop_sim::{FieldSpec, Layout};
@@ -105,44 +105,69 @@ fn layout_of(field: &Field) -> anyhow::Result<Layout> {
     })
 }
 
-/// Each block's paths: the robots' in blue, the balls' in orange, starts marked.
+/// Each block's paths: the robots' in blue, the balls' in orange, starts marked; a row of
+/// panels for each field (the blocks with latency and blur beside the clean ones).
 fn figure(file: &Path, results: &[BlockResult]) -> anyhow::Result<()> {
     let layouts: Vec<Layout> = results
         .iter()
         .map(|r| layout_of(&r.block.field))
         .collect::<Result<_, _>>()?;
-    let panels: Vec<Panel<'_>> = results
-        .iter()
-        .zip(&layouts)
-        .map(|(r, layout)| Panel {
-            title: block_name(&r.block),
-            layout,
-            paths: r
-                .trials
-                .iter()
-                .flat_map(|t| {
-                    [
-                        path("robot", [40, 90, 200], &t.robot_path),
-                        path("ball", [255, 110, 20], &t.ball_path),
-                    ]
-                })
-                .collect(),
-            markers: r
-                .trials
-                .iter()
-                .filter_map(|t| t.ball_path.first())
-                .map(|&at| Marker {
-                    at,
-                    radius_mm: 21.5,
-                    rgb: [255, 110, 20],
-                    label: String::new(),
-                })
-                .collect(),
-            spots: Vec::new(),
-            grid: None,
-        })
-        .collect();
-    draw_panels(file, &panels, 420).map_err(anyhow::Error::from)
+    let mut fields: Vec<&'static str> = results.iter().map(|r| r.block.field.preset).collect();
+    fields.dedup();
+    let mut rows = Vec::new();
+    for preset in fields {
+        let panels: Vec<Panel<'_>> = results
+            .iter()
+            .zip(&layouts)
+            .filter(|(r, _)| r.block.field.preset == preset)
+            .map(|(r, layout)| panel(r, layout))
+            .collect();
+        let name = file.display().to_string();
+        rows.push(render_panels(&name, &panels, 420)?);
+    }
+    let width = rows.iter().map(|r| r.width()).max().unwrap_or(1);
+    let height = rows.iter().map(|r| r.height()).sum::<u32>().max(1);
+    let mut img = image::RgbImage::from_pixel(width, height, image::Rgb([255, 255, 255]));
+    let mut y = 0;
+    for row in &rows {
+        image::imageops::replace(&mut img, row, 0, i64::from(y));
+        y += row.height();
+    }
+    img.save(file)
+        .with_context(|| format!("writing {}", file.display()))
+}
+
+/// One block's panel: every trial's paths, the first of each kind in the legend.
+fn panel<'a>(r: &'a BlockResult, layout: &'a Layout) -> Panel<'a> {
+    let label = |k: usize, name: &'static str| if k == 0 { name } else { "" };
+    Panel {
+        title: block_name(&r.block),
+        layout,
+        paths: r
+            .trials
+            .iter()
+            .enumerate()
+            .flat_map(|(k, t)| {
+                [
+                    path(label(k, "robot"), [40, 90, 200], &t.robot_path),
+                    path(label(k, "ball"), [255, 110, 20], &t.ball_path),
+                ]
+            })
+            .collect(),
+        markers: r
+            .trials
+            .iter()
+            .filter_map(|t| t.ball_path.first())
+            .map(|&at| Marker {
+                at,
+                radius_mm: 21.5,
+                rgb: [255, 110, 20],
+                label: String::new(),
+            })
+            .collect(),
+        spots: Vec::new(),
+        grid: None,
+    }
 }
 
 /// A path layer.

@@ -104,7 +104,7 @@ impl Watch {
         let attacked =
             ball.position_mm.x > 0.0 && self.field.in_defense_area(ball.position_mm, 0.0);
         s.ball_in_defense_area |= attacked;
-        s.robot_in_defense_area |= self.field.in_defense_area(robot, ROBOT_RADIUS_MM);
+        s.robot_in_defense_area |= self.field.body_touches_defense_area(robot, ROBOT_RADIUS_MM);
         let holding = world.ball_holder() == Some(0);
         let still = truth.velocity_mm_s.norm() < 20.0;
         self.standing_since = match (holding && still, self.standing_since) {

@@ -17,6 +17,7 @@
 //! at the dribbler's touch or after 10 s (the 2019 rules' time).
 
 use nalgebra::{Point2, Vector2};
+use omniloop_sim::{FieldPreset, FieldSpec};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use std::f64::consts::PI;
@@ -86,6 +87,8 @@ impl Stage {
 pub struct Field {
     /// The preset's name (`[world.field] preset`).
     pub preset: &'static str,
+    /// The preset.
+    pub kind: FieldPreset,
     /// Half length to the goal lines, mm.
     pub half_length_mm: f64,
     /// Half width, mm.
@@ -99,6 +102,7 @@ pub struct Field {
 /// The challenge's remote field: 4 m x 3 m, a 0.7 m goal, a 0.8 m x 2 m defense area.
 pub const HARDWARE_CHALLENGE: Field = Field {
     preset: "hardware_challenge",
+    kind: FieldPreset::HardwareChallenge,
     half_length_mm: 2000.0,
     half_width_mm: 1500.0,
     goal_width_mm: 700.0,
@@ -108,6 +112,7 @@ pub const HARDWARE_CHALLENGE: Field = Field {
 /// Division B's field: 9 m x 6 m, 1 m goals, 1 m x 2 m defense areas.
 pub const DIVISION_B: Field = Field {
     preset: "division_b",
+    kind: FieldPreset::DivisionB,
     half_length_mm: 4500.0,
     half_width_mm: 3000.0,
     goal_width_mm: 1000.0,
@@ -121,6 +126,17 @@ impl Field {
         p.x.abs() >= self.half_length_mm - self.defense_mm[0] - margin_mm
             && p.x.abs() <= self.half_length_mm + margin_mm
             && p.y.abs() <= 0.5 * self.defense_mm[1] + margin_mm
+    }
+
+    /// Whether a body of radius `radius_mm` centred at `p` touches a defense area (its lines
+    /// included): the distance from `p` to the area below the radius, round the corners.
+    pub fn body_touches_defense_area(&self, p: Point2<f64>, radius_mm: f64) -> bool {
+        let [depth, width] = self.defense_mm;
+        let x =
+            p.x.abs()
+                .clamp(self.half_length_mm - depth, self.half_length_mm);
+        let y = p.y.clamp(-0.5 * width, 0.5 * width);
+        (p - Point2::new(p.x.signum() * x, y)).norm() < radius_mm
     }
 
     /// Whether `p` lies on the field `margin_mm` in from its lines.
@@ -239,8 +255,9 @@ fn moving_ball(rng: &mut StdRng, field: &Field) -> Placement {
 
 /// The scenario of one trial: the field, the ball, the defender, and E1's robot (its
 /// 256 x 220 hyperbolic camera with E1's noise, wheel odometry with the noise of
-/// `ssl_teams.toml`, the league's kicker) playing the striker; `realism` adds rows to
-/// `[robot]` (E1's latency and blur tables).
+/// `ssl_teams.toml`, the league's kicker) playing the striker, its pose from odometry
+/// corrected by floor-region self-localization (E2) on the field's floor outline; `realism`
+/// adds rows to `[robot]` (E1's latency and blur tables).
 pub fn scenario_text(
     stage: Stage,
     field: &Field,
@@ -293,8 +310,14 @@ pub fn scenario_text(
     s += "[robot.sensors.hyperbolic]\na_mm = 12.129\nb_mm = 15.650\nc_mm = 19.8\n\
           focal_px = 479.37\nfocus_height_mm = 205.08\nrim_radius_mm = 30.0\n\n\
           [odometry]\nspeed_noise_frac = 0.03\nscale_bias_frac = 0.04\nomega_bias_rad_s = 0.01\n\n\
-          [control]\nkind = \"striker\"\n\n[control.striker]\n";
+          [control]\nkind = \"striker\"\npose_source = \"localization\"\n\n[control.striker]\n";
     s += &format!("task = \"{task}\"\n");
+    let o = FieldSpec::from(field.kind).floor_outline();
+    s += &format!(
+        "\n[vision.localization.field]\na1_mm = {:?}\na2_mm = {:?}\nb_mm = {:?}\n\
+         goal_half_width_mm = {:?}\nboundary_line_mm = {:?}\n",
+        o.a1_mm, o.a2_mm, o.b_mm, o.goal_half_width_mm, o.boundary_line_mm
+    );
     s
 }
 
@@ -332,6 +355,21 @@ mod tests {
             place(Stage::Grab, &HARDWARE_CHALLENGE, 1),
             place(Stage::Grab, &HARDWARE_CHALLENGE, 2)
         );
+    }
+
+    #[test]
+    fn a_body_touches_the_defense_area_by_its_distance_round_the_corner() {
+        let f = HARDWARE_CHALLENGE;
+        // The +x area's corner at (1200, 1000): 92.7 mm off diagonally, clear of a 90 mm body
+        // though inside the area's rectangle grown by 90 mm.
+        let p = Point2::new(1115.0, 1037.0);
+        assert!(f.in_defense_area(p, ROBOT_RADIUS_MM));
+        assert!(!f.body_touches_defense_area(p, ROBOT_RADIUS_MM));
+        assert!(f.body_touches_defense_area(Point2::new(1125.0, 1030.0), ROBOT_RADIUS_MM));
+        // Straight in front of the line, and at the -x area.
+        assert!(f.body_touches_defense_area(Point2::new(1111.0, 0.0), ROBOT_RADIUS_MM));
+        assert!(!f.body_touches_defense_area(Point2::new(-1109.0, 0.0), ROBOT_RADIUS_MM));
+        assert!(f.body_touches_defense_area(Point2::new(-1500.0, -200.0), ROBOT_RADIUS_MM));
     }
 }
 
