@@ -387,52 +387,13 @@ impl Striker {
             return self.wait_outside(pose, &f, b);
         }
         if v.norm() > 500.0 && v.dot(&(here - b)) > 0.0 {
-            let meet = intercept_point(
-                here,
-                b,
-                v,
-                self.roll_decel_mm_s2,
-                0.7 * self.max_speed_mm_s,
-                0.3,
-            );
-            let face = -unit(v);
-            return self.go(
-                pose,
-                meet - face * contact,
-                face.y.atan2(face.x),
-                self.config.speed_mm_s,
-            );
+            return self.meet(pose, b, v);
         }
-        let preferred = match (self.config.task, &self.field) {
-            (Task::Score, Some(f)) => unit(f.goal_centre(self.config.attack_side) - b),
-            _ => unit(b - here),
-        };
-        // Where the goal side of the ball is out of bounds (a ball by a defense area or a
-        // line), it takes the ball from another side and turns with it.
-        let full = Approach {
-            toward: preferred,
-            standoff_mm: contact + self.config.standoff_mm,
-            margin_mm: self.radius_mm + self.config.defense_margin_mm,
-        };
-        let approach = match &self.field {
-            Some(f) => match approach_direction(
-                f,
-                b,
-                here,
-                preferred,
-                self.approach,
-                [contact - 15.0, full.standoff_mm],
-                [full.margin_mm, self.radius_mm + CLOSEST_MM],
-                self.radius_mm + WALL_ROOM_MM,
-            ) {
-                Some(a) => a,
-                // By a defense area and out of reach from outside it.
-                None if f.in_defense_area(b, full.margin_mm) => {
-                    return self.wait_outside(pose, f, b);
-                }
-                None => full,
-            },
-            None => full,
+        let Some(approach) = self.approach_to(here, b) else {
+            return match &self.field {
+                Some(f) => self.wait_outside(pose, f, b),
+                None => BodyCommand::STOP,
+            };
         };
         self.approach = Some(approach);
         self.margin_mm = approach.margin_mm - self.radius_mm;
@@ -469,6 +430,62 @@ impl Striker {
         let clear = (self.radius_mm + self.ball_radius_mm + 80.0).max(self.blind_radius_mm + 60.0);
         let next = approach_point(here, b, toward, standoff, clear);
         self.go(pose, next, heading, self.config.speed_mm_s)
+    }
+
+    /// A ball rolling at `v` toward the robot, met on its predicted path facing it.
+    fn meet(&self, pose: &Isometry2<f64>, b: Point2<f64>, v: Vector2<f64>) -> BodyCommand {
+        let here = Point2::from(pose.translation.vector);
+        let meet = intercept_point(
+            here,
+            b,
+            v,
+            self.roll_decel_mm_s2,
+            0.7 * self.max_speed_mm_s,
+            0.3,
+        );
+        let face = -unit(v);
+        let contact = self.front_mm + self.ball_radius_mm;
+        self.go(
+            pose,
+            meet - face * contact,
+            face.y.atan2(face.x),
+            self.config.speed_mm_s,
+        )
+    }
+
+    /// How to take the ball at `b` from `here`: from behind it facing the goal (grab: facing
+    /// it), or, where that side is out of bounds (a ball by a defense area or a line), from
+    /// another side, turning with it after; `None` for a ball by a defense area that cannot
+    /// be reached from outside it.
+    fn approach_to(&self, here: Point2<f64>, b: Point2<f64>) -> Option<Approach> {
+        let contact = self.front_mm + self.ball_radius_mm;
+        let preferred = match (self.config.task, &self.field) {
+            (Task::Score, Some(f)) => unit(f.goal_centre(self.config.attack_side) - b),
+            _ => unit(b - here),
+        };
+        let full = Approach {
+            toward: preferred,
+            standoff_mm: contact + self.config.standoff_mm,
+            margin_mm: self.radius_mm + self.config.defense_margin_mm,
+        };
+        let Some(f) = &self.field else {
+            return Some(full);
+        };
+        let found = approach_direction(
+            f,
+            b,
+            here,
+            preferred,
+            self.approach,
+            [contact - 15.0, full.standoff_mm],
+            [full.margin_mm, self.radius_mm + CLOSEST_MM],
+            self.radius_mm + WALL_ROOM_MM,
+        );
+        match found {
+            None if f.in_defense_area(b, full.margin_mm) => None,
+            None => Some(full),
+            a => a,
+        }
     }
 
     /// With the ball out of reach in a defense area: wait facing it, well outside (standing at
