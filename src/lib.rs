@@ -30,6 +30,7 @@ pub mod report;
 pub mod robustness;
 pub mod run;
 pub mod scenario;
+pub mod ssl;
 pub mod sweep;
 pub mod viewing;
 
