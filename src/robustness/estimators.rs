@@ -289,7 +289,7 @@ mod tests {
     }
 
     #[test]
-    fn each_estimator_reads_its_experiments_metrics() {
+    fn the_heading_estimator_reads_the_rotations() {
         let turn = |max: f64, na_frames| RotationResult {
             true_deg: 60.0,
             median_deg: Some(60.0),
@@ -309,7 +309,10 @@ mod tests {
         let s = score("heading", &heading).unwrap();
         assert_eq!(s.error, 1.5);
         assert_eq!(s.missed.as_deref(), Some("over 1 degree; 3 readings N/A"));
+    }
 
+    #[test]
+    fn the_omnistereo_estimators_read_ranges_and_trilateration() {
         let omnistereo = OmnistereoMetrics {
             range_error_pct: RangeStats {
                 stats: stats(0.8, 3.5),
@@ -327,7 +330,10 @@ mod tests {
         let s = score("trilateration", &omnistereo).unwrap();
         assert_eq!(s.error, 50.0);
         assert_eq!(s.missed.as_deref(), Some("median over 40 mm"));
+    }
 
+    #[test]
+    fn the_resection_estimator_reads_its_places() {
         let place = |place_cm: [f64; 2], error_cm: Option<f64>| resection::PlaceResult {
             place_cm,
             true_cm: place_cm,
@@ -342,7 +348,10 @@ mod tests {
         let s = score("resection", &ResectionMetrics::new("pan", &located)).unwrap();
         assert_eq!(s.error, 1.5);
         assert_eq!(s.missed.as_deref(), Some("1 of 2 places located"));
+    }
 
+    #[test]
+    fn the_floor_localization_estimator_reads_its_places() {
         let at = |rms_position_mm| PlaceResult {
             true_pose: [0.0, 0.0, 0.0],
             rms_position_mm,
@@ -361,7 +370,10 @@ mod tests {
         let s = score("floor_localization", &places).unwrap();
         assert!(s.meets());
         assert_eq!(s.error, 21.0);
+    }
 
+    #[test]
+    fn the_odometry_estimators_read_the_forward_moves() {
         let step = |kind: &str, commanded, truth, scanline_deg, lk_mm| MoveResult {
             kind: kind.into(),
             commanded,
@@ -385,7 +397,10 @@ mod tests {
         let s = score("odometry_legs", &forward).unwrap();
         assert_eq!(s.error, 10.0);
         assert_eq!(s.missed.as_deref(), Some("over 7.2%"));
+    }
 
+    #[test]
+    fn the_ball_estimator_reads_the_ball_map() {
         let within = Rates {
             frames: 20,
             detected: 18,
