@@ -344,6 +344,15 @@ impl Simulation {
         self.world.place_robot(0, pose);
     }
 
+    /// Puts robot `k` of the team (in [`Simulation::robots`]' order) at `pose`, at rest, and
+    /// tells its software that it was carried (its pose is unknown until it finds it again).
+    pub fn carry_robot(&mut self, k: usize, pose: Isometry2<f64>) {
+        if let Some(a) = self.agents.get_mut(k) {
+            self.world.place_robot(a.body(), pose);
+            a.software_mut().forget_pose();
+        }
+    }
+
     /// One control cycle: the cameras see ([`Simulation::sense`]), then the robots' software
     /// decides and the world moves on ([`Simulation::act`]).
     pub fn step(&mut self) -> Result<(), RunError> {

@@ -1,6 +1,7 @@
 //! The scenario layer: the schema of a scenario file ([`schema`]), the rules it must satisfy
 //! ([`rules`], with the [`check`] types that name a field at fault), parsing with located
-//! problems ([`parse`]), and the traced calibration of its mirror cameras ([`calibrate`]).
+//! problems ([`parse`]), the Small-Size simulator's table ([`ssl`]), and the traced
+//! calibration of its mirror cameras ([`calibrate`]).
 //! It knows nothing of running: everything above imports it.
 
 pub mod calibrate;
@@ -8,6 +9,7 @@ pub mod check;
 pub mod parse;
 pub mod rules;
 pub mod schema;
+pub mod ssl;
 pub mod team;
 
 pub use check::{FieldPath, Location, PathSeg, PoseChecks, Problem, Problems};

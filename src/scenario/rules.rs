@@ -25,6 +25,9 @@ pub fn validate(s: &Scenario) -> Vec<Problem> {
     check_ball(&mut c, s);
     check_goal(&mut c, s);
     check_software(&mut c, s);
+    if let Some(ssl) = &s.ssl {
+        c.extend(ssl.check(s).into_vec());
+    }
     if let Some(g) = &s.goal {
         for (k, wp) in g.waypoints_mm.iter().enumerate() {
             if !in_floor(&s.world, Point2::new(wp[0], wp[1])) {

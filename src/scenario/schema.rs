@@ -95,6 +95,10 @@ pub struct Scenario {
     /// until the goal or the time is up.
     #[serde(default, skip_serializing_if = "Tables::is_empty")]
     pub experiment: Tables,
+    /// The scenario as a Small-Size League simulator (`omniloop ssl`): teams, ports, overhead
+    /// vision, referee. Other commands ignore it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ssl: Option<super::ssl::SslSpec>,
 }
 
 fn default_seed() -> u64 {

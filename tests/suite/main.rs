@@ -30,6 +30,7 @@ mod resection;
 mod robustness;
 mod selfloc;
 mod session;
+mod ssl;
 mod sweep;
 mod teams;
 mod timing;

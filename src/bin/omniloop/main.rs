@@ -14,6 +14,7 @@ mod dataset;
 mod render;
 mod replay;
 mod run;
+mod ssl;
 mod sweep;
 
 #[derive(Parser)]
@@ -42,6 +43,10 @@ enum Command {
     /// Write frames of a camera with their truth (depth, labels, poses) and the camera model,
     /// for training and evaluating perception (docs/truth.md).
     Dataset(dataset::DatasetArgs),
+    /// Serve a scenario as a Small-Size League simulator: a team's AI drives the robots over
+    /// the SSL simulation protocol and gets ssl-vision's and the referee's packets, while
+    /// every robot's cameras are rendered (docs/ssl.md).
+    Ssl(ssl::SslArgs),
     /// Trace a mirror sensor's image-to-floor map r = f(R) and write it for the vision crate;
     /// with --format, fit a standard camera model to its rays and write that tool's file.
     Calibrate(calibrate::CalibrateArgs),
@@ -102,6 +107,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sweep(args) => sweep::sweep_cmd(args),
         Command::Dataset(args) => dataset::dataset_cmd(args),
         Command::Calibrate(args) => calibrate::calibrate_cmd(args),
+        Command::Ssl(args) => ssl::ssl_cmd(args),
     }
 }
 

@@ -234,7 +234,7 @@ fn outcome_line(m: &omniloop::run::Summary) -> String {
 
 /// The run's Foxglove log, when it is recorded or served; a live server says where it is and,
 /// when asked, waits for a viewer.
-fn start_log(s: &Scenario, sinks: &Sinks) -> anyhow::Result<Option<FoxgloveLog>> {
+pub(super) fn start_log(s: &Scenario, sinks: &Sinks) -> anyhow::Result<Option<FoxgloveLog>> {
     if sinks.mcap.is_none() && sinks.live.is_none() {
         return Ok(None);
     }

@@ -355,3 +355,29 @@ pub struct SimulatorResponse {
     #[prost(message, repeated, tag = "1")]
     pub errors: Vec<SimulatorError>,
 }
+
+/// One lockstep exchange (`SimulationSyncRequest`, the protocol's draft synchronous message):
+/// apply the commands, then advance the simulation by `sim_step`.
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct SimulationSyncRequest {
+    /// How far to advance, s (0 or unset: not at all).
+    #[prost(float, optional, tag = "1")]
+    pub sim_step: Option<f32>,
+    /// Control and configuration, applied first.
+    #[prost(message, optional, tag = "2")]
+    pub simulator_command: Option<SimulatorCommand>,
+    /// A team's robot commands.
+    #[prost(message, optional, tag = "3")]
+    pub robot_control: Option<RobotControl>,
+}
+
+/// The answer to a [`SimulationSyncRequest`] (`SimulationSyncResponse`).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct SimulationSyncResponse {
+    /// The detection frames of the step.
+    #[prost(message, repeated, tag = "1")]
+    pub detection: Vec<super::vision::DetectionFrame>,
+    /// Feedback and errors.
+    #[prost(message, optional, tag = "2")]
+    pub robot_control_response: Option<RobotControlResponse>,
+}
