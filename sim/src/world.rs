@@ -652,6 +652,14 @@ impl World {
         }
     }
 
+    /// The ball rolls from now on at its present speed (no sliding phase first): a ball set
+    /// going with the spin of rolling. Nothing without a ball.
+    pub fn set_ball_rolling(&mut self) {
+        if let Some(p) = &mut self.play {
+            p.state.roll_below_mm_s = p.state.velocity_mm_s.norm();
+        }
+    }
+
     /// The game's events so far (kicks, touches, goals, ...), in order.
     pub fn ball_events(&self) -> &[BallEvent] {
         self.play.as_ref().map_or(&[], |p| p.referee.events())

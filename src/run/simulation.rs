@@ -344,6 +344,12 @@ impl Simulation {
         self.world.place_robot(0, pose);
     }
 
+    /// The ball placed last rolls from the start instead of sliding first (see
+    /// [`World::set_ball_rolling`]).
+    pub fn set_ball_rolling(&mut self) {
+        self.world.set_ball_rolling();
+    }
+
     /// Puts robot `k` of the team (in [`Simulation::robots`]' order) at `pose`, at rest, and
     /// tells its software that it was carried (its pose is unknown until it finds it again).
     pub fn carry_robot(&mut self, k: usize, pose: Isometry2<f64>) {

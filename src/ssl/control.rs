@@ -77,8 +77,10 @@ impl SslSimulator {
         if b.teleport_safely == Some(true) {
             self.clear_robots_from(at);
         }
-        if let Err(e) = self.sim.place_ball(at, v) {
-            errors.push(error("INVALID_TELEPORT", e.to_string()));
+        match self.sim.place_ball(at, v) {
+            Ok(()) if b.roll == Some(true) => self.sim.set_ball_rolling(),
+            Ok(()) => {}
+            Err(e) => errors.push(error("INVALID_TELEPORT", e.to_string())),
         }
         errors
     }

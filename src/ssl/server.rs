@@ -290,12 +290,17 @@ impl Server {
             ] {
                 any |= self.drain(port, true)? > 0;
             }
+            let quiet = last_heard.elapsed();
             if any {
                 last_heard = Instant::now();
-            } else if idle_s.is_some_and(|s| last_heard.elapsed().as_secs_f64() > s) {
+            } else if idle_s.is_some_and(|s| quiet.as_secs_f64() > s) {
                 break;
+            } else if quiet < Duration::from_millis(5) {
+                // A client in lockstep answers within microseconds: stay on the core a while
+                // (a sleep costs more than a step's work).
+                std::thread::yield_now();
             } else {
-                std::thread::sleep(Duration::from_micros(50));
+                std::thread::sleep(Duration::from_micros(200));
             }
         }
         Ok(())

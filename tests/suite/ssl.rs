@@ -642,10 +642,74 @@ fn in_real_time_floods_and_strangers_on_the_control_port_are_dropped_and_counted
     assert!(r.errors.is_empty() && r.feedback.len() == 6, "{r:?}");
     let (_, report) = server.join().unwrap();
     assert_eq!(report.refused, 1);
-    assert!(
-        report.flood_dropped + report.malformed >= 1000,
-        "{report:?}"
-    );
+    // What the socket's buffer held (the kernel drops the rest of a burst): up to 200 a cycle
+    // taken and answered, the others read and counted.
+    assert!(report.malformed >= 200, "{report:?}");
     assert!(report.flood_dropped > 0, "no flood was dropped: {report:?}");
     assert!(report.cycles >= 150, "{report:?}");
+}
+
+#[test]
+fn a_mixed_floor_plays_one_team_over_the_protocol_and_the_other_on_its_own_cameras() {
+    let mut s = scenario();
+    let ssl = s.ssl.as_mut().unwrap();
+    ssl.protocol_teams = vec![TeamColor::Blue];
+    ssl.render_cameras = true;
+    let frames = std::env::temp_dir().join(format!("omniloop_ssl_frames_{}", std::process::id()));
+    let options = RunOptions {
+        save_frames_every: Some(10),
+        frames_dir: Some(frames.clone()),
+        ..cpu()
+    };
+    let mut g = SslSimulator::new(&s, &options).unwrap();
+    let start = steps(&mut g, 1);
+    let r = control(&mut g, TeamColor::Yellow, vec![local(0, 1.0, 0.0, 0.0)]);
+    assert_eq!(codes(&r.errors), ["TEAM_NOT_REMOTE"]);
+    for _ in 0..30 {
+        control(&mut g, TeamColor::Blue, vec![local(0, 1.0, 0.0, 0.0)]);
+        steps(&mut g, 1);
+    }
+    let end = steps(&mut g, 1);
+    // The built-in striker looks for the ball on its own camera: turning or driving.
+    let moved = (0..6).filter(|&id| {
+        let (a, b) = (
+            seen(&start, TeamColor::Yellow, id).unwrap(),
+            seen(&end, TeamColor::Yellow, id).unwrap(),
+        );
+        let turned = (a.orientation.unwrap() - b.orientation.unwrap()).abs() > 0.05;
+        turned || (a.x - b.x).hypot(a.y - b.y) > 20.0
+    });
+    assert!(moved.count() >= 3, "the yellow strikers stood still");
+    let blue =
+        seen(&end, TeamColor::Blue, 0).unwrap().x - seen(&start, TeamColor::Blue, 0).unwrap().x;
+    assert!(blue > 100.0, "blue 0 drove {blue} mm");
+    // Every robot's camera was rendered and saved, the protocol's robots' too.
+    for name in ["blue1", "yellow6"] {
+        let saved = std::fs::read_dir(frames.join(name)).unwrap().count();
+        assert!(saved >= 3, "{name}: {saved} frames saved");
+    }
+}
+
+#[test]
+fn a_ball_teleported_with_roll_rolls_at_once_and_goes_further_than_a_sliding_one() {
+    let travel = |roll: bool| {
+        let mut g = game();
+        let mut b = ball_at(0.0, 1.0, 2.0, 0.0);
+        b.roll = Some(roll);
+        assert!(
+            command(&mut g, &teleport(Vec::new(), Some(b)))
+                .errors
+                .is_empty()
+        );
+        let frames = steps(&mut g, 30);
+        frames
+            .iter()
+            .find_map(|f| f.balls.first().map(|b| b.x))
+            .unwrap()
+    };
+    let (sliding, rolling) = (travel(false), travel(true));
+    assert!(
+        rolling > sliding + 20.0,
+        "rolling {rolling} mm, sliding {sliding} mm"
+    );
 }
