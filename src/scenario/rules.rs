@@ -26,7 +26,7 @@ pub fn validate(s: &Scenario) -> Vec<Problem> {
     check_goal(&mut c, s);
     check_software(&mut c, s);
     if let Some(ssl) = &s.ssl {
-        c.extend(ssl.check(s).into_vec());
+        c.extend(ssl.check(&s.robot_names()).into_vec());
     }
     if let Some(g) = &s.goal {
         for (k, wp) in g.waypoints_mm.iter().enumerate() {

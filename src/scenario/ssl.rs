@@ -2,7 +2,6 @@
 //! whose, the ports and addresses, the overhead vision it publishes and its realism, the
 //! referee. Plain data with defaults; [`SslSpec::check`] validates it once, naming the field.
 
-use super::schema::Scenario;
 use omniloop_problem::Problems;
 use serde::{Deserialize, Serialize};
 use std::net::SocketAddr;
@@ -244,9 +243,9 @@ pub fn referee_command_number(name: &str) -> Option<i32> {
 }
 
 impl SslSpec {
-    /// The names of `team`'s robots by id: the table's list, or the scenario's robots whose
-    /// names start with the team's colour.
-    pub fn team_names(&self, team: TeamColor, s: &Scenario) -> Vec<String> {
+    /// The names of `team`'s robots by id: the table's list, or those of the scenario's robots
+    /// (`names`, in order) that start with the team's colour.
+    pub fn team_names(&self, team: TeamColor, names: &[String]) -> Vec<String> {
         let listed = match team {
             TeamColor::Blue => &self.blue,
             TeamColor::Yellow => &self.yellow,
@@ -254,19 +253,19 @@ impl SslSpec {
         if !listed.is_empty() {
             return listed.clone();
         }
-        let names = s.robot_names();
-        (names.into_iter())
+        (names.iter())
             .filter(|n| n.starts_with(team.name()))
+            .cloned()
             .collect()
     }
 
-    /// The table's problems, each naming its field under `ssl`.
-    pub fn check(&self, s: &Scenario) -> Problems {
+    /// The table's problems, each naming its field under `ssl`, for a scenario whose robots
+    /// are `names`.
+    pub fn check(&self, names: &[String]) -> Problems {
         let mut c = Problems::under("ssl");
-        let names = s.robot_names();
         let mut seen = std::collections::HashSet::new();
         for team in TeamColor::BOTH {
-            let list = self.team_names(team, s);
+            let list = self.team_names(team, names);
             if list.len() > 16 {
                 c.fail(
                     team.name(),

@@ -102,7 +102,7 @@ impl SslSimulator {
     /// the others on the built-in stack.
     pub fn new(scenario: &Scenario, options: &RunOptions) -> Result<Self, SslError> {
         let spec = scenario.ssl.clone().unwrap_or_default();
-        let problems = spec.check(scenario).into_vec();
+        let problems = spec.check(&scenario.robot_names()).into_vec();
         if let Some(p) = problems.first() {
             return Err(SslError::Spec(p.to_string()));
         }
@@ -472,7 +472,11 @@ fn wrapper(
 fn team_of_names(spec: &SslSpec, s: &Scenario) -> HashMap<String, (TeamColor, u32)> {
     let mut out = HashMap::new();
     for team in TeamColor::BOTH {
-        for (id, name) in spec.team_names(team, s).into_iter().enumerate() {
+        for (id, name) in spec
+            .team_names(team, &s.robot_names())
+            .into_iter()
+            .enumerate()
+        {
             out.insert(name, (team, id as u32));
         }
     }

@@ -7,10 +7,10 @@ use anyhow::Context;
 use omniloop::report::output::{default_out_dir, write_run};
 use omniloop::run::RunOptions;
 use omniloop::scenario::ssl::SslSpec;
-use omniloop::ssl::{Pace, Ports, ServeOptions, Server, SslSimulator};
+use omniloop::ssl::{Bound, Pace, Ports, ServeOptions, ServeReport, Server, SslSimulator};
 use omniloop::viewing::{FoxgloveLog, LiveOptions, Sinks};
 use omniloop_sim::RendererChoice;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -152,15 +152,7 @@ pub fn ssl_cmd(args: SslArgs) -> anyhow::Result<()> {
         bound.referee_to
     );
     if let Some(file) = &args.ports_file {
-        let json = serde_json::json!({
-            "control": bound.control.to_string(),
-            "blue": bound.blue.to_string(),
-            "yellow": bound.yellow.to_string(),
-            "vision": bound.vision_to.to_string(),
-            "referee": bound.referee_to.to_string(),
-        });
-        std::fs::write(file, json.to_string())
-            .with_context(|| format!("writing {}", file.display()))?;
+        write_ports(file, &bound)?;
     }
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
@@ -184,22 +176,41 @@ pub fn ssl_cmd(args: SslArgs) -> anyhow::Result<()> {
         eprintln!("recorded {}", file.display());
     }
     println!(
-        "{}: {} cycles, {:.2} s simulated in {:.2} s ({:.0} cycles/s, {} late); score blue {} \
-         yellow {}; {} datagrams malformed, {} errors answered, {} dropped in floods, {} \
-         refused; results in {}",
-        s.name,
-        report.cycles,
-        report.sim_time_s,
-        report.wall_s,
-        report.cycles as f64 / report.wall_s.max(1e-9),
-        report.late_cycles,
-        report.score[0],
-        report.score[1],
-        report.malformed,
-        report.errors,
-        report.flood_dropped,
-        report.refused,
+        "{}; results in {}",
+        report_line(&s.name, &report),
         dir.display()
     );
     Ok(())
+}
+
+/// What the game came to, in a line.
+fn report_line(name: &str, r: &ServeReport) -> String {
+    format!(
+        "{name}: {} cycles, {:.2} s simulated in {:.2} s ({:.0} cycles/s, {} late); score blue \
+         {} yellow {}; {} datagrams malformed, {} errors answered, {} dropped in floods, {} \
+         refused",
+        r.cycles,
+        r.sim_time_s,
+        r.wall_s,
+        r.cycles as f64 / r.wall_s.max(1e-9),
+        r.late_cycles,
+        r.score[0],
+        r.score[1],
+        r.malformed,
+        r.errors,
+        r.flood_dropped,
+        r.refused,
+    )
+}
+
+/// Writes the bound ports' addresses as JSON into `file`.
+fn write_ports(file: &Path, bound: &Bound) -> anyhow::Result<()> {
+    let json = serde_json::json!({
+        "control": bound.control.to_string(),
+        "blue": bound.blue.to_string(),
+        "yellow": bound.yellow.to_string(),
+        "vision": bound.vision_to.to_string(),
+        "referee": bound.referee_to.to_string(),
+    });
+    std::fs::write(file, json.to_string()).with_context(|| format!("writing {}", file.display()))
 }
