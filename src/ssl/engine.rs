@@ -12,6 +12,7 @@
 use super::commands::{Abilities, Drive, Judged, error, judge};
 use super::referee_out::RefereeOut;
 use super::vision_out::{Capture, OverheadVision, SeenRobot};
+use super::wire::referee::{Command, Referee};
 use super::wire::sim::{
     RobotControl, RobotControlResponse, RobotFeedback, SimulatorError, SimulatorResponse,
 };
@@ -208,16 +209,40 @@ impl SslSimulator {
     }
 
     /// A datagram to the simulation-control port (encoded `SimulatorResponse`).
+    /// A game controller's `Referee` message there (with its `source_identifier` set) sets
+    /// the referee's command.
     pub fn simulator_command(&mut self, bytes: &[u8]) -> Vec<u8> {
         self.tallies.datagrams += 1;
         let response = match decode(bytes, "SimulatorCommand") {
             Ok(c) => SimulatorResponse {
                 errors: self.apply_simulator_command(&c),
             },
-            Err(e) => self.malformed(e, |errors| SimulatorResponse { errors }),
+            Err(e) => match self.referee_command(bytes) {
+                Some(errors) => SimulatorResponse { errors },
+                None => self.malformed(e, |errors| SimulatorResponse { errors }),
+            },
         };
         self.tallies.errors += response.errors.len() as u64;
         response.encode_to_vec()
+    }
+
+    /// A `Referee` message to the control port: its command taken (the errors: none, or
+    /// that it is no command); `None` when the datagram is not one.
+    fn referee_command(&mut self, bytes: &[u8]) -> Option<Vec<SimulatorError>> {
+        let r = decode::<Referee>(bytes, "Referee").ok()?;
+        r.source_identifier.as_ref()?;
+        if Command::try_from(r.command).is_err() {
+            return Some(vec![error(
+                "INVALID_REFEREE_COMMAND",
+                format!(
+                    "referee command {} is not one of the game controller's",
+                    r.command
+                ),
+            )]);
+        }
+        let now = self.time_s();
+        self.referee.set_command(r.command, now);
+        Some(Vec::new())
     }
 
     /// A decoded `SimulatorCommand` (inside a lockstep request): the errors.

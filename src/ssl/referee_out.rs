@@ -17,6 +17,8 @@ pub struct RefereeOut {
     pub score: [u32; 2],
     events_seen: usize,
     last_sent_s: Option<f64>,
+    /// A command set from outside, to send at once.
+    set_now: bool,
 }
 
 /// Microseconds of simulated time.
@@ -36,13 +38,14 @@ impl RefereeOut {
             score: [0, 0],
             events_seen: 0,
             last_sent_s: None,
+            set_now: false,
         }
     }
 
     /// Takes the game's new events (goals) and the script's cues due by `t_s`; a packet when
     /// one is due (every `period_s`, and at once on a new command or goal).
     pub fn update(&mut self, t_s: f64, events: &[BallEvent]) -> Option<Referee> {
-        let mut news = false;
+        let mut news = std::mem::take(&mut self.set_now);
         for e in events.iter().skip(self.events_seen) {
             if let BallEvent::Goal { goal, .. } = e {
                 let scorer = match goal {
@@ -72,6 +75,14 @@ impl RefereeOut {
         }
         self.last_sent_s = Some(t_s);
         Some(self.packet(t_s))
+    }
+
+    /// Sets the command at `t_s` (from the control port), sent with the next packet.
+    pub fn set_command(&mut self, command: i32, t_s: f64) {
+        self.command = command;
+        self.command_counter += 1;
+        self.command_since_s = t_s;
+        self.set_now = true;
     }
 
     /// The command now, in the game controller's numbering.

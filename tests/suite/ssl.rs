@@ -713,3 +713,31 @@ fn a_ball_teleported_with_roll_rolls_at_once_and_goes_further_than_a_sliding_one
         "rolling {rolling} mm, sliding {sliding} mm"
     );
 }
+
+#[test]
+fn a_game_controllers_referee_message_to_the_control_port_sets_the_command() {
+    let mut g = game();
+    let first = Referee::decode(g.step().unwrap().referee.unwrap().as_slice()).unwrap();
+    assert_eq!(first.command, 3, "FORCE_START from the scenario");
+    let halt = Referee {
+        command: 0,
+        source_identifier: Some("a game controller".to_string()),
+        ..Referee::default()
+    };
+    let r =
+        SimulatorResponse::decode(g.simulator_command(&halt.encode_to_vec()).as_slice()).unwrap();
+    assert!(r.errors.is_empty(), "{:?}", r.errors);
+    let next = Referee::decode(g.step().unwrap().referee.unwrap().as_slice()).unwrap();
+    assert_eq!(
+        (next.command, next.command_counter),
+        (0, 1),
+        "HALT, counted"
+    );
+    let bad = Referee {
+        command: 99,
+        ..halt
+    };
+    let r =
+        SimulatorResponse::decode(g.simulator_command(&bad.encode_to_vec()).as_slice()).unwrap();
+    assert_eq!(codes(&r.errors), ["INVALID_REFEREE_COMMAND"]);
+}
