@@ -5,11 +5,12 @@
 //! scenario's.
 
 use super::commands::error;
-use super::engine::SslSimulator;
+use super::engine::SslLink;
 use super::wire::sim::{
     RobotSpecs, SimulatorCommand, SimulatorConfig, SimulatorError, Team, TeleportBall,
     TeleportRobot,
 };
+use crate::run::Simulation;
 use crate::scenario::ssl::TeamColor;
 use nalgebra::{Isometry2, Point2, Vector2};
 
@@ -20,16 +21,20 @@ fn unsupported(field: &str, why: &str) -> SimulatorError {
     error("UNSUPPORTED_FIELD", format!("{field}: {why}"))
 }
 
-impl SslSimulator {
+impl SslLink {
     /// Applies a `SimulatorCommand`: the errors, one for each field not taken.
-    pub(super) fn apply_simulator_command(&mut self, c: &SimulatorCommand) -> Vec<SimulatorError> {
+    pub(super) fn apply_simulator_command(
+        &mut self,
+        sim: &mut Simulation,
+        c: &SimulatorCommand,
+    ) -> Vec<SimulatorError> {
         let mut errors = Vec::new();
         if let Some(control) = &c.control {
             if let Some(b) = &control.teleport_ball {
-                errors.extend(self.teleport_ball(b));
+                errors.extend(self.teleport_ball(sim, b));
             }
             for (k, r) in control.teleport_robot.iter().enumerate() {
-                errors.extend(self.teleport_robot(k, r));
+                errors.extend(self.teleport_robot(sim, k, r));
             }
             if let Some(s) = control.simulation_speed.map(f64::from) {
                 if s.is_finite() && s > 0.0 && s <= MAX_SPEED {
@@ -48,9 +53,9 @@ impl SslSimulator {
         errors
     }
 
-    fn teleport_ball(&mut self, b: &TeleportBall) -> Vec<SimulatorError> {
+    fn teleport_ball(&mut self, sim: &mut Simulation, b: &TeleportBall) -> Vec<SimulatorError> {
         let mut errors = Vec::new();
-        let Some((_, now)) = self.sim.world().ball() else {
+        let Some((_, now)) = sim.world().ball() else {
             return vec![error(
                 "NO_BALL",
                 "the scenario has no ball ([world.ball])".into(),
@@ -75,10 +80,10 @@ impl SslSimulator {
             }
         }
         if b.teleport_safely == Some(true) {
-            self.clear_robots_from(at);
+            self.clear_robots_from(sim, at);
         }
-        match self.sim.place_ball(at, v) {
-            Ok(()) if b.roll == Some(true) => self.sim.set_ball_rolling(),
+        match sim.place_ball(at, v) {
+            Ok(()) if b.roll == Some(true) => sim.set_ball_rolling(),
             Ok(()) => {}
             Err(e) => errors.push(error("INVALID_TELEPORT", e.to_string())),
         }
@@ -86,14 +91,14 @@ impl SslSimulator {
     }
 
     /// Moves every robot on the field that would touch a ball at `at` out of its way.
-    fn clear_robots_from(&mut self, at: Point2<f64>) {
-        let ball_r = self.sim.world().ball().map_or(21.5, |(s, _)| s.radius_mm);
+    fn clear_robots_from(&mut self, sim: &mut Simulation, at: Point2<f64>) {
+        let ball_r = sim.world().ball().map_or(21.5, |(s, _)| s.radius_mm);
         for k in 0..self.robots.len() {
             let r = &self.robots[k];
             if !r.present {
                 continue;
             }
-            let pose = self.sim.world().robot_state(r.body).pose;
+            let pose = sim.world().robot_state(r.body).pose;
             let off = pose.translation.vector - at.coords;
             let clear = r.radius_mm + ball_r + 20.0;
             if off.norm() < clear {
@@ -104,13 +109,17 @@ impl SslSimulator {
                 };
                 let to = at.coords + dir * clear;
                 let agent = r.agent;
-                self.sim
-                    .carry_robot(agent, Isometry2::new(to, pose.rotation.angle()));
+                sim.carry_robot(agent, Isometry2::new(to, pose.rotation.angle()));
             }
         }
     }
 
-    fn teleport_robot(&mut self, k: usize, t: &TeleportRobot) -> Vec<SimulatorError> {
+    fn teleport_robot(
+        &mut self,
+        sim: &mut Simulation,
+        k: usize,
+        t: &TeleportRobot,
+    ) -> Vec<SimulatorError> {
         let field = |f: &str| format!("teleport_robot[{k}].{f}");
         let team = match t.id.team.and_then(|v| Team::try_from(v).ok()) {
             Some(Team::Blue) => TeamColor::Blue,
@@ -147,7 +156,7 @@ impl SslSimulator {
         let present = t.present.unwrap_or(self.robots[r].present);
         let body = self.robots[r].body;
         let pose = if present {
-            let now = self.sim.world().robot_state(body).pose;
+            let now = sim.world().robot_state(body).pose;
             let parked = !self.robots[r].present;
             let metres = |v: Option<f32>, old: f64| v.map_or(old, |v| f64::from(v) * 1000.0);
             let (x, y) = (now.translation.x, now.translation.y);
@@ -164,7 +173,7 @@ impl SslSimulator {
             let at = Vector2::new(metres(t.x, x), metres(t.y, y));
             let heading = t.orientation.map_or(now.rotation.angle(), f64::from);
             let finite = at.iter().all(|v| v.is_finite()) && heading.is_finite();
-            if !(finite && self.sim.world().layout().is_floor(Point2::from(at))) {
+            if !(finite && sim.world().layout().is_floor(Point2::from(at))) {
                 errors.push(error(
                     "INVALID_TELEPORT",
                     format!(
@@ -178,11 +187,11 @@ impl SslSimulator {
             }
             Isometry2::new(at, heading)
         } else {
-            self.parking(r)
+            self.parking(sim, r)
         };
         self.robots[r].present = present;
         let agent = self.robots[r].agent;
-        self.sim.carry_robot(agent, pose);
+        sim.carry_robot(agent, pose);
         errors
     }
 

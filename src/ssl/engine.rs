@@ -2,7 +2,10 @@
 //! the protocol's datagrams as bytes and answers with bytes; each [`SslSimulator::step`] runs
 //! one control cycle (every robot's cameras rendered on its own truth, as in any run) and
 //! gives what ssl-vision and the referee send. The server ([`super::server`]) moves the bytes;
-//! tests and the lockstep mode drive it directly.
+//! tests and the lockstep mode drive it directly. Its protocol side is an [`SslLink`] that
+//! takes the simulation as an argument, so that a host owning a simulation of its own can
+//! serve the protocol beside it: [`SslSoftware`] builds the protocol robots' software, then
+//! [`SslLink::before_cycle`] and [`SslLink::after_cycle`] go round each cycle.
 //!
 //! The protocol's robots run [`Remote`] software: the team's AI is their software, and like
 //! any robot software it gets no world, only what the league gives it (vision, referee,
@@ -24,7 +27,7 @@ use crate::scenario::ssl::{SslSpec, TeamColor};
 use nalgebra::{Isometry2, Point3, Rotation2, Vector2};
 use omniloop_robot::boundary::{ActuatorCommand, BodyCommand};
 use omniloop_robot::remote::{Remote, RemoteHandle};
-use omniloop_sim::FieldSpec;
+use omniloop_robot::{RobotConfig, RobotSoftware};
 use prost::Message;
 use std::collections::HashMap;
 
@@ -82,9 +85,11 @@ pub struct Tallies {
     pub errors: u64,
 }
 
-/// A scenario as a Small-Size simulator (see the module's documentation).
-pub struct SslSimulator {
-    pub(super) sim: Simulation,
+/// The protocol's side of a game, beside the simulation it serves (which it takes as an
+/// argument): the teams' robots and their held commands, the overhead vision, the referee.
+/// [`SslSimulator`] pairs it with its simulation; a host that owns the simulation otherwise
+/// (the Python package's) holds one beside it.
+pub struct SslLink {
     pub(super) spec: SslSpec,
     pub(super) robots: Vec<SslRobot>,
     pub(super) by_id: HashMap<(TeamColor, u32), usize>,
@@ -98,43 +103,58 @@ pub struct SslSimulator {
     pub(super) tallies: Tallies,
 }
 
-impl SslSimulator {
-    /// Builds the game of a validated scenario: the protocol's teams on [`Remote`] software,
-    /// the others on the built-in stack.
-    pub fn new(scenario: &Scenario, options: &RunOptions) -> Result<Self, SslError> {
+/// The software of a scenario's robots under the protocol: [`Remote`] for the protocol's
+/// teams, the handles kept for the [`SslLink`].
+pub struct SslSoftware {
+    spec: SslSpec,
+    teams: HashMap<String, (TeamColor, u32)>,
+    handles: HashMap<String, RemoteHandle>,
+}
+
+impl SslSoftware {
+    /// The plan for a validated scenario: its `[ssl]` table (defaults without one) checked.
+    pub fn plan(scenario: &Scenario) -> Result<Self, SslError> {
         let spec = scenario.ssl.clone().unwrap_or_default();
         let problems = spec.check(&scenario.robot_names()).into_vec();
         if let Some(p) = problems.first() {
             return Err(SslError::Spec(p.to_string()));
         }
-        let field = scenario.world.field.clone().ok_or_else(|| {
-            SslError::Spec("the scenario has no field ([world.field])".to_string())
-        })?;
-        let teams = team_of_names(&spec, scenario);
-        let remote_names: Vec<String> = (teams.iter())
-            .filter(|(_, (t, _))| spec.protocol_teams.contains(t))
-            .map(|(n, _)| n.clone())
-            .collect();
-        let mut handles = HashMap::new();
-        let render = spec.render_cameras;
-        let sim = Simulation::with_software(
-            scenario,
-            options,
-            |config| {
-                if !remote_names.contains(&config.name) {
-                    return builtin_software(config);
-                }
-                let mut c = config.clone();
-                if !render {
-                    c.cameras.clear();
-                }
-                let (remote, handle) = Remote::new(&c, "ssl");
-                handles.insert(config.name.clone(), handle);
-                Ok(Box::new(remote))
-            },
-            |_| {},
-        )?;
-        let robots = robots_of(&sim, scenario, &spec, &teams, &mut handles);
+        if scenario.world.field.is_none() {
+            return Err(SslError::Spec(
+                "the scenario has no field ([world.field])".to_string(),
+            ));
+        }
+        Ok(Self {
+            teams: team_of_names(&spec, scenario),
+            spec,
+            handles: HashMap::new(),
+        })
+    }
+
+    /// The software of the robot `config` describes when the protocol drives it (its cameras
+    /// left out with `render_cameras` off); `None` for a robot it does not drive.
+    pub fn build(&mut self, config: &RobotConfig) -> Option<Box<dyn RobotSoftware>> {
+        let (team, _) = self.teams.get(&config.name)?;
+        if !self.spec.protocol_teams.contains(team) {
+            return None;
+        }
+        let mut c = config.clone();
+        if !self.spec.render_cameras {
+            c.cameras.clear();
+        }
+        let (remote, handle) = Remote::new(&c, "ssl");
+        self.handles.insert(config.name.clone(), handle);
+        Some(Box::new(remote))
+    }
+}
+
+impl SslLink {
+    /// The link of `sim`, whose robots' software `software` built.
+    pub fn new(sim: &Simulation, mut software: SslSoftware) -> Result<Self, SslError> {
+        let scenario = sim.scenario();
+        let spec = software.spec.clone();
+        let field = scenario.world.field.clone().unwrap_or_default();
+        let robots = robots_of(sim, &spec, &software.teams, &mut software.handles);
         let by_id = (robots.iter().enumerate())
             .map(|(k, r)| ((r.team, r.id), k))
             .collect();
@@ -142,7 +162,6 @@ impl SslSimulator {
         Ok(Self {
             vision: OverheadVision::new(&spec.vision, &field, ball_r, scenario.seed),
             referee: RefereeOut::new(&spec.referee),
-            sim,
             spec,
             robots,
             by_id,
@@ -153,19 +172,9 @@ impl SslSimulator {
         })
     }
 
-    /// The simulation being served.
-    pub fn simulation(&self) -> &Simulation {
-        &self.sim
-    }
-
     /// The `[ssl]` table it serves.
     pub fn spec(&self) -> &SslSpec {
         &self.spec
-    }
-
-    /// Simulated time now, s.
-    pub fn time_s(&self) -> f64 {
-        self.sim.world().time_s()
     }
 
     /// The tallies so far.
@@ -195,10 +204,10 @@ impl SslSimulator {
 
     /// A datagram to `team`'s robot-control port: its commands taken, the team's feedback and
     /// the errors answered (encoded `RobotControlResponse`).
-    pub fn robot_control(&mut self, team: TeamColor, bytes: &[u8]) -> Vec<u8> {
+    pub fn robot_control(&mut self, sim: &Simulation, team: TeamColor, bytes: &[u8]) -> Vec<u8> {
         self.tallies.datagrams += 1;
         let response = match decode::<RobotControl>(bytes, "RobotControl") {
-            Ok(c) => self.apply_robot_control(team, &c),
+            Ok(c) => self.apply_robot_control(sim, team, &c),
             Err(e) => self.malformed(e, |errors| RobotControlResponse {
                 errors,
                 feedback: Vec::new(),
@@ -211,13 +220,13 @@ impl SslSimulator {
     /// A datagram to the simulation-control port (encoded `SimulatorResponse`).
     /// A game controller's `Referee` message there (with its `source_identifier` set) sets
     /// the referee's command.
-    pub fn simulator_command(&mut self, bytes: &[u8]) -> Vec<u8> {
+    pub fn simulator_command(&mut self, sim: &mut Simulation, bytes: &[u8]) -> Vec<u8> {
         self.tallies.datagrams += 1;
         let response = match decode(bytes, "SimulatorCommand") {
             Ok(c) => SimulatorResponse {
-                errors: self.apply_simulator_command(&c),
+                errors: self.apply_simulator_command(sim, &c),
             },
-            Err(e) => match self.referee_command(bytes) {
+            Err(e) => match self.referee_command(sim.world().time_s(), bytes) {
                 Some(errors) => SimulatorResponse { errors },
                 None => self.malformed(e, |errors| SimulatorResponse { errors }),
             },
@@ -228,7 +237,7 @@ impl SslSimulator {
 
     /// A `Referee` message to the control port: its command taken (the errors: none, or
     /// that it is no command); `None` when the datagram is not one.
-    fn referee_command(&mut self, bytes: &[u8]) -> Option<Vec<SimulatorError>> {
+    fn referee_command(&mut self, now: f64, bytes: &[u8]) -> Option<Vec<SimulatorError>> {
         let r = decode::<Referee>(bytes, "Referee").ok()?;
         r.source_identifier.as_ref()?;
         if Command::try_from(r.command).is_err() {
@@ -240,7 +249,6 @@ impl SslSimulator {
                 ),
             )]);
         }
-        let now = self.time_s();
         self.referee.set_command(r.command, now);
         Some(Vec::new())
     }
@@ -248,23 +256,29 @@ impl SslSimulator {
     /// A decoded `SimulatorCommand` (inside a lockstep request): the errors.
     pub fn command_errors(
         &mut self,
+        sim: &mut Simulation,
         c: &super::wire::sim::SimulatorCommand,
     ) -> Vec<SimulatorError> {
-        let errors = self.apply_simulator_command(c);
+        let errors = self.apply_simulator_command(sim, c);
         self.tallies.errors += errors.len() as u64;
         errors
     }
 
     /// A decoded `RobotControl` of `team` (inside a lockstep request): the errors.
-    pub fn control_errors(&mut self, team: TeamColor, c: &RobotControl) -> Vec<SimulatorError> {
-        let errors = self.apply_robot_control(team, c).errors;
+    pub fn control_errors(
+        &mut self,
+        sim: &Simulation,
+        team: TeamColor,
+        c: &RobotControl,
+    ) -> Vec<SimulatorError> {
+        let errors = self.apply_robot_control(sim, team, c).errors;
         self.tallies.errors += errors.len() as u64;
         errors
     }
 
     /// The feedback of `team`'s robots on the field now.
-    pub fn team_feedback(&self, team: TeamColor) -> Vec<RobotFeedback> {
-        self.feedback(team)
+    pub fn team_feedback(&self, sim: &Simulation, team: TeamColor) -> Vec<RobotFeedback> {
+        self.feedback(sim, team)
     }
 
     pub(super) fn malformed<R>(
@@ -283,6 +297,7 @@ impl SslSimulator {
     /// Takes a team's commands; the team's feedback and the errors.
     pub(super) fn apply_robot_control(
         &mut self,
+        sim: &Simulation,
         team: TeamColor,
         c: &RobotControl,
     ) -> RobotControlResponse {
@@ -309,18 +324,17 @@ impl SslSimulator {
                     continue;
                 };
                 let judged = judge(cmd, &who, &self.robots[k].abilities);
-                errors.extend(self.take_command(k, judged, &who));
+                errors.extend(self.take_command(sim.world().time_s(), k, judged, &who));
             }
         }
         RobotControlResponse {
             errors,
-            feedback: self.feedback(team),
+            feedback: self.feedback(sim, team),
         }
     }
 
     /// Hands robot `k` a judged command; errors for a robot off the field.
-    fn take_command(&mut self, k: usize, j: Judged, who: &str) -> Vec<SimulatorError> {
-        let now = self.time_s();
+    fn take_command(&mut self, now: f64, k: usize, j: Judged, who: &str) -> Vec<SimulatorError> {
         let r = &mut self.robots[k];
         let mut errors = j.errors;
         if !r.present {
@@ -357,30 +371,34 @@ impl SslSimulator {
     }
 
     /// The feedback of `team`'s robots on the field: their light barriers.
-    pub(super) fn feedback(&self, team: TeamColor) -> Vec<RobotFeedback> {
+    pub(super) fn feedback(&self, sim: &Simulation, team: TeamColor) -> Vec<RobotFeedback> {
         (self.robots.iter())
             .filter(|r| r.team == team && r.present)
             .map(|r| RobotFeedback {
                 id: r.id,
-                dribbler_ball_contact: Some(self.sim.world().light_barrier(r.body)),
+                dribbler_ball_contact: Some(sim.world().light_barrier(r.body)),
                 custom: None,
             })
             .collect()
     }
 
-    /// One control cycle: the drives held, timed out or turned into the robots' frames; the
-    /// overhead cameras capture; every robot's cameras render and its software decides; the
-    /// world moves on. What vision and the referee send after it.
-    pub fn step(&mut self) -> Result<Outgoing, SslError> {
-        let t = self.time_s();
-        self.hand_drives(t);
-        let cycle = self.sim.cycle();
-        if cycle.is_multiple_of(u64::from(self.spec.vision.every_cycles)) {
-            let capture = self.capture(t);
+    /// Before a control cycle of `sim`: the drives held, timed out or turned into the robots'
+    /// frames; the overhead cameras capture when their cycle is due.
+    pub fn before_cycle(&mut self, sim: &Simulation) {
+        let t = sim.world().time_s();
+        self.hand_drives(sim, t);
+        if sim
+            .cycle()
+            .is_multiple_of(u64::from(self.spec.vision.every_cycles))
+        {
+            let capture = self.capture(sim, t);
             self.vision.capture(&capture);
         }
-        self.sim.step()?;
-        let now = self.time_s();
+    }
+
+    /// After a control cycle of `sim`: what vision and the referee send.
+    pub fn after_cycle(&mut self, sim: &Simulation) -> Outgoing {
+        let now = sim.world().time_s();
         let mut out = Outgoing {
             t_s: now,
             ..Outgoing::default()
@@ -396,14 +414,14 @@ impl SslSimulator {
             out.vision.push(wrapper(Some(f.clone()), None));
             out.detections.push(f);
         }
-        let events = self.sim.world().ball_events();
+        let events = sim.world().ball_events();
         out.referee = (self.referee.update(now, events)).map(|r| r.encode_to_vec());
-        Ok(out)
+        out
     }
 
     /// Each protocol robot's drive into its software's mailbox: stopped after the timeout, a
     /// field-frame velocity turned into the robot's frame by its heading now.
-    fn hand_drives(&mut self, t: f64) {
+    fn hand_drives(&mut self, sim: &Simulation, t: f64) {
         let timeout = self.spec.command_timeout_s;
         for r in &mut self.robots {
             let Some(handle) = &r.remote else { continue };
@@ -419,7 +437,7 @@ impl SslSimulator {
                     });
                 }
             }
-            let heading = self.sim.world().robot_state(r.body).pose.rotation.angle();
+            let heading = sim.world().robot_state(r.body).pose.rotation.angle();
             m.command = match (r.present, r.drive) {
                 (false, _) | (_, Drive::Stop) => BodyCommand::STOP,
                 (true, Drive::Local(v, w)) => BodyCommand {
@@ -435,8 +453,8 @@ impl SslSimulator {
     }
 
     /// The world as the overhead cameras see it now.
-    fn capture(&self, t: f64) -> Capture {
-        let world = self.sim.world();
+    fn capture(&self, sim: &Simulation, t: f64) -> Capture {
+        let world = sim.world();
         let robots = (self.robots.iter())
             .filter(|r| r.present)
             .map(|r| {
@@ -461,22 +479,11 @@ impl SslSimulator {
         }
     }
 
-    /// Ends the game: the run's records, as any run's.
-    pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
-        self.sim.record_final_state();
-        self.sim.finish(wall_time_s)
-    }
-
     /// Where absent robot `k` waits: off the floor, beyond the field's walls.
-    pub(super) fn parking(&self, k: usize) -> Isometry2<f64> {
-        let f = self.sim.scenario().world.field.clone().unwrap_or_default();
+    pub(super) fn parking(&self, sim: &Simulation, k: usize) -> Isometry2<f64> {
+        let f = sim.scenario().world.field.clone().unwrap_or_default();
         let y = f.half_width_mm + f.boundary_width_mm + 2000.0;
         Isometry2::new(Vector2::new(-5000.0 + 400.0 * k as f64, y), 0.0)
-    }
-
-    /// The field being played.
-    pub fn field(&self) -> FieldSpec {
-        self.sim.scenario().world.field.clone().unwrap_or_default()
     }
 }
 
@@ -511,12 +518,11 @@ fn team_of_names(spec: &SslSpec, s: &Scenario) -> HashMap<String, (TeamColor, u3
 /// The teams' robots, in the simulation's order.
 fn robots_of(
     sim: &Simulation,
-    s: &Scenario,
     spec: &SslSpec,
     teams: &HashMap<String, (TeamColor, u32)>,
     handles: &mut HashMap<String, RemoteHandle>,
 ) -> Vec<SslRobot> {
-    let bodies = s.robot_bodies();
+    let bodies = sim.scenario().robot_bodies();
     let mut out = Vec::new();
     for (k, a) in sim.robots().iter().enumerate() {
         let Some(&(team, id)) = teams.get(a.name()) else {
@@ -543,4 +549,113 @@ fn robots_of(
         });
     }
     out
+}
+
+/// A scenario as a Small-Size simulator (see the module's documentation): its simulation and
+/// the protocol's [`SslLink`] beside it.
+pub struct SslSimulator {
+    sim: Simulation,
+    link: SslLink,
+}
+
+impl SslSimulator {
+    /// Builds the game of a validated scenario: the protocol's teams on [`Remote`] software,
+    /// the others on the built-in stack.
+    pub fn new(scenario: &Scenario, options: &RunOptions) -> Result<Self, SslError> {
+        let mut software = SslSoftware::plan(scenario)?;
+        let sim = Simulation::with_software(
+            scenario,
+            options,
+            |config| match software.build(config) {
+                Some(remote) => Ok(remote),
+                None => builtin_software(config),
+            },
+            |_| {},
+        )?;
+        let link = SslLink::new(&sim, software)?;
+        Ok(Self { sim, link })
+    }
+
+    /// The simulation being served.
+    pub fn simulation(&self) -> &Simulation {
+        &self.sim
+    }
+
+    /// The protocol's side.
+    pub fn link(&self) -> &SslLink {
+        &self.link
+    }
+
+    /// The `[ssl]` table it serves.
+    pub fn spec(&self) -> &SslSpec {
+        self.link.spec()
+    }
+
+    /// Simulated time now, s.
+    pub fn time_s(&self) -> f64 {
+        self.sim.world().time_s()
+    }
+
+    /// The tallies so far.
+    pub fn tallies(&self) -> Tallies {
+        self.link.tallies()
+    }
+
+    /// The score: goals of blue and of yellow.
+    pub fn score(&self) -> [u32; 2] {
+        self.link.score()
+    }
+
+    /// Simulated time over wall time the protocol asked for (1: real time).
+    pub fn speed(&self) -> f64 {
+        self.link.speed()
+    }
+
+    /// The vision port the protocol asked for, if it did.
+    pub fn vision_port(&self) -> Option<u16> {
+        self.link.vision_port()
+    }
+
+    /// A datagram to `team`'s robot-control port (see [`SslLink::robot_control`]).
+    pub fn robot_control(&mut self, team: TeamColor, bytes: &[u8]) -> Vec<u8> {
+        self.link.robot_control(&self.sim, team, bytes)
+    }
+
+    /// A datagram to the simulation-control port (see [`SslLink::simulator_command`]).
+    pub fn simulator_command(&mut self, bytes: &[u8]) -> Vec<u8> {
+        self.link.simulator_command(&mut self.sim, bytes)
+    }
+
+    /// A decoded `SimulatorCommand`: the errors.
+    pub fn command_errors(
+        &mut self,
+        c: &super::wire::sim::SimulatorCommand,
+    ) -> Vec<SimulatorError> {
+        self.link.command_errors(&mut self.sim, c)
+    }
+
+    /// A decoded `RobotControl` of `team`: the errors.
+    pub fn control_errors(&mut self, team: TeamColor, c: &RobotControl) -> Vec<SimulatorError> {
+        self.link.control_errors(&self.sim, team, c)
+    }
+
+    /// The feedback of `team`'s robots on the field now.
+    pub fn team_feedback(&self, team: TeamColor) -> Vec<RobotFeedback> {
+        self.link.team_feedback(&self.sim, team)
+    }
+
+    /// One control cycle: the drives handed over and the overhead cameras' capture; every
+    /// robot's cameras rendered and its software deciding; the world moving on. What vision
+    /// and the referee send after it.
+    pub fn step(&mut self) -> Result<Outgoing, SslError> {
+        self.link.before_cycle(&self.sim);
+        self.sim.step()?;
+        Ok(self.link.after_cycle(&self.sim))
+    }
+
+    /// Ends the game: the run's records, as any run's.
+    pub fn finish(mut self, wall_time_s: f64) -> RunOutput {
+        self.sim.record_final_state();
+        self.sim.finish(wall_time_s)
+    }
 }

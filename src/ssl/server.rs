@@ -5,7 +5,8 @@
 //! - **real time** (default): a control cycle every period of wall time (scaled by the
 //!   protocol's `simulation_speed`), whatever arrived taken before it;
 //! - **lockstep**: the simulation waits for its clients. A `SimulationSyncRequest` (the
-//!   protocol's draft synchronous message) applies its commands and advances by `sim_step`,
+//!   protocol's draft synchronous message, with `sim_step` set: without it a datagram is the
+//!   port's own message) applies its commands and advances by `sim_step`,
 //!   answered with a `SimulationSyncResponse` holding the detection frames of the step. On a
 //!   team's port it also carries that team's `RobotControl`; on the control port its
 //!   `SimulatorCommand` only. Plain `RobotControl`s to the team ports are taken and answered
@@ -354,9 +355,12 @@ impl Server {
 
     /// The answer to one datagram; in lockstep a sync request steps the simulation.
     fn answer(&mut self, port: Port, bytes: &[u8], lockstep: bool) -> Result<Vec<u8>, ServeError> {
+        // A sync request sets its step: without one, the datagram is the port's own message
+        // (a `SimulatorCommand` with only `config` would decode as a sync request too).
         let sync = lockstep
             .then(|| decode::<SimulationSyncRequest>(bytes, "SimulationSyncRequest").ok())
-            .flatten();
+            .flatten()
+            .filter(|r| r.sim_step.is_some());
         if let Some(req) = sync {
             return self.sync(port, &req);
         }

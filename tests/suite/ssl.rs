@@ -509,6 +509,26 @@ fn lockstep_game(out: &Path) -> Vec<(String, Vec<u8>)> {
         .set_read_timeout(Some(Duration::from_secs(5)))
         .unwrap();
     let mut buf = vec![0u8; 65_536];
+    // A configuration alone to the control port is a `SimulatorCommand`, not a sync request
+    // (whose second field it would decode as): answered as one, vision moved to another port.
+    let moved = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let config = SimulatorCommand {
+        control: None,
+        config: Some(SimulatorConfig {
+            vision_port: Some(u32::from(moved.local_addr().unwrap().port())),
+            ..SimulatorConfig::default()
+        }),
+    };
+    client
+        .send_to(&config.encode_to_vec(), bound.control)
+        .unwrap();
+    let n = client.recv(&mut buf).unwrap();
+    assert!(
+        SimulatorResponse::decode(&buf[..n])
+            .unwrap()
+            .errors
+            .is_empty()
+    );
     let mut frames = 0;
     for k in 0..200u32 {
         let req = SimulationSyncRequest {
@@ -527,6 +547,13 @@ fn lockstep_game(out: &Path) -> Vec<(String, Vec<u8>)> {
     }
     // A frame a camera a step, but for the last three steps' frames: 35 ms on their way.
     assert_eq!(frames, 197 * 4);
+    moved
+        .set_read_timeout(Some(Duration::from_secs(1)))
+        .unwrap();
+    let n = moved
+        .recv(&mut buf)
+        .expect("vision on the port the configuration set");
+    assert!(WrapperPacket::decode(&buf[..n]).is_ok());
     let (g, report) = server.join().unwrap();
     assert_eq!(report.cycles, 200);
     write_run(out, &scenario, &g.finish(0.0)).unwrap();

@@ -212,5 +212,8 @@ fn write_ports(file: &Path, bound: &Bound) -> anyhow::Result<()> {
         "vision": bound.vision_to.to_string(),
         "referee": bound.referee_to.to_string(),
     });
-    std::fs::write(file, json.to_string()).with_context(|| format!("writing {}", file.display()))
+    // Written beside and renamed: a reader never sees half of it.
+    let tmp = file.with_extension("tmp");
+    std::fs::write(&tmp, json.to_string()).with_context(|| format!("writing {}", tmp.display()))?;
+    std::fs::rename(&tmp, file).with_context(|| format!("writing {}", file.display()))
 }
