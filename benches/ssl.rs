@@ -74,7 +74,7 @@ fn cpu() -> RunOptions {
 /// Cycles per second of `steps` lockstep steps over loopback UDP.
 fn over_udp(steps: u32) -> f64 {
     let g = SslSimulator::new(&scenario(false), &cpu()).unwrap();
-    let ports = Ports::bind(&g).unwrap();
+    let ports = Ports::bind(g.spec()).unwrap();
     let bound = ports.bound().unwrap();
     let options = ServeOptions {
         pace: Pace::Lockstep,

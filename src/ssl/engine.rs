@@ -659,3 +659,53 @@ impl SslSimulator {
         self.sim.finish(wall_time_s)
     }
 }
+
+/// What the server ([`super::server::Server`]) serves: a simulation with its [`SslLink`].
+/// [`SslSimulator`] is one; a host that owns its simulation otherwise (a session of the
+/// Python package) is another.
+pub trait SslHost {
+    /// The simulation.
+    fn simulation(&self) -> &Simulation;
+    /// The protocol's side.
+    fn link(&self) -> &SslLink;
+    /// A datagram to `team`'s robot-control port, answered.
+    fn robot_control(&mut self, team: TeamColor, bytes: &[u8]) -> Vec<u8>;
+    /// A datagram to the simulation-control port, answered.
+    fn simulator_command(&mut self, bytes: &[u8]) -> Vec<u8>;
+    /// A decoded `SimulatorCommand`: the errors.
+    fn command_errors(&mut self, c: &super::wire::sim::SimulatorCommand) -> Vec<SimulatorError>;
+    /// A decoded `RobotControl` of `team`: the errors.
+    fn control_errors(&mut self, team: TeamColor, c: &RobotControl) -> Vec<SimulatorError>;
+    /// One control cycle with the link around it.
+    fn step(&mut self) -> Result<Outgoing, SslError>;
+}
+
+impl SslHost for SslSimulator {
+    fn simulation(&self) -> &Simulation {
+        &self.sim
+    }
+
+    fn link(&self) -> &SslLink {
+        &self.link
+    }
+
+    fn robot_control(&mut self, team: TeamColor, bytes: &[u8]) -> Vec<u8> {
+        SslSimulator::robot_control(self, team, bytes)
+    }
+
+    fn simulator_command(&mut self, bytes: &[u8]) -> Vec<u8> {
+        SslSimulator::simulator_command(self, bytes)
+    }
+
+    fn command_errors(&mut self, c: &super::wire::sim::SimulatorCommand) -> Vec<SimulatorError> {
+        SslSimulator::command_errors(self, c)
+    }
+
+    fn control_errors(&mut self, team: TeamColor, c: &RobotControl) -> Vec<SimulatorError> {
+        SslSimulator::control_errors(self, team, c)
+    }
+
+    fn step(&mut self) -> Result<Outgoing, SslError> {
+        SslSimulator::step(self)
+    }
+}

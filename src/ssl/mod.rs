@@ -19,5 +19,5 @@ pub mod server;
 pub mod vision_out;
 pub mod wire;
 
-pub use engine::{Outgoing, SslError, SslLink, SslSimulator, SslSoftware, Tallies};
+pub use engine::{Outgoing, SslError, SslHost, SslLink, SslSimulator, SslSoftware, Tallies};
 pub use server::{Bound, Pace, Ports, ServeError, ServeOptions, ServeReport, Server};

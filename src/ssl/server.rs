@@ -18,10 +18,11 @@
 //! counted, and past `max_datagrams_per_cycle` a port's datagrams in a cycle are read, dropped
 //! and counted.
 
-use super::engine::{Outgoing, SslError, SslSimulator};
+use super::engine::{Outgoing, SslError, SslHost, SslSimulator};
 use super::log::{LogMessage, SslLog};
 use super::wire::sim::{RobotControlResponse, SimulationSyncRequest, SimulationSyncResponse};
 use super::wire::{MAX_DATAGRAM, decode};
+use crate::scenario::ssl::SslSpec;
 use crate::scenario::ssl::TeamColor;
 use prost::Message;
 use std::io::{self, BufWriter, Write};
@@ -127,8 +128,8 @@ pub struct ServeReport {
 
 impl Ports {
     /// Binds the scenario's ports (`port_override` replaces each port and address where set).
-    pub fn bind(sim: &SslSimulator) -> Result<Self, ServeError> {
-        let n = &sim.spec().network;
+    pub fn bind(spec: &SslSpec) -> Result<Self, ServeError> {
+        let n = &spec.network;
         let ip: IpAddr = n
             .bind_address
             .parse()
@@ -189,8 +190,8 @@ enum Port {
 }
 
 /// The game being served: the simulator, its ports, its log and its tallies.
-pub struct Server {
-    sim: SslSimulator,
+pub struct Server<H: SslHost = SslSimulator> {
+    sim: H,
     ports: Ports,
     log: Option<SslLog<BufWriter<std::fs::File>>>,
     report: ServeReport,
@@ -198,13 +199,9 @@ pub struct Server {
     buf: Vec<u8>,
 }
 
-impl Server {
+impl<H: SslHost> Server<H> {
     /// Serves `sim` on `ports`, logging to `options.log`.
-    pub fn new(
-        sim: SslSimulator,
-        ports: Ports,
-        options: &ServeOptions,
-    ) -> Result<Self, ServeError> {
+    pub fn new(sim: H, ports: Ports, options: &ServeOptions) -> Result<Self, ServeError> {
         let log = match &options.log {
             Some(path) => {
                 let f = std::fs::File::create(path)
@@ -228,7 +225,7 @@ impl Server {
         mut self,
         options: &ServeOptions,
         stop: &Arc<AtomicBool>,
-    ) -> Result<(SslSimulator, ServeReport), ServeError> {
+    ) -> Result<(H, ServeReport), ServeError> {
         let start = Instant::now();
         let end_s = options
             .duration_s
@@ -240,30 +237,48 @@ impl Server {
         if let Some(log) = self.log.take() {
             log.finish().map_err(io_err("writing the log"))?;
         }
-        let t = self.sim.tallies();
+        let t = self.sim.link().tallies();
         self.report.wall_s = start.elapsed().as_secs_f64();
-        self.report.sim_time_s = self.sim.time_s();
+        self.report.sim_time_s = self.sim.simulation().world().time_s();
         self.report.malformed = t.malformed;
         self.report.errors = t.errors;
-        self.report.score = self.sim.score();
+        self.report.score = self.sim.link().score();
         Ok((self.sim, self.report))
+    }
+
+    /// The game being served.
+    pub fn host(&self) -> &H {
+        &self.sim
+    }
+
+    /// The game being served, to reach it between cycles.
+    pub fn host_mut(&mut self) -> &mut H {
+        &mut self.sim
+    }
+
+    /// One cycle for a host that keeps time itself: what waits on the ports taken and
+    /// answered, a control cycle, its vision and referee packets sent.
+    pub fn serve_cycle(&mut self) -> Result<Outgoing, ServeError> {
+        for port in [
+            Port::Control,
+            Port::Team(TeamColor::Blue),
+            Port::Team(TeamColor::Yellow),
+        ] {
+            self.drain(port, false)?;
+        }
+        let out = self.sim.step()?;
+        self.report.cycles += 1;
+        self.send(&out)?;
+        Ok(out)
     }
 
     fn real_time(&mut self, end_s: f64, stop: &Arc<AtomicBool>) -> Result<(), ServeError> {
         let period = self.sim.simulation().scenario().run.control_period_s;
         let mut next = Instant::now();
-        while self.sim.time_s() < end_s - 1e-9 && !stop.load(Ordering::Relaxed) {
-            for port in [
-                Port::Control,
-                Port::Team(TeamColor::Blue),
-                Port::Team(TeamColor::Yellow),
-            ] {
-                self.drain(port, false)?;
-            }
-            let out = self.sim.step()?;
-            self.report.cycles += 1;
-            self.send(&out)?;
-            next += Duration::from_secs_f64(period / self.sim.speed());
+        while self.sim.simulation().world().time_s() < end_s - 1e-9 && !stop.load(Ordering::Relaxed)
+        {
+            self.serve_cycle()?;
+            next += Duration::from_secs_f64(period / self.sim.link().speed());
             let now = Instant::now();
             if now > next + Duration::from_secs_f64(period) {
                 self.report.late_cycles += 1;
@@ -282,7 +297,8 @@ impl Server {
         stop: &Arc<AtomicBool>,
     ) -> Result<(), ServeError> {
         let mut last_heard = Instant::now();
-        while self.sim.time_s() < end_s - 1e-9 && !stop.load(Ordering::Relaxed) {
+        while self.sim.simulation().world().time_s() < end_s - 1e-9 && !stop.load(Ordering::Relaxed)
+        {
             let mut any = false;
             for port in [
                 Port::Control,
@@ -405,7 +421,8 @@ impl Server {
             detection,
             robot_control_response: Some(RobotControlResponse {
                 errors,
-                feedback: team.map(|t| self.sim.team_feedback(t)).unwrap_or_default(),
+                feedback: (team.map(|t| self.sim.link().team_feedback(self.sim.simulation(), t)))
+                    .unwrap_or_default(),
             }),
         };
         Ok(response.encode_to_vec())
@@ -414,7 +431,7 @@ impl Server {
     /// Sends a cycle's vision and referee packets, and logs them.
     fn send(&mut self, out: &Outgoing) -> Result<(), ServeError> {
         let mut vision_to = self.ports.vision_to;
-        if let Some(p) = self.sim.vision_port() {
+        if let Some(p) = self.sim.link().vision_port() {
             vision_to.set_port(p);
         }
         for p in &out.vision {
@@ -443,7 +460,7 @@ impl Server {
 
     /// The errors answered since the last report, as a count now and then.
     fn say_errors(&mut self) {
-        let t = self.sim.tallies();
+        let t = self.sim.link().tallies();
         if t.errors > self.reported_errors
             && (self.reported_errors < 10 || t.errors - self.reported_errors >= 1000)
         {

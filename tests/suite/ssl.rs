@@ -489,7 +489,7 @@ fn lockstep_game(out: &Path) -> Vec<(String, Vec<u8>)> {
     ssl.vision.realism.enabled = true;
     let scenario = s.clone();
     let g = SslSimulator::new(&s, &cpu()).unwrap();
-    let ports = Ports::bind(&g).unwrap();
+    let ports = Ports::bind(g.spec()).unwrap();
     let bound = ports.bound().unwrap();
     let options = ServeOptions {
         pace: Pace::Lockstep,
@@ -617,7 +617,7 @@ fn in_real_time_floods_and_strangers_on_the_control_port_are_dropped_and_counted
     ssl.network.vision_address = sink.local_addr().unwrap().to_string();
     ssl.network.referee_address = sink.local_addr().unwrap().to_string();
     let g = SslSimulator::new(&s, &cpu()).unwrap();
-    let ports = Ports::bind(&g).unwrap();
+    let ports = Ports::bind(g.spec()).unwrap();
     let bound = ports.bound().unwrap();
     let options = ServeOptions {
         duration_s: Some(2.0),

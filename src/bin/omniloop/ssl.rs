@@ -135,7 +135,7 @@ pub fn ssl_cmd(args: SslArgs) -> anyhow::Result<()> {
     };
     let sim = SslSimulator::new(&s, &options)
         .with_context(|| format!("serving {}", args.scenario.display()))?;
-    let ports = Ports::bind(&sim)?;
+    let ports = Ports::bind(sim.spec())?;
     let bound = ports.bound()?;
     eprintln!(
         "omniloop ssl: {} ({}): control {}, blue {}, yellow {}; vision to {}, referee to {}",
