@@ -256,12 +256,17 @@ class Simulation:
         truth: bool = False,
     ) -> Self:
         """A run of `scenario` with `seed` (default: the scenario's), the `renderer` (`"cpu"`,
-        `"gpu"` or `"auto"`) and `robot`: `"python"` (you step it with commands) or
-        `"builtin"` (the scenario's own robot software decides); for a team, one of these for
-        every robot or a dict naming each robot's (`{"blue1": "python", "blue2": "builtin"}`);
-        `frames=True` renders (and calibrates) vision's camera even where the built-in software
-        reads no frame, to watch it or run a detector on it; `truth=True` traces the truth
-        beside each frame (`truth_frames()`), the simulator's side only."""
+        `"gpu"` or `"auto"`) and `robot`: `"python"` (you step it with commands),
+        `"builtin"` (the scenario's own robot software decides) or `"ssl"` (a team's AI over the
+        SSL simulation protocol, on the ports of the scenario's `[ssl]`; `ssl_ports()`); for a
+        team, one of these for every robot or a dict naming each robot's (`{"blue1": "python",
+        "blue2": "builtin"}`); `frames=True` renders (and calibrates) vision's camera even where
+        the built-in software reads no frame, to watch it or run a detector on it; `truth=True`
+        traces the truth beside each frame (`truth_frames()`), the simulator's side only."""
+
+    def ssl_ports(self) -> dict[str, str] | None:
+        """With `robot="ssl"`: where the protocol's ports are (`control`, `blue`, `yellow`, and
+        where `vision` and `referee` go), as `"host:port"`; `None` otherwise."""
 
     def reset(self, seed: int | None = None) -> Observation | Any:
         """Starts the run again from its start with `seed` (default: this simulation's seed) and

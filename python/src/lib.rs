@@ -9,6 +9,7 @@ mod errors;
 mod freespace;
 mod scenario;
 mod simulation;
+mod ssl;
 mod sweep;
 mod truth;
 mod vector;

@@ -10,6 +10,7 @@ use crate::convert::{finite_numbers, json_to_py, rgb_array, rgb_image_array};
 use crate::errors::{RunFinishedError, run_error};
 use crate::freespace::PyFreeSpaceDetector;
 use crate::scenario::PyScenario;
+use crate::ssl::{Engine, engine};
 use crate::truth::truth_frame_dict;
 use nalgebra::{Isometry2, Point2, Vector2};
 use omniloop::control::DeadReckoning;
@@ -35,6 +36,10 @@ pub enum Driver {
     Python,
     /// The built-in stack, as `omniloop run` runs it.
     Builtin,
+    /// The Small-Size League's simulation protocol: a team's AI on `omniloop ssl`'s ports
+    /// (the scenario's `[ssl]`); a robot of a team the protocol does not drive runs the
+    /// built-in stack.
+    Ssl,
 }
 
 impl Driver {
@@ -42,9 +47,11 @@ impl Driver {
         match robot {
             "python" => Ok(Self::Python),
             "builtin" => Ok(Self::Builtin),
+            "ssl" => Ok(Self::Ssl),
             other => Err(PyValueError::new_err(format!(
-                "robot={other:?}: expected \"python\" (your commands) or \"builtin\" (the \
-                 scenario's own robot software)"
+                "robot={other:?}: expected \"python\" (your commands), \"builtin\" (the \
+                 scenario's own robot software) or \"ssl\" (a team's AI over the SSL \
+                 simulation protocol)"
             ))),
         }
     }
@@ -154,7 +161,7 @@ pub struct Extras {
 
 /// One run being stepped, with what the robots' side keeps between steps.
 pub struct State {
-    session: Session,
+    engine: Engine,
     members: Vec<Member>,
     team: bool,
     seed: u64,
@@ -187,22 +194,18 @@ impl State {
         };
         let names = scenario.robot_names();
         let mut remotes: Vec<Option<RemoteHandle>> = vec![None; names.len()];
-        let session = Session::new(
-            &scenario,
-            &options,
-            |config| {
-                let k = names.iter().position(|n| *n == config.name).unwrap_or(0);
-                match drivers.get(k).copied().unwrap_or(Driver::Builtin) {
-                    Driver::Python => {
-                        let (software, handle) = Remote::new(config, "python");
-                        remotes[k] = Some(handle);
-                        Ok(Box::new(software))
-                    }
-                    Driver::Builtin => omniloop::run::builtin_software(config),
+        let served = drivers.contains(&Driver::Ssl);
+        let engine = engine(&scenario, &options, served, |config| {
+            let k = names.iter().position(|n| *n == config.name).unwrap_or(0);
+            match drivers.get(k).copied().unwrap_or(Driver::Builtin) {
+                Driver::Python => {
+                    let (software, handle) = Remote::new(config, "python");
+                    remotes[k] = Some(handle);
+                    Ok(Box::new(software))
                 }
-            },
-            |_| {},
-        )?;
+                Driver::Builtin | Driver::Ssl => omniloop::run::builtin_software(config),
+            }
+        })?;
         let members = scenario
             .members()
             .iter()
@@ -226,7 +229,7 @@ impl State {
             })
             .collect();
         Ok(Self {
-            session,
+            engine,
             members,
             team: scenario.is_team(),
             seed,
@@ -249,8 +252,8 @@ impl State {
                 mail.estimate = c.estimate;
             }
         }
-        self.session.step()?;
-        let sim = self.session.simulation();
+        self.engine.step()?;
+        let sim = self.engine.session().simulation();
         for (m, a) in self.members.iter_mut().zip(sim.robots()) {
             if let Some(r) = a.last_odometry() {
                 m.dead_reckoning
@@ -262,27 +265,32 @@ impl State {
 
     /// Whether the run is over.
     pub fn done(&self) -> bool {
-        self.session.finished()
+        self.engine.session().finished()
     }
 
     /// The truth now (the first robot's).
     pub fn truth(&self) -> Truth {
-        self.session.simulation().truth()
+        self.engine.session().simulation().truth()
     }
 
     /// Robot `k`'s truth now.
     fn truth_of(&self, k: usize) -> Option<Truth> {
-        self.session.simulation().truth_of(k)
+        self.engine.session().simulation().truth_of(k)
     }
 
     /// The session.
     pub fn session(&self) -> &Session {
-        &self.session
+        self.engine.session()
+    }
+
+    /// Where the protocol's ports are, when served over it.
+    pub fn ssl_ports(&self) -> Option<omniloop::ssl::Bound> {
+        self.engine.ports().copied()
     }
 
     /// The session, to change the world between steps.
     pub fn session_mut(&mut self) -> &mut Session {
-        &mut self.session
+        self.engine.session_mut()
     }
 
     /// The seed of this run.
@@ -788,12 +796,13 @@ impl PySimulation {
                      omega_rad_s) for a differential robot",
                 ));
             }
-            (Driver::Builtin, Some(c)) if !c.is_none() => {
+            (Driver::Builtin | Driver::Ssl, Some(c)) if !c.is_none() => {
                 return Err(PyValueError::new_err(
-                    "robot=\"builtin\" decides its own commands: call step() without one",
+                    "robot=\"builtin\" (or \"ssl\") decides its own commands: call step() \
+                     without one",
                 ));
             }
-            (Driver::Builtin, _) => None,
+            (Driver::Builtin | Driver::Ssl, _) => None,
         }])
     }
 
@@ -827,14 +836,15 @@ impl PySimulation {
                 }
                 if !python.contains(&name) {
                     return Err(PyValueError::new_err(format!(
-                        "step(): robot {name:?} runs the built-in software: give it no command"
+                        "step(): robot {name:?} runs the built-in software or the SSL \
+                         protocol's commands: give it no command"
                     )));
                 }
             }
         }
         let mut out = Vec::with_capacity(names.len());
         for (k, name) in names.iter().enumerate() {
-            if self.drivers[k] == Driver::Builtin {
+            if self.drivers[k] != Driver::Python {
                 out.push(None);
                 continue;
             }
@@ -868,10 +878,11 @@ impl PySimulation {
 #[pymethods]
 impl PySimulation {
     /// A run of `scenario` with `seed` (default: the scenario's), the `renderer` (`"cpu"`,
-    /// `"gpu"` or `"auto"`) and `robot`: `"python"` (you step it with commands) or
-    /// `"builtin"` (the scenario's own robot software decides); for a team, one of these for
-    /// every robot or a dict naming each robot's (`{"blue1": "python", "blue2": "builtin"}`);
-    /// `frames=True` renders (and calibrates) vision's camera even where the built-in software
+    /// `"gpu"` or `"auto"`) and `robot`: `"python"` (you step it with commands),
+    /// `"builtin"` (the scenario's own robot software decides) or `"ssl"` (a team's AI over the
+    /// SSL simulation protocol, on the ports of the scenario's `[ssl]`; `ssl_ports()`); for a
+    /// team, one of these for every robot or a dict naming each robot's (`{"blue1": "python",
+    /// "blue2": "builtin"}`); `frames=True` renders (and calibrates) vision's camera even where the built-in software
     /// reads no frame, to watch it or run a detector on it; `truth=True` traces the truth
     /// beside each frame (`truth_frames()`), the simulator's side only.
     #[new]
@@ -913,6 +924,13 @@ impl PySimulation {
     /// returns the first observation (a team's: a dict of observations by robot name).
     #[pyo3(signature = (seed = None))]
     fn reset(&self, py: Python<'_>, seed: Option<u64>) -> PyResult<Py<PyAny>> {
+        if self.drivers.contains(&Driver::Ssl) {
+            return Err(PyRuntimeError::new_err(
+                "a Simulation served over the SSL protocol (robot=\"ssl\") holds its ports: it \
+                 cannot be reset; make a new one (or teleport the robots and the ball over the \
+                 control port)",
+            ));
+        }
         let seed = seed.unwrap_or_else(|| self.lock().seed());
         let fresh = py
             .detach(|| {
@@ -929,6 +947,26 @@ impl PySimulation {
         let mut state = self.lock();
         *state = fresh;
         observations(py, &state)
+    }
+
+    /// With `robot="ssl"`: where the protocol's ports are (`control`, `blue`, `yellow`, and
+    /// where `vision` and `referee` go), as `"host:port"`; `None` otherwise.
+    fn ssl_ports<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let state = self.lock();
+        let Some(b) = state.ssl_ports() else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("control", b.control),
+            ("blue", b.blue),
+            ("yellow", b.yellow),
+            ("vision", b.vision_to),
+            ("referee", b.referee_to),
+        ] {
+            d.set_item(k, v.to_string())?;
+        }
+        Ok(Some(d))
     }
 
     /// The observation now (what the last `reset` or `step` returned).
@@ -1151,6 +1189,7 @@ impl PySimulation {
         let robot = |d: &Driver| match d {
             Driver::Python => "python",
             Driver::Builtin => "builtin",
+            Driver::Ssl => "ssl",
         };
         let drivers = match state.is_team() {
             true => format!(

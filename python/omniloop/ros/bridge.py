@@ -75,7 +75,8 @@ class BridgeOptions:
     realtime_factor: float = 1.0
     """Without lockstep: simulation seconds per wall second (0: as fast as it goes)."""
     robot: str = "python"
-    """``python``: the robots take ``cmd_vel``; ``builtin``: omniloop's own software drives."""
+    """``python``: the robots take ``cmd_vel``; ``builtin``: omniloop's own software drives;
+    ``ssl``: a Small-Size team's AI drives them over the SSL simulation protocol."""
     seed: Optional[int] = None
     renderer: str = "cpu"
     twist_stamped: bool = False
@@ -535,6 +536,12 @@ class Bridge:
             self.sim = omniloop.Simulation(
                 self.scenario, seed=seed, renderer=o.renderer, robot=o.robot, frames=frames
             )
+            ports = self.sim.ssl_ports()
+            if ports is not None:
+                self.node.get_logger().info(
+                    "serving the SSL simulation protocol: "
+                    + ", ".join(f"{k} {v}" for k, v in ports.items())
+                )
             truth: Any = self.sim.truth()
             if "ball" in (next(iter(truth.values())) if self.scenario.is_team else truth):
                 # Made before the first frame, so that a node started with it sees that frame.
@@ -597,7 +604,7 @@ class Bridge:
     def step(self) -> None:
         """One control cycle with each robot's command (and the kicker's and dribbler's
         commands come since the last), then its observation published."""
-        if self.options.robot == "builtin":
+        if self.options.robot in ("builtin", "ssl"):
             obs = self.running.step()
         elif self.scenario.is_team:
             kicks = {p.name: a for p in self.ports if (a := p.take_actuators()) is not None}

@@ -41,10 +41,12 @@ def parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--robot",
-        choices=["python", "builtin"],
+        choices=["python", "builtin", "ssl"],
         default="python",
         help="python: the robots take cmd_vel (default); builtin: omniloop's own software "
-        "drives and the node only publishes",
+        "drives and the node only publishes; ssl: a Small-Size team's AI drives them over the "
+        "SSL simulation protocol (the scenario's [ssl] ports, as omniloop ssl serves them) and "
+        "the node publishes every robot's cameras",
     )
     p.add_argument(
         "--seed", type=int, help="the episode's seed (default: the scenario's; the seed parameter)"
@@ -103,6 +105,13 @@ def main(argv: Optional[List[str]] = None) -> int:
         if not value >= 0:
             print(f"error: {name} must be a number >= 0 (got {value})", file=sys.stderr)
             return 2
+    if args.robot == "ssl" and args.lockstep:
+        print(
+            "error: --robot ssl is paced by the clock (the team's AI keeps its own time): "
+            "leave out --lockstep (omniloop ssl --lockstep steps on the protocol's sync requests)",
+            file=sys.stderr,
+        )
+        return 2
     try:
         import rclpy
 
