@@ -580,7 +580,7 @@ fn lockstep_runs_of_the_same_command_stream_give_byte_identical_files() {
 }
 
 fn tempfile_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("omniloop_{name}_{}", std::process::id()));
+    let dir = super::common::tmp(name);
     for sub in ["a", "b"] {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
     }
@@ -682,7 +682,7 @@ fn a_mixed_floor_plays_one_team_over_the_protocol_and_the_other_on_its_own_camer
     let ssl = s.ssl.as_mut().unwrap();
     ssl.protocol_teams = vec![TeamColor::Blue];
     ssl.render_cameras = true;
-    let frames = std::env::temp_dir().join(format!("omniloop_ssl_frames_{}", std::process::id()));
+    let frames = super::common::tmp("ssl_frames");
     let options = RunOptions {
         save_frames_every: Some(10),
         frames_dir: Some(frames.clone()),
@@ -767,4 +767,44 @@ fn a_game_controllers_referee_message_to_the_control_port_sets_the_command() {
     let r =
         SimulatorResponse::decode(g.simulator_command(&bad.encode_to_vec()).as_slice()).unwrap();
     assert_eq!(codes(&r.errors), ["INVALID_REFEREE_COMMAND"]);
+}
+
+#[test]
+fn the_command_line_serves_a_game_and_records_every_robots_camera_as_mcap() {
+    let out = super::common::tmp("ssl_cli_mcap");
+    let line = super::common::omniloop([
+        "ssl",
+        "scenarios/ssl_match.toml",
+        "--duration-s",
+        "0.05",
+        "--renderer",
+        "cpu",
+        "--bind",
+        "127.0.0.1",
+        "--control-port",
+        "0",
+        "--blue-port",
+        "0",
+        "--yellow-port",
+        "0",
+        "--vision",
+        "127.0.0.1:9",
+        "--referee",
+        "127.0.0.1:9",
+        "--mcap",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(line.contains("5 cycles"), "{line}");
+    let bytes = std::fs::read(out.join("run.mcap")).unwrap();
+    let mut cameras = std::collections::BTreeSet::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let topic = m.unwrap().channel.topic.clone();
+        if topic.ends_with("/camera/omni") {
+            cameras.insert(topic);
+        }
+    }
+    assert_eq!(cameras.len(), 12, "{cameras:?}");
+    let log = std::fs::read(out.join("ssl.log")).unwrap();
+    assert_eq!(&log[..12], b"SSL_LOG_FILE");
 }
