@@ -23,7 +23,7 @@ fn unsupported(field: &str, why: &str) -> SimulatorError {
 
 impl SslLink {
     /// Applies a `SimulatorCommand`: the errors, one for each field not taken.
-    pub(super) fn apply_simulator_command(
+    pub(crate) fn apply_simulator_command(
         &mut self,
         sim: &mut Simulation,
         c: &SimulatorCommand,

@@ -1,7 +1,7 @@
 //! [`SslSimulator`]: a scenario run as a Small-Size simulator, without the network. It takes
 //! the protocol's datagrams as bytes and answers with bytes; each [`SslSimulator::step`] runs
 //! one control cycle (every robot's cameras rendered on its own truth, as in any run) and
-//! gives what ssl-vision and the referee send. The server ([`super::server`]) moves the bytes;
+//! gives what ssl-vision and the referee send. The server (module `server`) moves the bytes;
 //! tests and the lockstep mode drive it directly. Its protocol side is an [`SslLink`] that
 //! takes the simulation as an argument, so that a host owning a simulation of its own can
 //! serve the protocol beside it: [`SslSoftware`] builds the protocol robots' software, then
@@ -43,22 +43,22 @@ pub enum SslError {
 }
 
 /// One robot of either team.
-pub(super) struct SslRobot {
-    pub(super) team: TeamColor,
-    pub(super) id: u32,
+pub(crate) struct SslRobot {
+    pub(crate) team: TeamColor,
+    pub(crate) id: u32,
     /// Its index in the simulation's robots.
-    pub(super) agent: usize,
+    pub(crate) agent: usize,
     /// Its body in the world.
-    pub(super) body: usize,
+    pub(crate) body: usize,
     /// The handle its protocol commands go through (none: it runs its scenario software).
-    pub(super) remote: Option<RemoteHandle>,
-    pub(super) drive: Drive,
+    pub(crate) remote: Option<RemoteHandle>,
+    pub(crate) drive: Drive,
     /// When it last heard a command, s (none: never, or timed out since).
-    pub(super) heard_s: Option<f64>,
-    pub(super) present: bool,
-    pub(super) abilities: Abilities,
-    pub(super) radius_mm: f64,
-    pub(super) height_mm: f64,
+    pub(crate) heard_s: Option<f64>,
+    pub(crate) present: bool,
+    pub(crate) abilities: Abilities,
+    pub(crate) radius_mm: f64,
+    pub(crate) height_mm: f64,
 }
 
 /// What a cycle sends: vision's wrapper packets and the referee's packet, encoded.
@@ -90,17 +90,17 @@ pub struct Tallies {
 /// [`SslSimulator`] pairs it with its simulation; a host that owns the simulation otherwise
 /// (the Python package's) holds one beside it.
 pub struct SslLink {
-    pub(super) spec: SslSpec,
-    pub(super) robots: Vec<SslRobot>,
-    pub(super) by_id: HashMap<(TeamColor, u32), usize>,
+    pub(crate) spec: SslSpec,
+    pub(crate) robots: Vec<SslRobot>,
+    pub(crate) by_id: HashMap<(TeamColor, u32), usize>,
     vision: OverheadVision,
     referee: RefereeOut,
     last_geometry_s: Option<f64>,
     /// Simulated time over wall time the protocol asked for.
-    pub(super) speed: f64,
+    pub(crate) speed: f64,
     /// A vision port the protocol asked for.
-    pub(super) vision_port: Option<u16>,
-    pub(super) tallies: Tallies,
+    pub(crate) vision_port: Option<u16>,
+    pub(crate) tallies: Tallies,
 }
 
 /// The software of a scenario's robots under the protocol: [`Remote`] for the protocol's
@@ -281,7 +281,7 @@ impl SslLink {
         self.feedback(sim, team)
     }
 
-    pub(super) fn malformed<R>(
+    pub(crate) fn malformed<R>(
         &mut self,
         e: WireError,
         wrap: impl Fn(Vec<SimulatorError>) -> R,
@@ -295,7 +295,7 @@ impl SslLink {
     }
 
     /// Takes a team's commands; the team's feedback and the errors.
-    pub(super) fn apply_robot_control(
+    pub(crate) fn apply_robot_control(
         &mut self,
         sim: &Simulation,
         team: TeamColor,
@@ -371,7 +371,7 @@ impl SslLink {
     }
 
     /// The feedback of `team`'s robots on the field: their light barriers.
-    pub(super) fn feedback(&self, sim: &Simulation, team: TeamColor) -> Vec<RobotFeedback> {
+    pub(crate) fn feedback(&self, sim: &Simulation, team: TeamColor) -> Vec<RobotFeedback> {
         (self.robots.iter())
             .filter(|r| r.team == team && r.present)
             .map(|r| RobotFeedback {
@@ -480,7 +480,7 @@ impl SslLink {
     }
 
     /// Where absent robot `k` waits: off the floor, beyond the field's walls.
-    pub(super) fn parking(&self, sim: &Simulation, k: usize) -> Isometry2<f64> {
+    pub(crate) fn parking(&self, sim: &Simulation, k: usize) -> Isometry2<f64> {
         let f = sim.scenario().world.field.clone().unwrap_or_default();
         let y = f.half_width_mm + f.boundary_width_mm + 2000.0;
         Isometry2::new(Vector2::new(-5000.0 + 400.0 * k as f64, y), 0.0)
@@ -660,7 +660,7 @@ impl SslSimulator {
     }
 }
 
-/// What the server ([`super::server::Server`]) serves: a simulation with its [`SslLink`].
+/// What the server (`Server` of the `server` module) serves: a simulation with its [`SslLink`].
 /// [`SslSimulator`] is one; a host that owns its simulation otherwise (a session of the
 /// Python package) is another.
 pub trait SslHost {
