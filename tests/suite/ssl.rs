@@ -472,21 +472,24 @@ fn random_and_mutated_datagrams_never_stop_the_simulator() {
     steps(&mut g, 10);
 }
 
+/// The scenario served on free ports of `bind_address`, vision and the referee sent to the
+/// socket returned beside it (keep it open while the game runs).
+fn on_free_ports(bind_address: &str) -> (Scenario, UdpSocket) {
+    let mut s = scenario();
+    let sink = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let n = &mut s.ssl.as_mut().unwrap().network;
+    n.bind_address = bind_address.into();
+    (n.control_port, n.blue_port, n.yellow_port) = (0, 0, 0);
+    n.vision_address = sink.local_addr().unwrap().to_string();
+    n.referee_address = n.vision_address.clone();
+    (s, sink)
+}
+
 /// A lockstep game on free loopback ports, its files into `out`: 200 sync steps of fixed
 /// commands to blue, a teleport on the way.
 fn lockstep_game(out: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut s = scenario();
-    let ssl = s.ssl.as_mut().unwrap();
-    ssl.network.bind_address = "127.0.0.1".into();
-    (
-        ssl.network.control_port,
-        ssl.network.blue_port,
-        ssl.network.yellow_port,
-    ) = (0, 0, 0);
-    let sink = UdpSocket::bind("127.0.0.1:0").unwrap();
-    ssl.network.vision_address = sink.local_addr().unwrap().to_string();
-    ssl.network.referee_address = sink.local_addr().unwrap().to_string();
-    ssl.vision.realism.enabled = true;
+    let (mut s, _sink) = on_free_ports("127.0.0.1");
+    s.ssl.as_mut().unwrap().vision.realism.enabled = true;
     let scenario = s.clone();
     let g = SslSimulator::new(&s, &cpu()).unwrap();
     let ports = Ports::bind(g.spec()).unwrap();
@@ -605,17 +608,7 @@ fn network_address() -> std::net::IpAddr {
 
 #[test]
 fn in_real_time_floods_and_strangers_on_the_control_port_are_dropped_and_counted() {
-    let mut s = scenario();
-    let ssl = s.ssl.as_mut().unwrap();
-    ssl.network.bind_address = "0.0.0.0".into();
-    (
-        ssl.network.control_port,
-        ssl.network.blue_port,
-        ssl.network.yellow_port,
-    ) = (0, 0, 0);
-    let sink = UdpSocket::bind("127.0.0.1:0").unwrap();
-    ssl.network.vision_address = sink.local_addr().unwrap().to_string();
-    ssl.network.referee_address = sink.local_addr().unwrap().to_string();
+    let (s, _sink) = on_free_ports("0.0.0.0");
     let g = SslSimulator::new(&s, &cpu()).unwrap();
     let ports = Ports::bind(g.spec()).unwrap();
     let bound = ports.bound().unwrap();
