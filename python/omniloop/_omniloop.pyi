@@ -268,9 +268,11 @@ class Simulation:
         """With `robot="ssl"`: where the protocol's ports are (`control`, `blue`, `yellow`, and
         where `vision` and `referee` go), as `"host:port"`; `None` otherwise."""
 
-    def reset(self, seed: int | None = None) -> Observation | Any:
+    def reset(self, seed: int | None = None, scenario: Scenario | None = None) -> Observation | Any:
         """Starts the run again from its start with `seed` (default: this simulation's seed) and
-        returns the first observation (a team's: a dict of observations by robot name)."""
+        returns the first observation (a team's: a dict of observations by robot name); with
+        `scenario`, runs that scenario from now on (another placement of the same robots:
+        their names, cameras and actuators must be this one's, `ValueError` if not)."""
 
     def observe(self) -> Observation | Any:
         """The observation now (what the last `reset` or `step` returned)."""
@@ -392,9 +394,13 @@ class VectorSimulation:
     def __len__(self) -> int:
         """How many runs."""
 
-    def reset(self, index: int, seed: int | None = None) -> Observation:
+    def reset(
+        self, index: int, seed: int | None = None, scenario: Scenario | None = None
+    ) -> Observation:
         """Starts run `index` again with `seed` (default: its seed) and returns its first
-        observation."""
+        observation; with `scenario`, from that scenario instead (another placement of the
+        same robot: its robots, cameras and actuators must be this one's, `ValueError` if
+        not)."""
 
     def observe(self) -> list[Observation]:
         """Every run's observation now."""

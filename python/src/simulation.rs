@@ -159,6 +159,43 @@ pub struct Extras {
     pub truth: bool,
 }
 
+/// Why `other` cannot stand in for `base` in a run already stepped from Python: the robots
+/// (names, cameras and their sizes, drive, kicker) must be the same; where they start, the
+/// world and the ball may differ.
+pub fn same_shape(base: &Scenario, other: &Scenario) -> Result<(), String> {
+    let (names, others) = (base.robot_names(), other.robot_names());
+    if names != others {
+        return Err(format!(
+            "scenario {:?} has robots {others:?}, this run {names:?}",
+            other.name
+        ));
+    }
+    for ((a, b), name) in base.members().iter().zip(other.members()).zip(&names) {
+        let cams = |s: &Scenario| -> Vec<(String, u32, u32)> {
+            let r = &s.robot.sensors;
+            r.iter()
+                .map(|c| (c.name.clone(), c.width_px, c.height_px))
+                .collect()
+        };
+        let what = if cams(a) != cams(&b) {
+            Some("cameras (names and sizes)")
+        } else if a.robot.differential.is_some() != b.robot.differential.is_some() {
+            Some("drive")
+        } else if a.robot.kicker.is_some() != b.robot.kicker.is_some() {
+            Some("kicker")
+        } else {
+            None
+        };
+        if let Some(what) = what {
+            return Err(format!(
+                "scenario {:?}: robot {name:?} has other {what} than in this run",
+                other.name
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// One run being stepped, with what the robots' side keeps between steps.
 pub struct State {
     engine: Engine,
@@ -921,9 +958,16 @@ impl PySimulation {
     }
 
     /// Starts the run again from its start with `seed` (default: this simulation's seed) and
-    /// returns the first observation (a team's: a dict of observations by robot name).
-    #[pyo3(signature = (seed = None))]
-    fn reset(&self, py: Python<'_>, seed: Option<u64>) -> PyResult<Py<PyAny>> {
+    /// returns the first observation (a team's: a dict of observations by robot name); with
+    /// `scenario`, runs that scenario from now on (another placement of the same robots:
+    /// their names, cameras and actuators must be this one's, `ValueError` if not).
+    #[pyo3(signature = (seed = None, scenario = None))]
+    fn reset(
+        &mut self,
+        py: Python<'_>,
+        seed: Option<u64>,
+        scenario: Option<PyRef<'_, PyScenario>>,
+    ) -> PyResult<Py<PyAny>> {
         if self.drivers.contains(&Driver::Ssl) {
             return Err(PyRuntimeError::new_err(
                 "a Simulation served over the SSL protocol (robot=\"ssl\") holds its ports: it \
@@ -931,11 +975,15 @@ impl PySimulation {
                  control port)",
             ));
         }
+        if let Some(s) = &scenario {
+            same_shape(&self.scenario.scenario, &s.scenario).map_err(PyValueError::new_err)?;
+        }
         let seed = seed.unwrap_or_else(|| self.lock().seed());
+        let from = scenario.as_deref().unwrap_or(&self.scenario).clone();
         let fresh = py
             .detach(|| {
                 State::new(
-                    &self.scenario.scenario,
+                    &from.scenario,
                     seed,
                     self.renderer,
                     &self.drivers,
@@ -944,6 +992,7 @@ impl PySimulation {
                 )
             })
             .map_err(run_error)?;
+        self.scenario = from;
         let mut state = self.lock();
         *state = fresh;
         observations(py, &state)

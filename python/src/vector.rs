@@ -6,7 +6,7 @@ use crate::errors::{RenderError, RunFinishedError, run_error};
 use crate::scenario::PyScenario;
 use crate::simulation::{
     Command, Driver, Extras, NO_TRUTH, Observation, State, observation, renderer_choice,
-    truth_dict, truth_frames,
+    same_shape, truth_dict, truth_frames,
 };
 use omniloop_sim::RendererChoice;
 use omniloop_sim::render::{BatchHandle, BatchServer};
@@ -36,8 +36,16 @@ impl PyVectorSimulation {
     }
 
     fn build(&self, seed: u64) -> Result<State, omniloop::run::RunError> {
+        self.build_from(&self.scenario.scenario, seed)
+    }
+
+    fn build_from(
+        &self,
+        scenario: &omniloop::scenario::Scenario,
+        seed: u64,
+    ) -> Result<State, omniloop::run::RunError> {
         State::new(
-            &self.scenario.scenario,
+            scenario,
             seed,
             self.renderer,
             &[self.driver],
@@ -114,9 +122,16 @@ impl PyVectorSimulation {
     }
 
     /// Starts run `index` again with `seed` (default: its seed) and returns its first
-    /// observation.
-    #[pyo3(signature = (index, seed = None))]
-    fn reset(&self, py: Python<'_>, index: usize, seed: Option<u64>) -> PyResult<Observation> {
+    /// observation; with `scenario`, from that scenario instead (another placement of the
+    /// same robot: its robots, cameras and actuators must be this one's, `ValueError` if not).
+    #[pyo3(signature = (index, seed = None, scenario = None))]
+    fn reset(
+        &self,
+        py: Python<'_>,
+        index: usize,
+        seed: Option<u64>,
+        scenario: Option<PyRef<'_, PyScenario>>,
+    ) -> PyResult<Observation> {
         let old_seed = {
             let states = self.lock();
             let s = states
@@ -124,8 +139,16 @@ impl PyVectorSimulation {
                 .ok_or_else(|| PyIndexError::new_err(format!("run {index} of {}", states.len())))?;
             s.seed()
         };
+        let base = &self.scenario.scenario;
+        let from = match &scenario {
+            Some(s) => {
+                same_shape(base, &s.scenario).map_err(PyValueError::new_err)?;
+                &s.scenario
+            }
+            None => base,
+        };
         let fresh = py
-            .detach(|| self.build(seed.unwrap_or(old_seed)))
+            .detach(|| self.build_from(from, seed.unwrap_or(old_seed)))
             .map_err(run_error)?;
         let mut states = self.lock();
         states[index] = fresh;
