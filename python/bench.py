@@ -9,7 +9,8 @@ Prints a table: the command line's cycles/s (`omniloop run`, from its summary.js
 cycles alone), the same run through `omniloop.run`, `Simulation.step` with the built-in robot
 (the same cycle, driven from Python: the overhead of the boundary) and with a Python robot
 (a proportional controller toward the goal on dead reckoning: render, physics and the
-frame handed to NumPy), and the vector environment's steps/s at 1, 4 and 16 runs.
+frame handed to NumPy), and the vector environment's steps/s at 1, 4 and 16 runs, then with
+the panorama observation (``omniloop.gym.VectorPanoramaObservation``) beside the raw image.
 """
 
 from __future__ import annotations
@@ -88,10 +89,14 @@ def python_steps_per_s(scenario: omniloop.Scenario, steps: int) -> float:
     return n / (time.perf_counter() - start)
 
 
-def vector_steps_per_s(scenario: omniloop.Scenario, num_envs: int, steps: int) -> float:
+def vector_steps_per_s(
+    scenario: omniloop.Scenario, num_envs: int, steps: int, panorama: bool = False
+) -> float:
     import omniloop.gym
 
     env = omniloop.gym.make_vec(scenario, num_envs=num_envs)
+    if panorama:
+        env = omniloop.gym.VectorPanoramaObservation(env)
     obs, _ = env.reset(seed=1)
     start = time.perf_counter()
     for _ in range(steps):
@@ -110,6 +115,8 @@ def main() -> int:
     ap.add_argument("--rounds", type=int, default=3, help="medians of this many rounds")
     ap.add_argument("--steps", type=int, default=150, help="steps a round (vector, python)")
     ap.add_argument("--envs", default="1,4,16", help="vector sizes")
+    ap.add_argument("--panorama-envs", type=int, default=16,
+                    help="vector size of the panorama against the raw image")
     args = ap.parse_args()
     scenario = omniloop.Scenario.load(SCENARIO)
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
@@ -132,7 +139,17 @@ def main() -> int:
     for n in (int(x) for x in args.envs.split(",")):
         v = median_of(args.rounds, lambda: vector_steps_per_s(scenario, n, args.steps))
         rows.append((f"vector env, {n} runs, env steps/s", v, None))
-    print("| what | per second | step cost over the command line's cycle |")
+    # The panorama (omniloop.panorama, 128 x 16 by default) against the raw image, rounds
+    # taken in turn so that both see the machine alike.
+    n = args.panorama_envs
+    raw, pano = [], []
+    for _ in range(args.rounds):
+        raw.append(vector_steps_per_s(scenario, n, args.steps))
+        pano.append(vector_steps_per_s(scenario, n, args.steps, panorama=True))
+    raw_v, pano_v = statistics.median(raw), statistics.median(pano)
+    rows.append((f"vector env, {n} runs, raw image, env steps/s", raw_v, None))
+    rows.append((f"vector env, {n} runs, panorama, env steps/s", pano_v, raw_v / pano_v - 1.0))
+    print("| what | per second | step cost over the command line's cycle (panorama: over the raw image's step) |")
     print("|---|---:|---:|")
     for name, value, overhead in rows:
         extra = "" if overhead is None else f"{100.0 * overhead:+.1f}%"

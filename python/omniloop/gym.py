@@ -1,6 +1,7 @@
 """Gymnasium environments of omniloop scenarios (``pip install "omniloop[gym]"``).
 
-Importing this module registers ``omniloop/Scenario-v0``::
+Importing this module registers ``omniloop/Scenario-v0`` (and ``omniloop/BlackoutGrab-v0``, the
+vision-blackout challenge's first stage as a learning task: ``omniloop.grab``)::
 
     import gymnasium
     import omniloop.gym
@@ -40,6 +41,9 @@ Importing this module registers ``omniloop/Scenario-v0``::
   ``uint16`` ``H x W``, and ``"legend"``), for perception's losses and scores; never in the
   observation. The vector environment gives it as an object array of these dicts, one a run.
 - ``render_mode="rgb_array"``: ``render()`` returns a top view of the moment.
+- ``PanoramaObservation(env)`` (``VectorPanoramaObservation`` for the vector environment)
+  gives each mirror camera's image as its panorama strip (``omniloop.panorama``): azimuth
+  across, elevation down, the robot's heading a circular shift of the columns.
 
 Seeds: ``reset(seed=s)`` runs with seed ``s``; ``reset()`` without one runs the scenario's
 seed the first time and the previous episode's seed plus one after, so that every episode is
@@ -150,9 +154,24 @@ class _Task:
         if self.goal is not None:
             parts["goal"] = spaces.Box(-np.inf, np.inf, (2,), dtype=np.float32)
         self.observation_space = spaces.Dict(parts)
+        #: Cameras given as their panorama, by name (``use_panorama``).
+        self.panoramas: dict[str, Any] = {}
+
+    def use_panorama(self, scenario: Scenario, robot: Optional[str], settings: dict[str, Any]) -> None:
+        """Gives each mirror camera's image as its panorama (``omniloop.panorama``)."""
+        from .panorama import Panorama
+
+        info = scenario.robots[robot] if robot is not None else scenario.robot
+        for s in info["sensors"]:
+            if s["kind"] != "pinhole":
+                pano = Panorama.of(scenario, s["name"], robot, **settings)
+                self.panoramas[s["name"]] = pano
+                self.observation_space[s["name"]] = spaces.Box(0, 255, pano.shape, dtype=np.uint8)
 
     def observation(self, obs: Observation) -> dict[str, np.ndarray]:
         out: dict[str, np.ndarray] = {name: obs.frames[name] for name, _, _ in self.sensors}
+        for name, pano in self.panoramas.items():
+            out[name] = pano(out[name])
         o = obs.odometry
         out["odometry"] = np.array([o.vx_mm_s, o.vy_mm_s, o.omega_rad_s], dtype=np.float32)
         if self.kicker is not None:
@@ -375,6 +394,61 @@ class OmniloopVectorEnv(VectorEnv):
         return infos
 
 
+def _panorama_spaces(
+    space: spaces.Dict, scenario: Scenario, sensors: Optional[Sequence[str]], settings: dict[str, Any]
+) -> tuple[dict[str, Any], spaces.Dict]:
+    """The panoramas of ``sensors`` (default: every mirror camera of the observation) and the
+    observation space with their strips in place of their images."""
+    from .panorama import Panorama
+
+    mirrors = [s["name"] for s in scenario.robot["sensors"] if s["kind"] != "pinhole"]
+    names = list(mirrors if sensors is None else sensors)
+    unknown = [n for n in names if n not in space.spaces]
+    if unknown or not names:
+        raise ValueError(
+            f"sensors={sensors!r}: cameras of the observation to unwarp (its mirror cameras: "
+            f"{', '.join(mirrors) or 'none'})"
+        )
+    panos = {n: Panorama.of(scenario, n, **settings) for n in names}
+    parts = dict(space.spaces)
+    for n, p in panos.items():
+        parts[n] = spaces.Box(0, 255, p.shape, dtype=np.uint8)
+    return panos, spaces.Dict(parts)
+
+
+class PanoramaObservation(gymnasium.ObservationWrapper):
+    """An ``omniloop/Scenario-v0`` environment whose mirror cameras' images (or ``sensors``')
+    are given as their panoramas (``omniloop.panorama.Panorama``; ``settings`` its keyword
+    arguments: ``width_px``, ``height_px``, ``elevation_deg`` or ``floor_mm``, ``samples``)."""
+
+    def __init__(self, env: gymnasium.Env, sensors: Optional[Sequence[str]] = None,
+                 **settings: Any) -> None:
+        super().__init__(env)
+        scenario: Scenario = env.get_wrapper_attr("scenario")
+        self.panoramas, self.observation_space = _panorama_spaces(
+            env.observation_space, scenario, sensors, settings  # type: ignore[arg-type]
+        )
+
+    def observation(self, observation: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {k: (self.panoramas[k](v) if k in self.panoramas else v) for k, v in observation.items()}
+
+
+class VectorPanoramaObservation(gymnasium.vector.VectorObservationWrapper):
+    """``PanoramaObservation`` for the vector environment: each batch of images is unwarped at
+    once."""
+
+    def __init__(self, env: VectorEnv, sensors: Optional[Sequence[str]] = None, **settings: Any) -> None:
+        super().__init__(env)
+        scenario: Scenario = getattr(env.unwrapped, "scenario")
+        self.panoramas, self.single_observation_space = _panorama_spaces(
+            env.single_observation_space, scenario, sensors, settings  # type: ignore[arg-type]
+        )
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+
+    def observations(self, observations: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {k: (self.panoramas[k](v) if k in self.panoramas else v) for k, v in observations.items()}
+
+
 def make_vec(
     scenario: ScenarioLike, num_envs: int, renderer: str = "cpu", **kwargs: Any
 ) -> OmniloopVectorEnv:
@@ -387,5 +461,14 @@ gymnasium.register(
     entry_point="omniloop.gym:OmniloopEnv",
     vector_entry_point="omniloop.gym:OmniloopVectorEnv",
 )
+# The vision-blackout challenge's first stage as a learning task (``omniloop.grab``).
+gymnasium.register(
+    id="omniloop/BlackoutGrab-v0",
+    entry_point="omniloop.grab:GrabEnv",
+    vector_entry_point="omniloop.grab:GrabVectorEnv",
+)
 
-__all__ = ["ENV_ID", "OmniloopEnv", "OmniloopVectorEnv", "make_vec"]
+__all__ = [
+    "ENV_ID", "OmniloopEnv", "OmniloopVectorEnv", "PanoramaObservation",
+    "VectorPanoramaObservation", "make_vec",
+]

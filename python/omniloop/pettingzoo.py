@@ -27,7 +27,9 @@ observation).
 
 An agent whose robot reached its goal (on the truth) is terminated and leaves ``agents``; its
 robot stands still from then on, an obstacle for the others. When the run's time is up, the
-agents left are truncated. ``builtin=["r5", ...]`` runs those robots on the scenario's own
+agents left are truncated. ``panorama={}`` (or its settings: ``{"width_px": 128, ...}``) gives
+every agent's mirror cameras as their panoramas (``omniloop.panorama``), as
+``omniloop.gym.PanoramaObservation`` does. ``builtin=["r5", ...]`` runs those robots on the scenario's own
 software (they are no agents): five built-in robots and one policy share one floor.
 
 Seeds: ``reset(seed=s)`` runs with seed ``s`` (the images' and odometry's noise of every
@@ -73,6 +75,7 @@ class OmniloopParallelEnv(ParallelEnv):  # type: ignore[misc]
         max_omega_rad_s: Optional[float] = None,
         builtin: Sequence[str] = (),
         render_width_px: int = 640,
+        panorama: Optional[dict[str, Any]] = None,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
@@ -90,6 +93,9 @@ class OmniloopParallelEnv(ParallelEnv):  # type: ignore[misc]
         self._tasks = {
             n: _Task(robots[n], contact_penalty, max_omega_rad_s) for n in self.possible_agents
         }
+        if panorama is not None:
+            for n, task in self._tasks.items():
+                task.use_panorama(self.scenario, n, dict(panorama))
         drivers = {n: ("builtin" if n in builtin else "python") for n in robots}
         self.render_mode = render_mode
         self.render_width_px = render_width_px
