@@ -49,3 +49,11 @@ pub use omniloop_vision as vision;
 
 /// A complete, commented scenario showing every key with its default.
 pub const DEFAULT_SCENARIO: &str = include_str!("default_scenario.toml");
+
+/// Scenario files built into the library, `(name, text)` with the name the file's stem under
+/// `scenarios/`: for programs without the repository beside them (the Python package ships no
+/// `scenarios/`; `omniloop.Scenario.bundled(name)`). One line here bundles another.
+pub const BUNDLED_SCENARIOS: &[(&str, &str)] = &[(
+    "blackout_stage1",
+    include_str!("../scenarios/blackout_stage1.toml"),
+)];

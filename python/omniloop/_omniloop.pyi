@@ -89,6 +89,11 @@ class Scenario:
         """Parses and validates scenario text (messages name it `<string>`); `name` is its name
         when the text gives none (default `scenario`)."""
 
+    @staticmethod
+    def bundled(name: str) -> Scenario:
+        """A scenario file built into omniloop (`omniloop::BUNDLED_SCENARIOS`: `"blackout_stage1"`),
+        its text as `scenarios/NAME.toml` holds it; raises `ValueError` naming the others."""
+
     def with_values(self, values: dict[str, Any]) -> Scenario:
         """A new scenario with each dotted key (`"robot.max_speed_mm_s"`,
         `"robot.sensors[0].noise_sigma"`, `"seed"`) set to its value, validated as

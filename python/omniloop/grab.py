@@ -18,9 +18,11 @@ Placements (drawn from the episode's seed, so every episode is reproducible):
   defense areas, the ball at least 400 mm from the robot (``omniloop replay blackout``'s
   stage-1 trials).
 
-The robot is ``scenarios/blackout_stage1.toml``'s: E1's hyperbolic mirror camera (256 x 220,
-noise sigma 4) on a 90 mm body with the league's kicker, 1.5 m/s and 2 m/s^2, wheel odometry
-with its errors. The dribbler spins at its full speed throughout; the kicker is never armed.
+The robot is ``scenarios/blackout_stage1.toml``'s (built into omniloop:
+``Scenario.bundled("blackout_stage1")``): E1's hyperbolic mirror camera (256 x 220, noise sigma
+4) on a 90 mm body with the league's kicker, 1.5 m/s and 2 m/s^2, wheel odometry with its
+errors. The dribbler spins at its full speed throughout; the kicker is never armed. The
+settings are ``GrabConfig``'s fields.
 
 - Observation (``observation=``): ``"panorama"`` (default: the camera's panorama, ``uint8``
   ``H x W x 3``, ``omniloop.panorama.Panorama`` with ``panorama=`` its settings),
@@ -49,6 +51,7 @@ with its errors. The dribbler spins at its full speed throughout; the kicker is 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, fields
 from typing import Any, Optional, Sequence, Union
 
 import numpy as np
@@ -60,6 +63,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import Observation, Scenario, Simulation, VectorSimulation
+from .gym import RunSeeds
 from .panorama import Panorama
 from .types import Truth
 
@@ -72,60 +76,43 @@ PLACEMENTS = ("2019", "2021")
 HALF_LENGTH_MM, HALF_WIDTH_MM, MARGIN_MM = 2000.0, 1500.0, 300.0
 DEFENSE_DEPTH_MM, DEFENSE_HALF_WIDTH_MM = 800.0, 1000.0
 
-SCENARIO_TOML = """
-description = "Vision blackout, stage 1, as a learning task: grab the ball on the robot's own camera."
-seed = 1
-
-[run]
-duration_s = 60.0
-stop_at_goal = false
-
-[world.field]
-preset = "hardware_challenge"
-
-[world.ball]
-center_mm = [900.0, 600.0]
-
-[robot]
-start = { x_mm = -1200.0, y_mm = -700.0, heading_deg = -90.0 }
-radius_mm = 90.0
-height_mm = 150.0
-max_speed_mm_s = 1500.0
-accel_limit_mm_s2 = 2000.0
-
-[robot.kicker]
-front_mm = 75.0
-dribbler_width_mm = 60.0
-
-[[robot.sensors]]
-name = "omni"
-width_px = 256
-height_px = 220
-noise_sigma = 4.0
-[robot.sensors.hyperbolic]
-a_mm = 12.129
-b_mm = 15.650
-c_mm = 19.8
-focal_px = 479.37
-focus_height_mm = 205.08
-rim_radius_mm = 30.0
-
-[odometry]
-speed_noise_frac = 0.03
-scale_bias_frac = 0.04
-omega_bias_rad_s = 0.01
-
-[control]
-kind = "striker"
-
-[control.striker]
-task = "grab"
-"""
-
-
 def default_scenario() -> Scenario:
-    """The task's scenario (``scenarios/blackout_stage1.toml``'s robot and field, 60 s)."""
-    return Scenario.from_toml(SCENARIO_TOML, name="blackout_grab")
+    """The task's scenario: ``scenarios/blackout_stage1.toml``, built into omniloop
+    (``Scenario.bundled``); the task sets its run's length and each episode's placement."""
+    return Scenario.bundled("blackout_stage1")
+
+
+@dataclass(frozen=True)
+class GrabConfig:
+    """The task's settings: the keyword arguments of ``GrabEnv``, ``GrabVectorEnv``,
+    ``make_vec`` and ``gymnasium.make(ENV_ID, ...)``, checked by ``GrabTask``."""
+
+    #: ``"panorama"``, ``"image"`` or ``"state"`` (see the module's documentation).
+    observation: str = "panorama"
+    #: ``"2019"`` or ``"2021"``: the rules the placements follow.
+    placements: str = "2019"
+    #: An episode's length (the rules' minute), s.
+    time_limit_s: float = 60.0
+    #: The turn rate an action of 1 asks for, rad/s.
+    max_omega_rad_s: float = 4.0
+    #: ``omniloop.panorama.Panorama``'s settings (``width_px``, ``height_px``, ...).
+    panorama: Optional[dict[str, Any]] = None
+    #: Images or strips in an observation, and the steps between them.
+    stack: int = 1
+    stack_every: int = 1
+    #: Another robot (default: ``default_scenario()``); it needs a kicker and a camera.
+    scenario: Optional[Scenario] = None
+    #: ``"cpu"`` (bit-reproducible) or ``"gpu"``.
+    renderer: str = "cpu"
+
+    @staticmethod
+    def of(settings: dict[str, Any]) -> GrabConfig:
+        """The settings from keyword arguments; raises ``ValueError`` naming an unknown one."""
+        known = [f.name for f in fields(GrabConfig)]
+        for key in settings:
+            if key not in known:
+                raise ValueError(f"{key}=: no such setting of {ENV_ID}; one of {', '.join(known)}")
+        return GrabConfig(**settings)
 
 
 def placement(seed: int, kind: str = "2019") -> tuple[tuple[float, float, float], tuple[float, float]]:
@@ -196,17 +183,10 @@ class GrabTask:
     """What the single and the vector environment share: the placements' scenarios, the
     spaces, observation, reward and ends."""
 
-    def __init__(
-        self,
-        scenario: Optional[Scenario],
-        observation: str,
-        placements: str,
-        time_limit_s: float,
-        max_omega_rad_s: float,
-        panorama: Optional[dict[str, Any]],
-        stack: int = 1,
-        stack_every: int = 1,
-    ) -> None:
+    def __init__(self, config: GrabConfig = GrabConfig()) -> None:
+        self.config = c = config
+        observation, placements, stack = c.observation, c.placements, c.stack
+        time_limit_s, max_omega_rad_s = float(c.time_limit_s), float(c.max_omega_rad_s)
         if observation not in OBSERVATIONS:
             raise ValueError(f"observation={observation!r}: one of {', '.join(OBSERVATIONS)}")
         if placements not in PLACEMENTS:
@@ -215,7 +195,7 @@ class GrabTask:
             raise ValueError(f"time_limit_s={time_limit_s}: above 0 and at most 600")
         if not (math.isfinite(max_omega_rad_s) and max_omega_rad_s > 0.0):
             raise ValueError(f"max_omega_rad_s={max_omega_rad_s}: a finite number > 0")
-        base = default_scenario() if scenario is None else scenario
+        base = default_scenario() if c.scenario is None else c.scenario
         robot = base.robot
         if robot["kicker"] is None or not robot["sensors"]:
             raise ValueError(f"scenario {base.name!r}: the task needs a robot with a kicker and a camera")
@@ -227,12 +207,12 @@ class GrabTask:
         self.max_omega = float(max_omega_rad_s)
         self.full_rpm = float(robot["kicker"]["full_pull_rpm"])
         self.panorama = (
-            Panorama.of(self.base, self.camera, **(panorama or {}))
+            Panorama.of(self.base, self.camera, **(c.panorama or {}))
             if observation == "panorama" else None
         )
         self.stack = 1 if observation == "state" else stack
-        FrameHistory(stack, stack_every)  # checks them
-        self.stack_every = stack_every
+        FrameHistory(stack, c.stack_every)  # checks them
+        self.stack_every = c.stack_every
         self.observation_space = spaces.Dict(self._parts(robot))
         self.action_space = spaces.Box(-1.0, 1.0, (3,), dtype=np.float32)
 
@@ -332,29 +312,16 @@ class GrabEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
 
-    def __init__(
-        self,
-        observation: str = "panorama",
-        placements: str = "2019",
-        time_limit_s: float = 60.0,
-        max_omega_rad_s: float = 4.0,
-        panorama: Optional[dict[str, Any]] = None,
-        stack: int = 1,
-        stack_every: int = 1,
-        scenario: Optional[Scenario] = None,
-        renderer: str = "cpu",
-        render_mode: Optional[str] = None,
-    ) -> None:
+    def __init__(self, render_mode: Optional[str] = None, **settings: Any) -> None:
+        """``settings``: ``GrabConfig``'s fields."""
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
-        self.task = GrabTask(
-            scenario, observation, placements, time_limit_s, max_omega_rad_s, panorama, stack, stack_every
-        )
-        self._history = FrameHistory(self.task.stack, stack_every)
+        self.task = GrabTask(GrabConfig.of(settings))
+        self._history = FrameHistory(self.task.stack, self.task.stack_every)
         self.observation_space = self.task.observation_space
         self.action_space = self.task.action_space
         self.render_mode = render_mode
-        self.sim = Simulation(self.task.base, renderer=renderer)
+        self.sim = Simulation(self.task.base, renderer=self.task.config.renderer)
         self._seed: Optional[int] = None
         self._truth: Truth = self.sim.truth()
 
@@ -400,31 +367,18 @@ class GrabVectorEnv(VectorEnv):
 
     metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
-    def __init__(
-        self,
-        num_envs: int,
-        observation: str = "panorama",
-        placements: str = "2019",
-        time_limit_s: float = 60.0,
-        max_omega_rad_s: float = 4.0,
-        panorama: Optional[dict[str, Any]] = None,
-        stack: int = 1,
-        stack_every: int = 1,
-        scenario: Optional[Scenario] = None,
-        renderer: str = "cpu",
-    ) -> None:
-        self.task = GrabTask(
-            scenario, observation, placements, time_limit_s, max_omega_rad_s, panorama, stack, stack_every
-        )
-        self._history = FrameHistory(self.task.stack, stack_every)
+    def __init__(self, num_envs: int, **settings: Any) -> None:
+        """``settings``: ``GrabConfig``'s fields."""
+        self.task = GrabTask(GrabConfig.of(settings))
+        self._history = FrameHistory(self.task.stack, self.task.stack_every)
         self.num_envs = int(num_envs)
         self.single_observation_space = self.task.observation_space
         self.single_action_space = self.task.action_space
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.render_mode = None
-        self.vec = VectorSimulation(self.task.base, self.num_envs, renderer=renderer)
-        self._seeds: Optional[list[int]] = None
+        self.vec = VectorSimulation(self.task.base, self.num_envs, renderer=self.task.config.renderer)
+        self._seeds = RunSeeds(self.num_envs, 1)
         self._truths: list[Truth] = self.vec.truth()
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
 
@@ -437,20 +391,11 @@ class GrabVectorEnv(VectorEnv):
         seed: Optional[Union[int, Sequence[int]]] = None,
         options: Optional[dict[str, Any]] = None,
     ) -> tuple[dict[str, npt.NDArray[Any]], dict[str, Any]]:
-        n = self.num_envs
-        if seed is None:
-            seeds = [1 + i for i in range(n)] if self._seeds is None else [s + n for s in self._seeds]
-        elif isinstance(seed, int):
-            seeds = [seed + i for i in range(n)]
-        else:
-            seeds = [int(s) for s in seed]
-            if len(seeds) != n:
-                raise ValueError(f"{len(seeds)} seeds for {n} runs")
-        self._seeds = seeds
+        seeds = self._seeds.reset(seed)
         obs = [self._start(i, s) for i, s in enumerate(seeds)]
         self._truths = self.vec.truth()
         self._autoreset[:] = False
-        fresh = np.ones(n, dtype=bool)
+        fresh = np.ones(self.num_envs, dtype=bool)
         infos = {"seed": np.array(seeds), "state": self._states(self._truths)}
         return self.task.batch(obs, self._truths, self._history, fresh), infos
 
@@ -458,14 +403,12 @@ class GrabVectorEnv(VectorEnv):
         self, actions: Any
     ) -> tuple[dict[str, npt.NDArray[Any]], npt.NDArray[np.float64], npt.NDArray[np.bool_],
                npt.NDArray[np.bool_], dict[str, Any]]:
-        if self._seeds is None:
-            raise RuntimeError("call reset() before step()")
+        self._seeds.check_started()
         acts = np.asarray(actions, dtype=np.float64).reshape(self.num_envs, -1)
         commands = [self.task.command(a) for a in acts]
         resetting = self._autoreset.copy()
         for k in np.flatnonzero(resetting):
-            self._seeds[k] += self.num_envs
-            self._start(int(k), self._seeds[k])
+            self._start(int(k), self._seeds.next(int(k)))
         motions = np.stack([m for m, _ in commands])
         obs = self.vec.step(motions, active=[not r for r in resetting], actuators=[a for _, a in commands])
         truths = self.vec.truth()
@@ -482,25 +425,24 @@ class GrabVectorEnv(VectorEnv):
         self._truths = truths
         self._autoreset = terminated | truncated
         infos = {
-            "success": success, "time_s": time_s, "seed": np.array(self._seeds),
+            "success": success, "time_s": time_s, "seed": np.array(self._seeds.check_started()),
             "state": self._states(truths),
         }
         batch = self.task.batch(obs, truths, self._history, resetting)
         return batch, rewards, terminated, truncated, infos
-
 
     @staticmethod
     def _states(truths: list[Truth]) -> npt.NDArray[np.float32]:
         return np.stack([ball_state(t) for t in truths])
 
 
-def make_vec(num_envs: int, **kwargs: Any) -> GrabVectorEnv:
-    """``num_envs`` runs of the task (see ``GrabVectorEnv``; ``kwargs`` as ``GrabEnv``'s)."""
-    return GrabVectorEnv(num_envs, **kwargs)
+def make_vec(num_envs: int, **settings: Any) -> GrabVectorEnv:
+    """``num_envs`` runs of the task (see ``GrabVectorEnv``; ``settings``: ``GrabConfig``'s fields)."""
+    return GrabVectorEnv(num_envs, **settings)
 
 
 __all__ = [
-    "ENV_ID", "FrameHistory", "GrabEnv", "GrabTask", "GrabVectorEnv", "ball_polar", "ball_state",
+    "ENV_ID", "FrameHistory", "GrabConfig", "GrabEnv", "GrabTask", "GrabVectorEnv", "ball_polar", "ball_state",
     "default_scenario",
     "make_vec", "placement",
 ]

@@ -287,6 +287,43 @@ class OmniloopEnv(gymnasium.Env):
         return None
 
 
+class RunSeeds:
+    """The episode seeds of a vector environment's runs. ``reset(s)`` gives run ``i`` seed
+    ``s + i`` (or each run its own from a sequence of ``num_envs``); ``reset(None)`` gives
+    run ``i`` ``first + i`` the first time and its previous seed plus ``num_envs`` after;
+    ``next(i)``, at the end of run ``i``'s episode, moves its seed up by ``num_envs``. Each
+    run keeps to its own residue modulo ``num_envs``: no two episodes share a seed."""
+
+    def __init__(self, num_envs: int, first: int) -> None:
+        self.num_envs, self.first = int(num_envs), int(first)
+        self.seeds: Optional[list[int]] = None
+
+    def reset(self, seed: Optional[Union[int, Sequence[int]]]) -> list[int]:
+        n = self.num_envs
+        if seed is None:
+            seeds = [self.first + i for i in range(n)] if self.seeds is None else [s + n for s in self.seeds]
+        elif isinstance(seed, int):
+            seeds = [seed + i for i in range(n)]
+        else:
+            seeds = [int(s) for s in seed]
+            if len(seeds) != n:
+                raise ValueError(f"{len(seeds)} seeds for {n} runs")
+        self.seeds = seeds
+        return list(seeds)
+
+    def check_started(self) -> list[int]:
+        """The runs' seeds; raises ``RuntimeError`` before the first ``reset``."""
+        if self.seeds is None:
+            raise RuntimeError("call reset() before step()")
+        return self.seeds
+
+    def next(self, run: int) -> int:
+        """Run ``run``'s next episode seed (its episode ended)."""
+        seeds = self.check_started()
+        seeds[run] += self.num_envs
+        return seeds[run]
+
+
 class OmniloopVectorEnv(VectorEnv):
     """N runs of one scenario stepped together in Rust, in parallel on the cores (and in
     shared GPU batches on a GPU renderer); Gymnasium's next-step autoreset: the step after an
@@ -315,7 +352,7 @@ class OmniloopVectorEnv(VectorEnv):
         self.vec = VectorSimulation(
             self.scenario, self.num_envs, renderer=renderer, truth=self.truth_frames
         )
-        self._seeds: Optional[list[int]] = None
+        self._seeds = RunSeeds(self.num_envs, self.scenario.seed)
         self._truths = self.vec.truth()
         self._autoreset = np.zeros(self.num_envs, dtype=bool)
 
@@ -326,17 +363,7 @@ class OmniloopVectorEnv(VectorEnv):
         options: Optional[dict[str, Any]] = None,
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         super().reset(seed=None if seed is None or not isinstance(seed, int) else seed)
-        n = self.num_envs
-        if seed is None:
-            base = self.scenario.seed if self._seeds is None else self._seeds[0] + n
-            seeds = [base + i for i in range(n)]
-        elif isinstance(seed, int):
-            seeds = [seed + i for i in range(n)]
-        else:
-            seeds = [int(s) for s in seed]
-            if len(seeds) != n:
-                raise ValueError(f"{len(seeds)} seeds for {n} runs")
-        self._seeds = seeds
+        seeds = self._seeds.reset(seed)
         obs = [self.vec.reset(i, s) for i, s in enumerate(seeds)]
         self._truths = self.vec.truth()
         self._autoreset[:] = False
@@ -345,8 +372,7 @@ class OmniloopVectorEnv(VectorEnv):
     def step(
         self, actions: Any
     ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
-        if self._seeds is None:
-            raise RuntimeError("call reset() before step()")
+        self._seeds.check_started()
         actions = np.asarray(actions, dtype=np.float64)
         n = self.num_envs
         if actions.shape[0] != n:
@@ -356,8 +382,7 @@ class OmniloopVectorEnv(VectorEnv):
         kicks = None if self._task.kicker is None else [k for _, k in split]
         resetting = self._autoreset.copy()
         for k in np.flatnonzero(resetting):
-            self._seeds[k] += n
-            self.vec.reset(int(k), self._seeds[k])
+            self.vec.reset(int(k), self._seeds.next(int(k)))
         obs = self.vec.step(motions, active=[not r for r in resetting], actuators=kicks)
         truths = self.vec.truth()
         rewards = np.zeros(n, dtype=np.float64)
@@ -469,6 +494,6 @@ gymnasium.register(
 )
 
 __all__ = [
-    "ENV_ID", "OmniloopEnv", "OmniloopVectorEnv", "PanoramaObservation",
+    "ENV_ID", "OmniloopEnv", "OmniloopVectorEnv", "PanoramaObservation", "RunSeeds",
     "VectorPanoramaObservation", "make_vec",
 ]

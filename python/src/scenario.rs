@@ -64,6 +64,29 @@ impl PyScenario {
         })
     }
 
+    /// A scenario file built into omniloop (`omniloop::BUNDLED_SCENARIOS`: `"blackout_stage1"`),
+    /// its text as `scenarios/NAME.toml` holds it; raises `ValueError` naming the others.
+    #[staticmethod]
+    fn bundled(name: &str) -> PyResult<Self> {
+        let Some((_, text)) = omniloop::BUNDLED_SCENARIOS.iter().find(|(n, _)| *n == name) else {
+            let known: Vec<&str> = omniloop::BUNDLED_SCENARIOS
+                .iter()
+                .map(|(n, _)| *n)
+                .collect();
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "no bundled scenario {name:?}: one of {}",
+                known.join(", ")
+            )));
+        };
+        let file = PathBuf::from(format!("scenarios/{name}.toml"));
+        let scenario = parse_scenario(text, &file, name).map_err(load_error)?;
+        Ok(Self {
+            scenario,
+            text: text.to_string(),
+            file,
+        })
+    }
+
     /// A new scenario with each dotted key (`"robot.max_speed_mm_s"`,
     /// `"robot.sensors[0].noise_sigma"`, `"seed"`) set to its value, validated as
     /// `omniloop sweep --set` validates; raises `ScenarioError` naming the key.

@@ -125,6 +125,18 @@ def test_the_vector_env_resets_a_finished_run_on_the_next_step(smoke):
     assert list(vec.vec.seeds) == [7, 8], "a new episode, a new seed"
 
 
+def test_run_seeds_never_give_two_episodes_one_seed():
+    seeds = omniloop.gym.RunSeeds(3, first=10)
+    with pytest.raises(RuntimeError, match="reset"):
+        seeds.next(0)
+    assert seeds.reset(None) == [10, 11, 12]
+    assert [seeds.next(0), seeds.next(0), seeds.next(2)] == [13, 16, 15]
+    assert seeds.reset(None) == [19, 14, 18], "each run its previous seed plus 3"
+    assert seeds.reset(4) == [4, 5, 6]
+    with pytest.raises(ValueError, match="2 seeds for 3 runs"):
+        seeds.reset([1, 2])
+
+
 def test_bad_actions_raise(smoke):
     env = omniloop.gym.OmniloopEnv(smoke)
     env.reset(seed=1)

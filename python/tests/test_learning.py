@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 @pytest.fixture(scope="module")
 def task() -> grab.GrabTask:
-    return grab.GrabTask(None, "panorama", "2019", 10.0, 4.0, None)
+    return grab.GrabTask(grab.GrabConfig(time_limit_s=10.0))
 
 
 def strip_at(task: grab.GrabTask, heading_deg: float, ball: tuple[float, float]) -> np.ndarray:
@@ -180,6 +180,15 @@ def test_the_task_environment() -> None:
     assert set(a) == {"panorama", "odometry", "ball_in_dribbler"}  # never the truth
     with pytest.raises(ValueError, match="observation"):
         grab.GrabEnv(observation="truth")
+    with pytest.raises(ValueError, match="stak=: no such setting"):
+        gymnasium.make("omniloop/BlackoutGrab-v0", stak=3)
+
+
+def test_the_task_runs_the_bundled_blackout_scenario() -> None:
+    on_disk = omniloop.Scenario.load(ROOT / "scenarios" / "blackout_stage1.toml")
+    assert grab.default_scenario().to_toml() == on_disk.to_toml()
+    with pytest.raises(ValueError, match='no bundled scenario "nope": one of blackout_stage1'):
+        omniloop.Scenario.bundled("nope")
 
 
 def drive_to_ball(obs: dict[str, np.ndarray]) -> np.ndarray:
