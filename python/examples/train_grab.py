@@ -417,7 +417,7 @@ def evaluate(
 def striker(placements: str, count: int, limit_s: float) -> dict[str, Any]:
     """The built-in striker (its hand-written ball detector on the mirror image) on the same
     held-out placements."""
-    task = grab.GrabTask(None, "state", placements, limit_s, 4.0, None)
+    task = grab.GrabTask(grab.GrabConfig(observation="state", placements=placements, time_limit_s=limit_s))
     outcomes = {}
     for k in range(count):
         seed = HELD_OUT + k
@@ -525,9 +525,19 @@ def curves(root: Path) -> dict[str, list[np.ndarray]]:
     return found
 
 
+def finals_of(kind_dir: Path) -> np.ndarray:
+    """Each seed's final evaluation under ``kind_dir``: (steps, wall s, 2019 success rate)."""
+    rows = []
+    for path in sorted(kind_dir.glob("seed-*/eval.json")):
+        e = json.loads(path.read_text())
+        rows.append([e["env_steps"], e["train_wall_s"], e["eval"]["2019"]["success_rate"]])
+    return np.array(rows).reshape(-1, 3)
+
+
 def plot(root: Path) -> Path:
     """``root/learning.png``: held-out success against environment steps and against training
-    wall time, the mean of the seeds and their spread (min to max), beside the baselines."""
+    wall time, the mean of the seeds and their spread (min to max), each seed's final policy
+    (circles), beside the baselines."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -537,21 +547,30 @@ def plot(root: Path) -> Path:
     for kind, runs in curves(root).items():
         n = min(len(r) for r in runs)
         rates = np.stack([r[:n, 2] for r in runs])
+        finals = finals_of(root / kind)
         for ax, col in zip(axes, (0, 1)):
             x = np.mean([r[:n, col] for r in runs], axis=0)
             line = ax.plot(x, rates.mean(axis=0), label=f"PPO on {kind} ({len(runs)} seeds)")
-            ax.fill_between(x, rates.min(axis=0), rates.max(axis=0), alpha=0.2, color=line[0].get_color())
+            color = line[0].get_color()
+            ax.fill_between(x, rates.min(axis=0), rates.max(axis=0), alpha=0.2, color=color)
+            if len(finals):
+                ax.scatter(finals[:, col], finals[:, 2], marker="o", facecolors="none", edgecolors=color)
     for name, style in (("striker", "--"), ("random", ":")):
         path = root / name / "eval.json"
         if path.is_file():
             rate = json.loads(path.read_text())["2019"]["success_rate"]
             for ax in axes:
                 ax.axhline(rate, linestyle=style, color="k", label=f"{name} ({rate:.0%}, 60 s)")
+    axes[0].scatter([], [], marker="o", facecolors="none", edgecolors="k",
+                    label="a seed's final policy (100 placements, 60 s)")
     axes[0].set_xlabel("environment steps")
+    axes[1].axvline(1200.0, color="grey", linewidth=0.8)
+    axes[1].text(1190.0, 0.02, "20 min", rotation=90, ha="right", va="bottom", color="grey")
     axes[1].set_xlabel("training wall time on this machine, s")
     axes[0].set_ylabel("held-out success (touch with the dribbler)")
     axes[0].legend(loc="lower right", fontsize=8)
-    fig.suptitle("omniloop/BlackoutGrab-v0, 2019 placements")
+    fig.suptitle("omniloop/BlackoutGrab-v0, 2019 placements "
+                 "(lines: 32 held-out placements, 10 s; band: the seeds' spread)")
     fig.tight_layout()
     out = root / "learning.png"
     fig.savefig(out, dpi=110)
@@ -564,7 +583,7 @@ def parser() -> argparse.ArgumentParser:
     add("--observation", choices=grab.OBSERVATIONS, default="panorama")
     add("--seeds", type=int, nargs="+", default=[1])
     add("--out", type=Path, default=Path("runs/grab"))
-    add("--steps", type=int, default=600_000, help="environment steps a seed")
+    add("--steps", type=int, default=450_000, help="environment steps a seed")
     add("--minutes", type=float, default=20.0, help="training wall-time cap a seed")
     add("--envs", type=int, default=16)
     add("--n-steps", type=int, default=64, help="steps a run between updates")
