@@ -200,8 +200,6 @@ class GrabTask:
         if robot["kicker"] is None or not robot["sensors"]:
             raise ValueError(f"scenario {base.name!r}: the task needs a robot with a kicker and a camera")
         self.base = base.with_values({"run.duration_s": float(time_limit_s)})
-        self.observation_kind, self.placements = observation, placements
-        self.time_limit_s = float(time_limit_s)
         self.camera = robot["sensors"][0]["name"]
         self.max_speed = float(robot["max_speed_mm_s"])
         self.max_omega = float(max_omega_rad_s)
@@ -212,26 +210,25 @@ class GrabTask:
         )
         self.stack = 1 if observation == "state" else stack
         FrameHistory(stack, c.stack_every)  # checks them
-        self.stack_every = c.stack_every
         self.observation_space = spaces.Dict(self._parts(robot))
         self.action_space = spaces.Box(-1.0, 1.0, (3,), dtype=np.float32)
 
     def _parts(self, robot: Any) -> dict[str, spaces.Space[Any]]:
         s = robot["sensors"][0]
         h, w, _ = self.panorama.shape if self.panorama is not None else (s["height_px"], s["width_px"], 3)
-        if self.observation_kind != "state":
+        if self.config.observation != "state":
             first: spaces.Space[Any] = spaces.Box(0, 255, (h, w, 3 * self.stack), dtype=np.uint8)
         else:
             first = spaces.Box(-np.inf, np.inf, (2,), dtype=np.float32)
         return {
-            self.observation_kind: first,
+            self.config.observation: first,
             "odometry": spaces.Box(-np.inf, np.inf, (3,), dtype=np.float32),
             "ball_in_dribbler": spaces.Box(0.0, 1.0, (1,), dtype=np.float32),
         }
 
     def scenario(self, seed: int) -> Scenario:
         """Episode ``seed``'s scenario: the base with the placement drawn from the seed."""
-        (rx, ry, heading), (bx, by) = placement(seed, self.placements)
+        (rx, ry, heading), (bx, by) = placement(seed, self.config.placements)
         return self.base.with_values({
             "robot.start.x_mm": rx,
             "robot.start.y_mm": ry,
@@ -256,7 +253,7 @@ class GrabTask:
         """The observations of a batch of runs (``fresh``: those whose episode starts)."""
         each = [self.observation(o, t) for o, t in zip(obs, truths)]
         out = {k: np.stack([e[k] for e in each]) for k in self.observation_space.keys()}
-        kind = self.observation_kind
+        kind = self.config.observation
         if kind != "state":
             frames = out[kind] if self.panorama is None else self.panorama(out[kind])
             out[kind] = history.update(frames, fresh)
@@ -271,8 +268,8 @@ class GrabTask:
             "ball_in_dribbler": np.array([1.0 if obs.ball_in_dribbler else 0.0], dtype=np.float32),
         }
         frame = obs.frames[self.camera]
-        if self.observation_kind != "state":  # the env unwarps and stacks its batch at once
-            out[self.observation_kind] = frame
+        if self.config.observation != "state":  # the env unwarps and stacks its batch at once
+            out[self.config.observation] = frame
         else:
             out["state"] = ball_state(truth)
         return out
@@ -317,7 +314,7 @@ class GrabEnv(gymnasium.Env):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode={render_mode!r}: expected None or 'rgb_array'")
         self.task = GrabTask(GrabConfig.of(settings))
-        self._history = FrameHistory(self.task.stack, self.task.stack_every)
+        self._history = FrameHistory(self.task.stack, self.task.config.stack_every)
         self.observation_space = self.task.observation_space
         self.action_space = self.task.action_space
         self.render_mode = render_mode
@@ -370,7 +367,7 @@ class GrabVectorEnv(VectorEnv):
     def __init__(self, num_envs: int, **settings: Any) -> None:
         """``settings``: ``GrabConfig``'s fields."""
         self.task = GrabTask(GrabConfig.of(settings))
-        self._history = FrameHistory(self.task.stack, self.task.stack_every)
+        self._history = FrameHistory(self.task.stack, self.task.config.stack_every)
         self.num_envs = int(num_envs)
         self.single_observation_space = self.task.observation_space
         self.single_action_space = self.task.action_space

@@ -34,6 +34,18 @@ fn load_error(e: LoadError) -> PyErr {
     }
 }
 
+impl PyScenario {
+    /// Scenario text parsed and validated, its messages naming `file`.
+    fn parsed(text: &str, file: PathBuf, name: &str) -> PyResult<Self> {
+        let scenario = parse_scenario(text, &file, name).map_err(load_error)?;
+        Ok(Self {
+            scenario,
+            text: text.to_string(),
+            file,
+        })
+    }
+}
+
 #[pymethods]
 impl PyScenario {
     /// Reads, parses and validates a scenario file; raises `ScenarioError` with every problem
@@ -55,13 +67,7 @@ impl PyScenario {
     #[staticmethod]
     #[pyo3(signature = (text, name = "scenario"))]
     fn from_toml(text: &str, name: &str) -> PyResult<Self> {
-        let file = PathBuf::from(TEXT_FILE);
-        let scenario = parse_scenario(text, &file, name).map_err(load_error)?;
-        Ok(Self {
-            scenario,
-            text: text.to_string(),
-            file,
-        })
+        Self::parsed(text, PathBuf::from(TEXT_FILE), name)
     }
 
     /// A scenario file built into omniloop (`omniloop::BUNDLED_SCENARIOS`: `"blackout_stage1"`),
@@ -78,13 +84,7 @@ impl PyScenario {
                 known.join(", ")
             )));
         };
-        let file = PathBuf::from(format!("scenarios/{name}.toml"));
-        let scenario = parse_scenario(text, &file, name).map_err(load_error)?;
-        Ok(Self {
-            scenario,
-            text: text.to_string(),
-            file,
-        })
+        Self::parsed(text, PathBuf::from(format!("scenarios/{name}.toml")), name)
     }
 
     /// A new scenario with each dotted key (`"robot.max_speed_mm_s"`,
