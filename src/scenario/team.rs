@@ -179,10 +179,18 @@ fn writes_path(table: &Table, path: &[PathSeg]) -> bool {
 pub fn validate_team(s: &Scenario) -> Vec<Problem> {
     let mut out = Problems::new();
     for (k, entry) in s.robots.iter().enumerate() {
-        out.merge(validate(&s.member(k)).into_iter().map(|p| Problem {
+        // `[ssl]` names the team's robots: checked once below, against every robot's name.
+        let member = Scenario {
+            ssl: None,
+            ..s.member(k)
+        };
+        out.merge(validate(&member).into_iter().map(|p| Problem {
             field: attribute(entry, k, &p.field),
             ..p
         }));
+    }
+    if let Some(ssl) = &s.ssl {
+        out.extend(ssl.check(&s.robot_names()).into_vec());
     }
     team_rules(s, &mut out);
     out.into_vec()

@@ -801,3 +801,22 @@ fn the_command_line_serves_a_game_and_records_every_robots_camera_as_mcap() {
     let log = std::fs::read(out.join("ssl.log")).unwrap();
     assert_eq!(&log[..12], b"SSL_LOG_FILE");
 }
+
+#[test]
+fn team_lists_name_robots_of_the_whole_team() {
+    // Each robot is checked in its one-robot form; the lists name the others too.
+    let from = "protocol_teams = [\"blue\", \"yellow\"]";
+    let listed =
+        format!("blue = [\"blue2\", \"blue1\", \"blue3\"]\nyellow = [\"yellow1\"]\n{from}");
+    let (code, err) = crate::common::check_variant("ssl_match.toml", "ssl_lists_ok", from, &listed);
+    assert_eq!(code, Some(0), "{err}");
+    let unknown = format!("blue = [\"blue1\", \"blue9\"]\n{from}");
+    let (code, err) =
+        crate::common::check_variant("ssl_match.toml", "ssl_lists_bad", from, &unknown);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("field `ssl.blue[1]`: no robot called \"blue9\""),
+        "{err}"
+    );
+    assert_eq!(err.matches("no robot called").count(), 1, "{err}");
+}
