@@ -4,7 +4,7 @@ the driver's overhead per job, side by side in one run.
     pip install "./python[ray]"
     python python/bench_ray.py                # the corner sweep, 48 runs, three rounds
 
-The sweep is the README's corner over four angles and two speeds, six seeds each (48 runs of
+The sweep is docs/sweeps.md's corner over four angles and two speeds, six seeds each (48 runs of
 E1, CPU renderer, each run on its task's one CPU). Throughput is runs per second of the whole
 sweep, wall clock on the driver (plan, tasks, journal, report). The driver's overhead per job is
 what a job costs beyond its own run on one node: (the sweep's wall time - the sum of the runs'

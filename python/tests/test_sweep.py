@@ -17,7 +17,7 @@ os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
 
 E1 = SCENARIOS / "corner55_velocity_aware.toml"
 SMALL = {"robot.max_speed_mm_s": [300, 400]}
-#: A 24-run part of the README's corner sweep.
+#: A 24-run part of docs/sweeps.md's corner sweep.
 CORNER = {"experiment.corner.angle_deg": [40, 55, 70, 85], "robot.max_speed_mm_s": "400,1000"}
 
 

@@ -13,6 +13,7 @@ mod blackout;
 mod camera_models;
 mod corner55;
 mod custom_robot;
+mod docs;
 mod effects;
 mod errors;
 mod field_presets;
