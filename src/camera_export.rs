@@ -15,8 +15,8 @@ use omniloop_sim::{Sensor, SensorSpec};
 use omniloop_vision::VisionError;
 use omniloop_vision::camera_model::{
     CameraFile, Correspondence, DoubleSphereModel, FitResidual, ModelPose, OcamModel, UnifiedModel,
-    fit_unified, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml, parse_camera_file, refine,
-    residual as reprojection,
+    fit_double_sphere, fit_unified, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml,
+    parse_camera_file, residual as reprojection,
 };
 
 /// A camera model file format.
@@ -386,33 +386,6 @@ fn image_circle(sensor: &Sensor, rays: &[Ray], dark_radii: &[f64]) -> Option<f64
         .filter(|r| *r > lit)
         .fold(f64::INFINITY, f64::min);
     dark.is_finite().then_some(0.5 * (lit + dark))
-}
-
-/// The double sphere model fitted to `rays`: from the unified fit with the second sphere's
-/// weight at a few values (xi grown until the model's field of view holds every ray), the best
-/// refined one.
-fn fit_double_sphere(
-    unified: &UnifiedModel,
-    rays: &[Correspondence],
-) -> Result<(DoubleSphereModel, FitResidual), VisionError> {
-    let mut best: Option<(DoubleSphereModel, FitResidual)> = None;
-    for alpha in [0.0, 0.2, 0.4, 0.6] {
-        let mut start = DoubleSphereModel {
-            alpha,
-            ..DoubleSphereModel::from_unified(unified)
-        };
-        while start.xi < 5.0 && !reprojection(&start, rays).rms_px.is_finite() {
-            start.xi += 0.1;
-        }
-        if let Ok((m, r)) = refine(start, rays)
-            && best.as_ref().is_none_or(|(_, b)| r.rms_px < b.rms_px)
-        {
-            best = Some((m, r));
-        }
-    }
-    best.ok_or_else(|| {
-        VisionError::Calibration("no start of the double sphere model images every ray".into())
-    })
 }
 
 /// The unified and double sphere models' frame in the body frame (its columns): x forward, y

@@ -6,8 +6,9 @@
 //! centres at integer coordinates. With `alpha = 0` it is Mei's unified model without
 //! distortion.
 
-use super::fit::Projection;
+use super::fit::{Correspondence, FitResidual, Projection, refine, residual};
 use super::unified::UnifiedModel;
+use crate::VisionError;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -106,6 +107,33 @@ impl DoubleSphereModel {
         let n = p.norm();
         (n.is_finite() && n > 0.0).then(|| p / n)
     }
+}
+
+/// The double sphere model fitted to `rays`: from the unified fit with the second sphere's
+/// weight at a few values (xi grown until the model's field of view holds every ray), the best
+/// refined one.
+pub fn fit_double_sphere(
+    unified: &UnifiedModel,
+    rays: &[Correspondence],
+) -> Result<(DoubleSphereModel, FitResidual), VisionError> {
+    let mut best: Option<(DoubleSphereModel, FitResidual)> = None;
+    for alpha in [0.0, 0.2, 0.4, 0.6] {
+        let mut start = DoubleSphereModel {
+            alpha,
+            ..DoubleSphereModel::from_unified(unified)
+        };
+        while start.xi < 5.0 && !residual(&start, rays).rms_px.is_finite() {
+            start.xi += 0.1;
+        }
+        if let Ok((m, r)) = refine(start, rays)
+            && best.as_ref().is_none_or(|(_, b)| r.rms_px < b.rms_px)
+        {
+            best = Some((m, r));
+        }
+    }
+    best.ok_or_else(|| {
+        VisionError::Calibration("no start of the double sphere model images every ray".into())
+    })
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ pub mod ocamcalib;
 pub mod read;
 pub mod unified;
 
-pub use double_sphere::DoubleSphereModel;
+pub use double_sphere::{DoubleSphereModel, fit_double_sphere};
 pub use files::{ModelPose, kalibr_ds_yaml, kalibr_omni_yaml, opencv_omnidir_yaml};
 pub use fit::{Correspondence, FitResidual, Projection, fit_unified, refine, residual};
 pub use ocamcalib::{OcamModel, PolynomialError};
