@@ -79,6 +79,25 @@ pub enum CellState {
     Blocked,
 }
 
+/// A cell's state from its evidence: a wall of the map (`fixed`) is blocked; log-odds `l` above
+/// [`BLOCKED_ABOVE`] are blocked where a near sighting `confirmed` them, suspect otherwise;
+/// below [`FREE_BELOW`] free; between them (or never seen) unknown.
+fn classify(fixed: bool, l: f32, confirmed: bool) -> CellState {
+    if fixed {
+        CellState::Blocked
+    } else if l > BLOCKED_ABOVE {
+        if confirmed {
+            CellState::Blocked
+        } else {
+            CellState::Suspect
+        }
+    } else if l < FREE_BELOW {
+        CellState::Free
+    } else {
+        CellState::Unknown
+    }
+}
+
 /// Where the grid lies: its lower-left corner, cell size and extent.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GridGeometry {
@@ -178,35 +197,31 @@ impl OccupancyGrid {
 
     /// The state of cell `i`.
     pub fn state(&self, i: usize) -> CellState {
-        if self.fixed[i] {
-            return CellState::Blocked;
-        }
-        let l = self.log_odds[i];
-        if l > BLOCKED_ABOVE {
-            if self.confirmed[i] {
-                CellState::Blocked
-            } else {
-                CellState::Suspect
-            }
-        } else if l < FREE_BELOW {
-            CellState::Free
-        } else {
-            CellState::Unknown
-        }
+        classify(self.fixed[i], self.log_odds[i], self.confirmed[i])
     }
 
-    /// Counts of free, unknown, suspect and blocked cells.
+    /// Every cell's state, row-major from the lower-left cell.
+    pub fn states(&self) -> impl Iterator<Item = CellState> + '_ {
+        self.fixed
+            .iter()
+            .zip(&self.log_odds)
+            .zip(&self.confirmed)
+            .map(|((&fixed, &l), &confirmed)| classify(fixed, l, confirmed))
+    }
+
+    /// Counts of free, unknown, suspect and blocked cells: [`classify`] as sums of its
+    /// conditions, without branches, since the record counts the whole grid every cycle.
     pub fn counts(&self) -> [usize; 4] {
-        let mut c = [0; 4];
-        for i in 0..self.geometry.len() {
-            c[match self.state(i) {
-                CellState::Free => 0,
-                CellState::Unknown => 1,
-                CellState::Suspect => 2,
-                CellState::Blocked => 3,
-            }] += 1;
+        let (mut free, mut suspect, mut blocked) = (0, 0, 0);
+        let cells = self.fixed.iter().zip(&self.log_odds).zip(&self.confirmed);
+        for ((&fixed, &l), &confirmed) in cells {
+            let occupied = l > BLOCKED_ABOVE;
+            free += usize::from(!fixed & (l < FREE_BELOW));
+            suspect += usize::from(!fixed & occupied & !confirmed);
+            blocked += usize::from(fixed | (occupied & confirmed));
         }
-        c
+        let unknown = self.geometry.len() - free - suspect - blocked;
+        [free, unknown, suspect, blocked]
     }
 
     /// Marks every cell whose centre lies within half a cell of segment `s`'s body.
@@ -397,7 +412,7 @@ impl OccupancyGrid {
     pub fn snapshot(&self) -> MapSnapshot {
         MapSnapshot {
             geometry: self.geometry,
-            cells: (0..self.geometry.len()).map(|i| self.state(i)).collect(),
+            cells: self.states().collect(),
         }
     }
 }
@@ -469,6 +484,32 @@ mod tests {
             CellState::Unknown,
             "beyond the template's range"
         );
+    }
+
+    #[test]
+    fn the_counts_are_the_states_tallied_cell_by_cell() {
+        // A map's wall (fixed), a wall seen from afar (suspect), one from near (blocked), the
+        // floor before them (free) and the rest unknown: every state occurs.
+        let map = WorldMap {
+            bounds: vec![MapSegment {
+                from_mm: Point2::new(-1900.0, -1900.0),
+                to_mm: Point2::new(-1900.0, 1900.0),
+                half_thickness_mm: 10.0,
+            }],
+            ..WorldMap::default()
+        };
+        let geometry = *grid().geometry();
+        let mut g = OccupancyGrid::new(geometry, &map, &PlannerConfig::default());
+        g.observe(&wall(700.0), &Isometry2::identity(), 90.0, 0.0);
+        let behind = Isometry2::new(Vector2::new(-1000.0, 0.0), std::f64::consts::PI);
+        g.observe(&wall(300.0), &behind, 90.0, 0.04);
+        let mut tally = [0; 4];
+        for state in g.states() {
+            tally[state as usize] += 1;
+        }
+        assert!(tally.iter().all(|&n| n > 0), "{tally:?}");
+        assert_eq!(g.counts(), tally);
+        assert_eq!(tally.iter().sum::<usize>(), g.geometry().len());
     }
 
     #[test]

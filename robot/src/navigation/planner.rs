@@ -289,8 +289,8 @@ fn distances_mm(grid: &OccupancyGrid, state: CellState) -> Option<Vec<f32>> {
     let g = grid.geometry();
     let mut marked = GrayImage::new(g.width as u32, g.height as u32);
     let mut any = false;
-    for (i, px) in marked.pixels_mut().enumerate() {
-        if grid.state(i) == state {
+    for (px, cell) in marked.pixels_mut().zip(grid.states()) {
+        if cell == state {
             px.0[0] = 255;
             any = true;
         }
