@@ -5,6 +5,9 @@
     python python/bench.py                    # all cores
     taskset -c 0 python python/bench.py       # one core
 
+`pip` builds the extension in the workspace's `wheel` profile: `--cli target/wheel/omniloop`
+(`cargo build --profile wheel`) compares it with the command line built alike.
+
 Prints a table: the command line's cycles/s (`omniloop run`, from its summary.json: control
 cycles alone), the same run through `omniloop.run`, `Simulation.step` with the built-in robot
 (the same cycle, driven from Python: the overhead of the boundary) and with a Python robot
