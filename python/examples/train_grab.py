@@ -21,7 +21,8 @@ reproduces its weights (``--minutes`` also caps it by the clock, which does not 
 Outputs, per seed under ``OUT/OBSERVATION/seed-S/``: ``curve.csv`` (environment steps, training
 wall time without the evaluations, the success rate on the first ``--curve-placements``
 held-out placements with ``--curve-limit-s``), ``eval.json`` (the final policy on
-``--eval-placements`` held-out placements of 2019 and of 2021 with the rules' minute),
+``--eval-placements`` held-out placements of 2019 and of 2021 with ``--eval-limit-s``, by default
+the rules' minute),
 ``weights.npz`` and ``config.json``. Held-out placements are the episodes with seeds from
 1,000,000,000 on; training episodes have seeds below.
 """
@@ -489,8 +490,10 @@ def train(args: argparse.Namespace, seed: int, out: Path) -> dict[str, Any]:
     np.savez(out / "weights.npz", **weights)  # type: ignore[arg-type]
     result = {
         "seed": seed, "env_steps": steps, "train_wall_s": wall,
-        "eval": {p: evaluate(learner.mean_action, cfg.observation, p, args.eval_placements, 60.0, stack=stack)
-                 for p in ("2019", "2021")},
+        "eval": {
+            p: evaluate(learner.mean_action, cfg.observation, p, args.eval_placements, args.eval_limit_s, stack=stack)
+            for p in ("2019", "2021")
+        },
     }
     (out / "eval.json").write_text(json.dumps(result, indent=1))
     return result
@@ -507,9 +510,9 @@ def baseline(args: argparse.Namespace) -> None:
     result = {}
     for p in ("2019", "2021"):
         if args.baseline == "striker":
-            result[p] = striker(p, args.eval_placements, 60.0)
+            result[p] = striker(p, args.eval_placements, args.eval_limit_s)
         else:
-            result[p] = evaluate(random_policy(1), "state", p, args.eval_placements, 60.0)
+            result[p] = evaluate(random_policy(1), "state", p, args.eval_placements, args.eval_limit_s)
         print(f"{args.baseline}, {p} placements: {result[p]['success_rate']:.0%}", file=sys.stderr)
     (out / "eval.json").write_text(json.dumps(result, indent=1))
 
@@ -605,6 +608,8 @@ def parser() -> argparse.ArgumentParser:
     add("--curve-placements", type=int, default=32)
     add("--curve-limit-s", type=float, default=10.0)
     add("--eval-placements", type=int, default=100)
+    add("--eval-limit-s", type=float, default=60.0,
+        help="the final evaluation's time limit (the rules' minute)")
     add("--baseline", choices=("random", "striker"), help="evaluate a baseline instead")
     add("--plot", type=Path, metavar="DIR", help="draw DIR/learning.png from DIR's runs")
     return ap

@@ -245,7 +245,7 @@ def test_training_end_to_end_reproduces_its_weights(tmp_path: Path) -> None:
             sys.executable, script, "--observation", "panorama", "--seeds", "3",
             "--steps", str(steps), "--envs", "4", "--n-steps", "64", "--eval-every", "256",
             "--curve-placements", "4", "--curve-limit-s", "1", "--eval-placements", "2",
-            "--train-limit-s", "2", "--out", str(out),
+            "--train-limit-s", "2", "--eval-limit-s", "2", "--out", str(out),
         ]
         return subprocess.Popen(cmd, cwd=tmp_path)
 
@@ -266,7 +266,7 @@ def test_training_end_to_end_reproduces_its_weights(tmp_path: Path) -> None:
     assert rows[0].startswith("env_steps") and len(rows) == 4  # 0, 256 and 512 steps
     result = json.loads((tmp_path / "a" / "panorama" / "seed-3" / "eval.json").read_text())
     assert set(result["eval"]) == {"2019", "2021"} and result["env_steps"] == 512
-    assert result["eval"]["2019"]["count"] == 2
+    assert result["eval"]["2019"]["count"] == 2 and result["eval"]["2019"]["limit_s"] == 2.0
     subprocess.run([sys.executable, script, "--plot", str(tmp_path / "a")], check=True, timeout=300)
     assert (tmp_path / "a" / "learning.png").stat().st_size > 10_000
 
