@@ -27,7 +27,9 @@ if [ ! -x "$sslvision/bin/python" ] || ! "$sslvision/bin/python" -c "import pySS
   python3 -m venv "$sslvision"
   "$sslvision/bin/python" -m pip install -q pysslvision==2.0.0 protobuf==3.20.3
 fi
-"$venv/bin/python" -m pytest -q python/tests
+# The Python tests in parallel (pytest-xdist, in the test extra): a worker a core, four at most;
+# each test keeps its own ports, folders and ROS 2 domain.
+"$venv/bin/python" -m pytest -q -n logical --maxprocesses 4 python/tests
 # The package's types: mypy --strict on the package and its examples (the settings in
 # python/pyproject.toml's [tool.mypy]), then stubtest, the native module's stub
 # (omniloop/_omniloop.pyi) against the module built above.

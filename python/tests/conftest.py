@@ -1,5 +1,7 @@
 """Shared paths and scenarios of the Python tests (run from anywhere: `pytest python/tests`)."""
 
+import os
+import random
 from pathlib import Path
 
 import pytest
@@ -8,6 +10,20 @@ import omniloop
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = ROOT / "scenarios"
+
+
+def ros_domain_id() -> int:
+    """A ROS 2 domain (1-100) for this test process's nodes.
+
+    Drawn from the test run's process id, so that two runs on one machine seldom meet, and
+    offset by the pytest-xdist worker's index (`pytest -n`, as scripts/test.sh runs), so that
+    two workers of one run never share a domain: each worker's nodes would see the other's
+    topics.
+    """
+    worker = os.environ.get("PYTEST_XDIST_WORKER")  # gw0, gw1, ... under pytest -n
+    run = os.getppid() if worker else os.getpid()
+    index = int(worker[2:]) if worker else 0
+    return 1 + (random.Random(run).randrange(100) + index) % 100
 
 
 @pytest.fixture(scope="session")

@@ -5,7 +5,6 @@ with the same seed and commands."""
 import json
 import math
 import os
-import random
 import signal
 import subprocess
 import sys
@@ -18,13 +17,13 @@ import pytest
 import omniloop
 from omniloop.ros import mapping
 
-from conftest import ROOT, SCENARIOS
+from conftest import ROOT, SCENARIOS, ros_domain_id
 
 if sys.version_info < (3, 10):
     pytest.skip("ROS 2's wheels are for Python 3.10 and later", allow_module_level=True)
 
 # ROS 2 is part of the tests' environment (`pip install './python[test,ros]'`): no skip.
-os.environ["ROS_DOMAIN_ID"] = str(random.Random(os.getpid()).randint(1, 100))
+os.environ["ROS_DOMAIN_ID"] = str(ros_domain_id())
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 import rclpy  # noqa: E402
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped, Vector3  # noqa: E402

@@ -3,7 +3,6 @@ while the ROS 2 node publishes every robot's own camera; and `Simulation(robot="
 from Python."""
 
 import os
-import random
 import signal
 import socket
 import subprocess
@@ -16,13 +15,13 @@ import pytest
 import omniloop
 from omniloop import ssl
 
-from conftest import SCENARIOS
+from conftest import SCENARIOS, ros_domain_id
 
 if sys.version_info < (3, 10):
     pytest.skip("ROS 2's wheels are for Python 3.10 and later", allow_module_level=True)
 
 # ROS 2 is part of the tests' environment (`pip install './python[test,ros]'`): no skip.
-os.environ["ROS_DOMAIN_ID"] = str(random.Random(os.getpid() + 58).randint(1, 100))
+os.environ["ROS_DOMAIN_ID"] = str(ros_domain_id())
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 import rclpy  # noqa: E402
 from nav_msgs.msg import Odometry  # noqa: E402
