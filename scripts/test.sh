@@ -45,7 +45,7 @@ envs_dir="$(mktemp -d)"
 python_envs > "$envs_dir/log" 2>&1 &
 envs=$!
 # Should the Rust tests fail, the environments' installs stop with them.
-trap 'pkill -P "$envs" 2>/dev/null; kill "$envs" 2>/dev/null || true' EXIT
+trap 'pkill -P "$envs" 2>/dev/null || true; kill "$envs" 2>/dev/null || true' EXIT
 
 cargo test --workspace
 # The binary cargo test just built: python/tests/test_ssl.py serves its games with it.
