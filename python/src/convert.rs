@@ -4,6 +4,7 @@
 use numpy::ndarray::Array3;
 use numpy::{PyArray1, PyArray3, PyReadonlyArray3, PyUntypedArrayMethods};
 use omniloop::TrajectoryRow;
+use omniloop::vision::pixels;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
@@ -11,11 +12,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 /// An RGBA image as an `H x W x 3` `uint8` array (the alpha channel, always opaque, dropped).
 pub fn rgb_array<'py>(py: Python<'py>, img: &image::RgbaImage) -> Bound<'py, PyArray3<u8>> {
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let mut rgb = vec![0u8; w * h * 3];
-    for (out, px) in rgb.chunks_exact_mut(3).zip(img.as_raw().chunks_exact(4)) {
-        out.copy_from_slice(&px[..3]);
-    }
-    rgb_from_vec(py, h, w, rgb)
+    rgb_from_vec(py, h, w, pixels::rgb_bytes(img))
 }
 
 /// An `H x W x 3` `uint8` array (an observation's frame) as an opaque RGBA image.
@@ -28,14 +25,15 @@ pub fn rgba_from_array(frame: &PyReadonlyArray3<'_, u8>) -> PyResult<image::Rgba
     }
     let (h, w) = (shape[0], shape[1]);
     let view = frame.as_array();
-    let pixels = view.as_standard_layout();
-    let mut rgba = vec![255u8; h * w * 4];
-    let rgb = pixels.as_slice().unwrap_or(&[]);
-    for (out, px) in rgba.chunks_exact_mut(4).zip(rgb.chunks_exact(3)) {
-        out[..3].copy_from_slice(px);
-    }
-    image::RgbaImage::from_raw(w as u32, h as u32, rgba)
-        .ok_or_else(|| PyValueError::new_err("the frame's pixels do not fill its shape"))
+    let standard = view.as_standard_layout();
+    let rgb = standard.as_slice().unwrap_or(&[]);
+    let size = u32::try_from(w).ok().zip(u32::try_from(h).ok());
+    size.and_then(|(w, h)| pixels::rgba_from_rgb(w, h, rgb))
+        .ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "the frame's pixels do not fill its shape {shape:?}"
+            ))
+        })
 }
 
 /// An RGB image as an `H x W x 3` `uint8` array.

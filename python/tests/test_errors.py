@@ -40,3 +40,19 @@ def test_the_free_space_stage_failing_on_a_frame_raises_robot_software_error(cor
     detector = omniloop.Simulation(corner).free_space_detector()
     with pytest.raises(omniloop.RobotSoftwareError, match="free space"):
         detector.detect(np.zeros((16, 16, 3), dtype=np.uint8))
+
+
+def test_a_frame_of_any_memory_layout_is_read_and_one_not_rgb_raises_value_error(corner):
+    sim = omniloop.Simulation(corner)
+    frame = sim.reset().frames["omni"]
+    flipped = frame[::-1, ::-1]  # a view with negative strides: copied into rows by the binding
+    assert not flipped.flags["C_CONTIGUOUS"]
+    a = sim.free_space_detector().detect(flipped)
+    b = sim.free_space_detector().detect(np.ascontiguousarray(flipped))
+    assert a.keys() == b.keys()
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+    # The flipped frame is another image: the ranges differ from the frame's own.
+    c = sim.free_space_detector().detect(frame)
+    assert not np.array_equal(a["free_mm"], c["free_mm"])
+    with pytest.raises(ValueError, match=r"H x W x 3 uint8 array \(RGB\), got shape \[16, 16, 4\]"):
+        sim.free_space_detector().detect(np.zeros((16, 16, 4), dtype=np.uint8))

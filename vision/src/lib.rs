@@ -15,6 +15,7 @@ pub mod image_centre;
 pub mod luminance_heading;
 pub mod mask;
 pub mod omnistereo;
+pub mod pixels;
 pub mod resection;
 
 pub use ball::{BallColor, BallConfig, BallMiss, BallSighting};
