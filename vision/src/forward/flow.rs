@@ -6,7 +6,6 @@
 //! (1/6 at the sides, 1/12 at the corners). Each iteration applies eqs. (1)-(2) everywhere.
 
 use super::grey::Grey;
-use imageproc::kernel::Kernel;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the flow and of the flow-balance avoidance (`[vision.forward.flow]`).
@@ -162,37 +161,60 @@ pub fn horn_schunck(a: &Grey, b: &Grey, alpha: f32, iterations: u32) -> FlowFiel
         }
     }
     let a2 = alpha * alpha;
-    let mut u = Grey::new(w, h);
-    let mut v = Grey::new(w, h);
-    const K: [f32; 9] = [
-        1.0 / 12.0,
-        1.0 / 6.0,
-        1.0 / 12.0,
-        1.0 / 6.0,
-        0.0,
-        1.0 / 6.0,
-        1.0 / 12.0,
-        1.0 / 6.0,
-        1.0 / 12.0,
-    ];
-    let kernel = Kernel::new(&K, 3, 3);
+    let (mut u, mut v) = (vec![0.0f32; n], vec![0.0f32; n]);
+    let (mut ub, mut vb) = (vec![0.0f32; n], vec![0.0f32; n]);
     for _ in 0..iterations {
-        let ub: Grey = imageproc::filter::filter(&u, kernel, |p| p);
-        let vb: Grey = imageproc::filter::filter(&v, kernel, |p| p);
+        local_average(&u, wu, &mut ub);
+        local_average(&v, wu, &mut vb);
         for i in 0..n {
-            let (x, y) = ((i % wu) as u32, (i / wu) as u32);
-            let (uu, vv) = (ub.get_pixel(x, y).0[0], vb.get_pixel(x, y).0[0]);
+            let (uu, vv) = (ub[i], vb[i]);
             // Eqs. (1)-(2).
             let r = (ex[i] * uu + ey[i] * vv + et[i]) / (a2 + ex[i] * ex[i] + ey[i] * ey[i]);
-            u.put_pixel(x, y, image::Luma([uu - ex[i] * r]));
-            v.put_pixel(x, y, image::Luma([vv - ey[i] * r]));
+            u[i] = uu - ex[i] * r;
+            v[i] = vv - ey[i] * r;
         }
     }
     FlowField {
         width: w,
         height: h,
-        u: u.into_raw(),
-        v: v.into_raw(),
+        u,
+        v,
+    }
+}
+
+/// Horn and Schunck's 3x3 kernel of the local averages: 1/6 at the sides, 1/12 at the corners,
+/// row by row.
+const AVERAGE: [f32; 9] = [
+    1.0 / 12.0,
+    1.0 / 6.0,
+    1.0 / 12.0,
+    1.0 / 6.0,
+    0.0,
+    1.0 / 6.0,
+    1.0 / 12.0,
+    1.0 / 6.0,
+    1.0 / 12.0,
+];
+
+/// `u_bar` of eqs. (1)-(2): `field` (rows of `width` values) correlated with [`AVERAGE`] into
+/// `out`, the borders padded by continuity. The sum runs over the kernel row by row from zero,
+/// the centre's zero weight included, as `imageproc::filter::filter` sums it: the same values
+/// to the last bit, without its per-tap clamping.
+fn local_average(field: &[f32], width: usize, out: &mut [f32]) {
+    let height = field.len() / width;
+    for y in 0..height {
+        let rows =
+            [y.saturating_sub(1), y, (y + 1).min(height - 1)].map(|r| &field[r * width..][..width]);
+        for (x, o) in out[y * width..][..width].iter_mut().enumerate() {
+            let cols = [x.saturating_sub(1), x, (x + 1).min(width - 1)];
+            let mut acc = 0.0f32;
+            for (row, k) in rows.iter().zip(AVERAGE.chunks_exact(3)) {
+                for (&c, &kk) in cols.iter().zip(k) {
+                    acc += row[c] * kk;
+                }
+            }
+            *o = acc;
+        }
     }
 }
 
@@ -200,6 +222,27 @@ pub fn horn_schunck(a: &Grey, b: &Grey, alpha: f32, iterations: u32) -> FlowFiel
 mod tests {
     use super::super::testing::texture;
     use super::*;
+
+    #[test]
+    fn the_local_average_is_imageprocs_correlation_to_the_bit() {
+        // Odd sizes, one-pixel-wide strips, signed values and zeros of both signs.
+        for (w, h) in [(7usize, 5usize), (1, 4), (6, 1), (1, 1)] {
+            let field: Vec<f32> = (0..w * h)
+                .map(|i| match i % 5 {
+                    0 => -0.0,
+                    1 => 0.0,
+                    k => ((i * 37 % 101) as f32 - 50.0) / (k as f32 * 7.0),
+                })
+                .collect();
+            let img = Grey::from_raw(w as u32, h as u32, field.clone()).unwrap();
+            let kernel = imageproc::kernel::Kernel::new(&AVERAGE, 3, 3);
+            let theirs: Grey = imageproc::filter::filter(&img, kernel, |p| p);
+            let mut ours = vec![f32::NAN; w * h];
+            local_average(&field, w, &mut ours);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&ours), bits(theirs.as_raw()), "{w}x{h}");
+        }
+    }
 
     #[test]
     fn a_known_translation_of_a_texture_is_recovered() {
