@@ -201,7 +201,7 @@ const AVERAGE: [f32; 9] = [
 /// the centre's zero weight included, as `imageproc::filter::filter` sums it: the same values
 /// to the last bit, without its per-tap clamping.
 fn local_average(field: &[f32], width: usize, out: &mut [f32]) {
-    let height = field.len() / width;
+    let height = field.len().checked_div(width).unwrap_or(0);
     for y in 0..height {
         let rows =
             [y.saturating_sub(1), y, (y + 1).min(height - 1)].map(|r| &field[r * width..][..width]);
@@ -225,8 +225,8 @@ mod tests {
 
     #[test]
     fn the_local_average_is_imageprocs_correlation_to_the_bit() {
-        // Odd sizes, one-pixel-wide strips, signed values and zeros of both signs.
-        for (w, h) in [(7usize, 5usize), (1, 4), (6, 1), (1, 1)] {
+        // Odd sizes, one-pixel-wide strips, empty images, signed values and zeros of both signs.
+        for (w, h) in [(7usize, 5usize), (1, 4), (6, 1), (1, 1), (0, 3), (4, 0)] {
             let field: Vec<f32> = (0..w * h)
                 .map(|i| match i % 5 {
                     0 => -0.0,
@@ -242,6 +242,8 @@ mod tests {
             let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&ours), bits(theirs.as_raw()), "{w}x{h}");
         }
+        let empty = Grey::new(0, 3);
+        assert!(horn_schunck(&empty, &empty, 10.0, 5).u.is_empty());
     }
 
     #[test]
