@@ -49,7 +49,11 @@ KEYS = {
 
 
 class Client(Node):
-    """Drives to the goal from odom alone, one command per cycle; records what it gets."""
+    """Drives to the goal from odom alone, one command per cycle; records what it gets.
+
+    A cycle is answered once all its messages are here (each topic's and its ``/clock``), as a
+    node synchronising its inputs would: a sample lost on a loaded machine is sent again on the
+    writer's next heartbeat, and lockstep waits for it instead of publishing past it."""
 
     def __init__(self) -> None:
         super().__init__("omniloop_test_client")
@@ -60,30 +64,43 @@ class Client(Node):
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.create_subscription(PoseStamped, f"{NS}/goal_pose", self.on_goal, latched)
         for key, (kind, topic) in KEYS.items():
-            self.create_subscription(kind, f"{NS}/{topic}", self.msgs[key].append, 10)
-        self.create_subscription(Odometry, f"{NS}/odom", self.on_odom, 10)
-        self.create_subscription(Clock, "/clock", lambda m: self.clock.append(m.clock), 100)
+            self.create_subscription(kind, f"{NS}/{topic}", self.recorder(key), 10)
+        self.create_subscription(Odometry, f"{NS}/odom", self.recorder("odom"), 10)
+        self.create_subscription(Clock, "/clock", self.on_clock, 100)
         self.cmd = self.create_publisher(Twist, f"{NS}/cmd_vel", 10)
         self.reset = self.create_client(Trigger, "/omniloop/reset")
         self.last = time.monotonic()
-        self.pending = None
+
+    def recorder(self, key: str):
+        def record(msg) -> None:
+            self.msgs[key].append(msg)
+            if key == "odom":
+                self.last = time.monotonic()
+            self.answer_when_complete()
+
+        return record
 
     def on_goal(self, msg: PoseStamped) -> None:
         self.goal = (msg.pose.position.x, msg.pose.position.y)
-        if self.pending is not None:  # a frame came before the goal: answered now
-            self.answer(self.pending)
-            self.pending = None
+        self.answer_when_complete()
 
-    def on_odom(self, msg: Odometry) -> None:
-        self.last = time.monotonic()
-        self.msgs["odom"].append(msg)
-        if self.goal is None:
-            self.pending = msg
-            return
-        self.answer(msg)
+    def on_clock(self, msg: Clock) -> None:
+        self.clock.append(msg.clock)
+        self.answer_when_complete()
 
-    def answer(self, msg: Odometry) -> None:
-        cycle = len(self.msgs["odom"]) - 1
+    def answer_when_complete(self) -> None:
+        """Answers each odom in turn once the goal, its cycle's other topics and its clock are
+        here."""
+        odoms = self.msgs["odom"]
+        while self.goal is not None and len(self.commands) < len(odoms):
+            cycle = len(self.commands)
+            if any(len(msgs) <= cycle for msgs in self.msgs.values()):
+                return
+            if all(c != odoms[cycle].header.stamp for c in self.clock):
+                return
+            self.answer(cycle, odoms[cycle])
+
+    def answer(self, cycle: int, msg: Odometry) -> None:
         if cycle == RESET_AT:
             self.reset.call_async(Trigger.Request())
             self.commands.append(None)  # the reset answers this frame
@@ -107,6 +124,8 @@ class Client(Node):
         """Per episode, per cycle: each topic's message and the command that answered it."""
         split = {key: episodes_of(msgs) for key, msgs in self.msgs.items()}
         out, k = [], 0
+        counts = {key: [len(e) for e in episodes] for key, episodes in split.items()}
+        assert all(c == counts["odom"] for c in counts.values()), f"messages an episode: {counts}"
         for e, odoms in enumerate(split["odom"]):
             cycles = []
             for c in range(len(odoms)):
@@ -144,8 +163,12 @@ def drive(out: Path):
             rclpy.spin_once(client, timeout_sec=0.05)
             assert node.poll() is None, node.stdout.read()
             assert time.monotonic() - client.last < 60, "no bridge came up"
-        client.last = time.monotonic()
-        while time.monotonic() - client.last < 3.0 and node.poll() is None:
+        deadline = time.monotonic() + 300
+        while node.poll() is None:  # the node exits at the run's end
+            rclpy.spin_once(client, timeout_sec=0.05)
+            assert time.monotonic() < deadline, "the run did not end in 5 minutes"
+        end = time.monotonic() + 1.0
+        while time.monotonic() < end:  # what reached the client before the node left
             rclpy.spin_once(client, timeout_sec=0.05)
         rc = node.wait(timeout=30)
     finally:

@@ -33,6 +33,7 @@ from builtin_interfaces.msg import Time
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped, Vector3
 from nav_msgs.msg import Odometry
 from rcl_interfaces.msg import SetParametersResult
+from rclpy.duration import Duration
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -685,7 +686,15 @@ class Bridge:
             if left <= 0:
                 return
 
-    def close(self) -> None:
+    def close(self, flush_timeout_s: float = 2.0) -> None:
+        """Waits (at most ``flush_timeout_s`` in all) until every subscriber has what was
+        published, then leaves: a reliable sample lost on its way (a loaded machine's shared
+        memory queue full) is sent again on the writer's next heartbeat, which a process
+        exiting at once would never send. The run's last cycle reaches its subscribers."""
+        end = time.monotonic() + flush_timeout_s
+        for publisher in self.node.publishers:
+            left = max(0.0, end - time.monotonic())
+            publisher.wait_for_all_acked(Duration(seconds=left))
         self.executor.remove_node(self.node)
         self.node.destroy_node()
 
