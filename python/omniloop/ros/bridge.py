@@ -690,9 +690,10 @@ class Bridge:
         """Waits (at most ``flush_timeout_s`` in all) until every subscriber has what was
         published, then leaves: a reliable sample lost on its way (a loaded machine's shared
         memory queue full) is sent again on the writer's next heartbeat, which a process
-        exiting at once would never send. The run's last cycle reaches its subscribers."""
+        exiting at once would never send. The run's last cycle reaches its subscribers. Shut
+        down already (Ctrl-C), it leaves at once."""
         end = time.monotonic() + flush_timeout_s
-        for publisher in self.node.publishers:
+        for publisher in self.node.publishers if self.node.context.ok() else []:
             left = max(0.0, end - time.monotonic())
             publisher.wait_for_all_acked(Duration(seconds=left))
         self.executor.remove_node(self.node)
