@@ -16,6 +16,15 @@ pub trait Projection: Copy {
     fn with_params(&self, p: &[f64]) -> Self;
     /// The pixel where a point of the model's frame images, if it does.
     fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]>;
+    /// The pixels of one point under each of `models`, into `out`: what
+    /// [`Projection::project`] gives model by model, to the bit. The Jacobian projects every
+    /// ray under `2n + 1` models that differ in one parameter each, so a model may compute
+    /// once what depends on the point and the parameters the models share.
+    fn project_each(models: &[Self], p: &Vector3<f64>, out: &mut [Option<[f64; 2]>]) {
+        for (pixel, model) in out.iter_mut().zip(models) {
+            *pixel = model.project(p);
+        }
+    }
 }
 
 impl Projection for UnifiedModel {
@@ -29,6 +38,25 @@ impl Projection for UnifiedModel {
     }
     fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
         UnifiedModel::project(self, p)
+    }
+    /// The point goes to the sphere once; through the plane at `z_s + xi` and the distortion
+    /// once for the first model and again only for a model whose `xi` or distortion differs
+    /// from the first's. The same operations in the same order as [`UnifiedModel::project`],
+    /// so the same bits.
+    fn project_each(models: &[Self], p: &Vector3<f64>, out: &mut [Option<[f64; 2]>]) {
+        let (Some(s), Some(first)) = (UnifiedModel::on_sphere(p), models.first()) else {
+            out.fill(None);
+            return;
+        };
+        let shared = first.lift(&s);
+        for (pixel, model) in out.iter_mut().zip(models) {
+            let m = if model.xi.to_bits() == first.xi.to_bits() {
+                shared
+            } else {
+                model.lift(&s)
+            };
+            *pixel = m.map(|(x, y)| model.image(x, y));
+        }
     }
 }
 
@@ -204,6 +232,7 @@ fn levenberg_marquardt<M: Projection>(start: M, rays: &[Correspondence]) -> M {
 }
 
 /// `J^T J` and `J^T r` of the reprojection residuals, with a central-difference Jacobian.
+/// `J^T J` is summed into its lower triangle, row after row of `J`, and mirrored at the end.
 fn normal_equations<M: Projection>(
     model: &M,
     rays: &[Correspondence],
@@ -211,28 +240,30 @@ fn normal_equations<M: Projection>(
     let p = model.params();
     let n = p.len();
     let steps: Vec<f64> = p.iter().map(|v| 1e-6 * v.abs().max(1e-2)).collect();
-    let shifted: Vec<[M; 2]> = (0..n)
-        .map(|i| {
-            [1.0, -1.0].map(|sign| {
-                let mut q = p.clone();
-                q[i] += sign * steps[i];
-                model.with_params(&q)
-            })
-        })
-        .collect();
-    let mut jtj = DMatrix::<f64>::zeros(n, n);
-    let mut jtr = DVector::<f64>::zeros(n);
-    let mut rows = [DVector::<f64>::zeros(n), DVector::<f64>::zeros(n)];
+    // The model, then each parameter moved up and down by its step.
+    let mut models = vec![*model];
+    for i in 0..n {
+        for sign in [1.0, -1.0] {
+            let mut q = p.clone();
+            q[i] += sign * steps[i];
+            models.push(model.with_params(&q));
+        }
+    }
+    let mut pixels = vec![None; models.len()];
+    let mut jtj = vec![0.0; n * n]; // column-major, as DMatrix
+    let mut jtr = vec![0.0; n];
+    let mut rows = [vec![0.0; n], vec![0.0; n]];
     for c in rays {
-        let Some(base) = model.project(&c.direction) else {
+        M::project_each(&models, &c.direction, &mut pixels);
+        let Some(base) = pixels[0] else {
             continue;
         };
         for row in rows.iter_mut() {
             row.fill(0.0);
         }
-        for (i, [plus, minus]) in shifted.iter().enumerate() {
+        for i in 0..n {
             // Central differences, one-sided at the edge of a parameter's range.
-            let (a, b, span) = match (plus.project(&c.direction), minus.project(&c.direction)) {
+            let (a, b, span) = match (pixels[1 + 2 * i], pixels[2 + 2 * i]) {
                 (Some(a), Some(b)) => (a, b, 2.0 * steps[i]),
                 (Some(a), None) => (a, base, steps[i]),
                 (None, Some(b)) => (base, b, steps[i]),
@@ -242,13 +273,21 @@ fn normal_equations<M: Projection>(
                 rows[k][i] = (a[k] - b[k]) / span;
             }
         }
-        for k in 0..2 {
-            jtj.syger(1.0, &rows[k], &rows[k], 1.0);
-            jtr.axpy(base[k] - c.pixel[k], &rows[k], 1.0);
+        for (k, row) in rows.iter().enumerate() {
+            for (j, (column, &rj)) in jtj.chunks_exact_mut(n).zip(row).enumerate() {
+                for (sum, &ri) in column[j..].iter_mut().zip(&row[j..]) {
+                    *sum += ri * rj;
+                }
+            }
+            let r = base[k] - c.pixel[k];
+            for (sum, &d) in jtr.iter_mut().zip(row) {
+                *sum += r * d;
+            }
         }
     }
+    let mut jtj = DMatrix::from_vec(n, n, jtj);
     jtj.fill_upper_triangle_with_lower_triangle();
-    (jtj, jtr)
+    (jtj, DVector::from_vec(jtr))
 }
 
 #[cfg(test)]
@@ -288,6 +327,50 @@ mod tests {
         assert!(r.worst_px < 1e-4, "{r:?}");
         assert!((m.xi - truth.xi).abs() < 1e-4, "{m:?}");
         assert!((m.focal_px[0] - truth.focal_px[0]).abs() < 0.05, "{m:?}");
+    }
+
+    #[test]
+    fn projecting_under_many_models_at_once_gives_each_models_own_bits() {
+        let base = UnifiedModel {
+            focal_px: [420.0, 415.0],
+            skew_px: 0.3,
+            principal_px: [127.3, 109.1],
+            xi: 0.97,
+            distortion: [0.02, -0.004, 0.0006, -0.0003],
+        };
+        // The Jacobian's models: each parameter moved up and down, xi among them; then one
+        // that images nothing below its horizon and one with xi back at the first's.
+        let p = UnifiedModel::params(&base);
+        let mut models = vec![base];
+        for i in 0..9 {
+            for step in [1e-6, -1e-6] {
+                let mut q = p;
+                q[i] += step * p[i].abs().max(1e-2);
+                models.push(base.with_params(&q));
+            }
+        }
+        models.push(UnifiedModel { xi: 0.0, ..base });
+        models.push(UnifiedModel {
+            focal_px: [1.0, 2.0],
+            ..base
+        });
+        let mut points: Vec<Vector3<f64>> = rays_of(&base).iter().map(|c| c.direction).collect();
+        points.extend([
+            Vector3::zeros(),
+            Vector3::new(f64::NAN, 0.0, 1.0),
+            Vector3::new(f64::INFINITY, 0.0, 1.0),
+            Vector3::new(0.3, -0.2, -0.97), // past the horizon of xi 0.97 but not of xi 1
+            Vector3::new(1.0, 0.0, -0.97),  // z_s + xi near zero
+            Vector3::new(-0.0, 0.0, 2.0),
+        ]);
+        let mut out = vec![None; models.len()];
+        for point in &points {
+            UnifiedModel::project_each(&models, point, &mut out);
+            for (model, got) in models.iter().zip(&out) {
+                let bits = |p: Option<[f64; 2]>| p.map(|[u, v]| [u.to_bits(), v.to_bits()]);
+                assert_eq!(bits(*got), bits(model.project(point)), "{point} {model:?}");
+            }
+        }
     }
 
     #[test]

@@ -51,24 +51,52 @@ impl UnifiedModel {
     /// The pixel `[u, v]` where the point `p` (model frame, any distance) images, or `None` for
     /// a point the model cannot image (`z_s + xi <= 0`, or at the origin).
     pub fn project(&self, p: &Vector3<f64>) -> Option<[f64; 2]> {
+        let (x, y) = self.lift(&Self::on_sphere(p)?)?;
+        Some(self.image(x, y))
+    }
+
+    /// `P_s = P / |P|`, or `None` at the origin or for a point not finite.
+    pub(crate) fn on_sphere(p: &Vector3<f64>) -> Option<Vector3<f64>> {
         let n = p.norm();
         if n.is_nan() || n <= 0.0 || !n.is_finite() {
             return None;
         }
-        let s = p / n;
+        Some(p / n)
+    }
+
+    /// `m = (x_s / (z_s + xi), y_s / (z_s + xi))` of a point on the unit sphere, or `None`
+    /// where `z_s + xi <= 0` (eq. (5)).
+    pub(crate) fn lift(&self, s: &Vector3<f64>) -> Option<(f64, f64)> {
         let denom = s.z + self.xi;
         if denom <= 1e-9 {
             return None;
         }
-        let (x, y) = (s.x / denom, s.y / denom);
+        Some((s.x / denom, s.y / denom))
+    }
+
+    /// The pixel of the undistorted normalised point `m = (x, y)`: the distortion, then the
+    /// focal lengths, skew and principal point.
+    pub(crate) fn image(&self, x: f64, y: f64) -> [f64; 2] {
+        let (xd, yd) = self.distort(x, y);
+        self.pixel(xd, yd)
+    }
+
+    /// `m_d`, the normalised point `m = (x, y)` distorted.
+    pub(crate) fn distort(&self, x: f64, y: f64) -> (f64, f64) {
         let [k1, k2, p1, p2] = self.distortion;
         let r2 = x * x + y * y;
         let radial = 1.0 + k1 * r2 + k2 * r2 * r2;
         let xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
         let yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+        (xd, yd)
+    }
+
+    /// The pixel of the distorted point `m_d = (xd, yd)`: focal lengths, skew and principal
+    /// point.
+    pub(crate) fn pixel(&self, xd: f64, yd: f64) -> [f64; 2] {
         let [fx, fy] = self.focal_px;
         let [cx, cy] = self.principal_px;
-        Some([fx * xd + self.skew_px * yd + cx, fy * yd + cy])
+        [fx * xd + self.skew_px * yd + cx, fy * yd + cy]
     }
 
     /// The unit ray (model frame) of pixel `[u, v]`, or `None` where the model has no ray: the
