@@ -44,8 +44,15 @@ PY
 envs_dir="$(mktemp -d)"
 python_envs > "$envs_dir/log" 2>&1 &
 envs=$!
-# Should the Rust tests fail, the environments' installs stop with them.
-trap 'pkill -P "$envs" 2>/dev/null || true; kill "$envs" 2>/dev/null || true' EXIT
+# Should the Rust tests fail, the environments' installs stop with them; the folder of their
+# logs goes at the end.
+stop() {
+  for job in "$@"; do
+    pkill -P "$job" 2>/dev/null || true
+    kill "$job" 2>/dev/null || true
+  done
+}
+trap 'stop "$envs" ${types:-}; rm -rf "$envs_dir"' EXIT
 
 cargo test --workspace
 # The binary cargo test just built: python/tests/test_ssl.py serves its games with it.
@@ -59,9 +66,20 @@ fi
 cat "$envs_dir/log"
 # The dev profile is the one `cargo test` just built: the extension reuses its artifacts.
 MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test,ros]"
-"$venv/bin/python" -m pytest -q -n logical --maxprocesses 4 python/tests
-# The package's types: mypy --strict on the package and its examples (the settings in
+# The package's types, checked beside the Python tests (on one core; they need only the package
+# built above): mypy --strict on the package and its examples (the settings in
 # python/pyproject.toml's [tool.mypy]), then stubtest, the native module's stub
 # (omniloop/_omniloop.pyi) against the module built above.
-"$venv/bin/python" -m mypy --config-file python/pyproject.toml python/omniloop python/examples
-"$venv/bin/python" -m mypy.stubtest omniloop._omniloop --allowlist python/stubtest-allowlist.txt
+(
+  "$venv/bin/python" -m mypy --config-file python/pyproject.toml python/omniloop python/examples
+  "$venv/bin/python" -m mypy.stubtest omniloop._omniloop --allowlist python/stubtest-allowlist.txt
+) > "$envs_dir/types.log" 2>&1 &
+types=$!
+status=0
+"$venv/bin/python" -m pytest -q -n logical --maxprocesses 4 python/tests || status=$?
+if ! wait "$types"; then
+  status=1
+  echo "omniloop: the package's type checks failed:" >&2
+fi
+cat "$envs_dir/types.log"
+exit "$status"

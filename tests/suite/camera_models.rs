@@ -9,12 +9,13 @@ use crate::common;
 use common::{assert_alike, bin, cpu, gpu_or_skip, scenario, scenario_path, tmp};
 use nalgebra::{Isometry2, Matrix3, Vector2};
 use omniloop::Scenario;
-use omniloop::camera_export::{CameraFormat, export_camera_model};
+use omniloop::camera_export::{CameraExport, CameraFormat, export_camera_model};
 use omniloop::run::render_snapshot;
 use omniloop::run_scenario;
 use omniloop_sim::Renderer;
 use omniloop_sim::optics::{CalibratedCamera, Optics};
 use std::path::Path;
+use std::sync::OnceLock;
 
 /// The E1 corner at its start and near its inner tip, where the walls fill the view.
 fn poses() -> [Option<Isometry2<f64>>; 2] {
@@ -27,11 +28,23 @@ fn poses() -> [Option<Isometry2<f64>>; 2] {
     ]
 }
 
+/// E1's sensor exported as `format`: fitted once for the tests of this file that share it (a
+/// fit takes seconds).
+fn exported(format: CameraFormat) -> &'static CameraExport {
+    static EXPORTS: OnceLock<Vec<(CameraFormat, CameraExport)>> = OnceLock::new();
+    let exports = EXPORTS.get_or_init(|| {
+        let s = scenario("corner55_velocity_aware.toml");
+        let spec = &s.robot.sensors[0];
+        let export = |(_, f): (&str, CameraFormat)| (f, export_camera_model(spec, f).unwrap());
+        CameraFormat::ALL.into_iter().map(export).collect()
+    });
+    &exports.iter().find(|(f, _)| *f == format).unwrap().1
+}
+
 /// E1's scenario with its sensor exported as `format` into `dir` and imported again.
 fn reimported(format: CameraFormat, dir: &Path) -> Scenario {
     let mut s = scenario("corner55_velocity_aware.toml");
-    let spec = &s.robot.sensors[0];
-    let e = export_camera_model(spec, format).unwrap();
+    let e = exported(format);
     assert!(
         e.residual.worst_px < 0.05,
         "{}: {:?}",
