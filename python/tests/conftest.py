@@ -61,3 +61,16 @@ def to_goal(goal_body_mm, speed_mm_s: float = 400.0):
     d = max((gx * gx + gy * gy) ** 0.5, 1e-9)
     v = min(speed_mm_s, 2.0 * d)
     return (v * gx / d, v * gy / d, 0.0)
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", "long: a test of tens of seconds, started first (see below)"
+    )
+
+
+def pytest_collection_modifyitems(items: list) -> None:
+    """The tests marked `long` first, in their order, then the rest in theirs: pytest-xdist
+    (`pytest -n`, as scripts/test.sh runs) hands tests out in this order, so that the long ones
+    start early and no worker is left running one alone at the end."""
+    items.sort(key=lambda item: item.get_closest_marker("long") is None)

@@ -238,6 +238,7 @@ def test_the_vector_task_gives_what_the_single_one_gives() -> None:
     assert seeds[-1] == (23, 24)
 
 
+@pytest.mark.long
 def test_training_end_to_end_reproduces_its_weights(tmp_path: Path) -> None:
     script = str(ROOT / "python" / "examples" / "train_grab.py")
 

@@ -60,6 +60,7 @@ def test_a_bad_key_raises_before_anything_runs(tmp_path):
     assert not (tmp_path / "bad" / "rows.jsonl").exists()
 
 
+@pytest.mark.long
 def test_a_ray_cluster_of_two_nodes_losing_one_gives_the_local_sweeps_rows(tmp_path):
     import ray  # in the test extra: pip install ./python[test]
     from ray.cluster_utils import Cluster
