@@ -77,23 +77,11 @@ impl UnifiedModel {
     /// The pixel of the undistorted normalised point `m = (x, y)`: the distortion, then the
     /// focal lengths, skew and principal point.
     pub(crate) fn image(&self, x: f64, y: f64) -> [f64; 2] {
-        let (xd, yd) = self.distort(x, y);
-        self.pixel(xd, yd)
-    }
-
-    /// `m_d`, the normalised point `m = (x, y)` distorted.
-    pub(crate) fn distort(&self, x: f64, y: f64) -> (f64, f64) {
         let [k1, k2, p1, p2] = self.distortion;
         let r2 = x * x + y * y;
         let radial = 1.0 + k1 * r2 + k2 * r2 * r2;
         let xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
         let yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
-        (xd, yd)
-    }
-
-    /// The pixel of the distorted point `m_d = (xd, yd)`: focal lengths, skew and principal
-    /// point.
-    pub(crate) fn pixel(&self, xd: f64, yd: f64) -> [f64; 2] {
         let [fx, fy] = self.focal_px;
         let [cx, cy] = self.principal_px;
         [fx * xd + self.skew_px * yd + cx, fy * yd + cy]
