@@ -44,6 +44,7 @@
 //!   end a run that a look from nearer would have saved).
 
 use super::config::PlannerConfig;
+use super::distances::DistanceFields;
 use super::grid::{CellState, GridGeometry, MAX_CELLS, MapSnapshot, OccupancyGrid};
 use super::planner::{CostMap, CostSettings, Suspects, length};
 use crate::RobotError;
@@ -208,6 +209,8 @@ pub struct Navigator {
     /// Places closed to the planner until the target changes, a level a cell: 1 after one
     /// failure there (dearer by `CLOSED_FACTOR`), 2 after a second (impassable).
     closed: Vec<u8>,
+    /// The grid's distance fields, made again only where its blocked or suspect cells changed.
+    distances: DistanceFields,
     cost_map: Option<CostMap>,
     plan: Option<Plan>,
     target: Option<Point2<f64>>,
@@ -256,6 +259,7 @@ impl Navigator {
             penalty: vec![0.0; geometry.len()],
             penalty_t_s: 0.0,
             closed: vec![0; geometry.len()],
+            distances: DistanceFields::default(),
             cost_map: None,
             plan: None,
             target: None,
@@ -526,12 +530,14 @@ impl Navigator {
 
     /// Why no route reaches `target`: a place the navigator closed, when a route exists
     /// without the closed places; else no route on the map.
-    fn why_no_route(&self, here: Point2<f64>, target: Point2<f64>) -> Unreachable {
+    fn why_no_route(&mut self, here: Point2<f64>, target: Point2<f64>) -> Unreachable {
         let Some(why) = self.closed_by else {
             return Unreachable::NoRoute;
         };
-        let costs = CostMap::new(
+        self.distances.update(&self.grid);
+        let costs = CostMap::priced(
             &self.grid,
+            &self.distances,
             &self.tight_costs(),
             &self.penalty,
             here,
@@ -602,14 +608,23 @@ impl Navigator {
         } else {
             std::borrow::Cow::Borrowed(&self.penalty[..])
         };
-        let mut costs = CostMap::new(&self.grid, &self.costs, &penalties, here, Suspects::Costly);
+        self.distances.update(&self.grid);
+        let (grid, fields) = (&self.grid, &self.distances);
+        let mut costs = CostMap::priced(
+            grid,
+            fields,
+            &self.costs,
+            &penalties,
+            here,
+            Suspects::Costly,
+        );
         let mut found = costs.plan(here, target, self.accept_mm);
         if found.is_none() {
             // No route with the comfort of the inflation: one the body fits, with
             // `TIGHT_MM` to spare, before giving up (the map's edges are a cell and a ring
             // out, and the controller drives where its body fits).
             let tight = self.tight_costs();
-            costs = CostMap::new(&self.grid, &tight, &penalties, here, Suspects::Costly);
+            costs = CostMap::priced(grid, fields, &tight, &penalties, here, Suspects::Costly);
             found = costs.plan(here, target, self.accept_mm);
         }
         self.report.replans += 1;
@@ -665,14 +680,16 @@ impl Navigator {
             inflated_mm: self.radius_mm,
             ..self.costs
         };
-        let closed = suspects
-            && (target - here).norm() <= self.config.pocket_sight_mm
-            && CostMap::new(&self.grid, &body, &[], here, Suspects::Blocked).goal_in_pocket(
+        let closed = suspects && (target - here).norm() <= self.config.pocket_sight_mm && {
+            self.distances.update(&self.grid);
+            let (grid, fields) = (&self.grid, &self.distances);
+            CostMap::priced(grid, fields, &body, &[], here, Suspects::Blocked).goal_in_pocket(
                 here,
                 target,
                 self.accept_mm,
                 pocket,
-            );
+            )
+        };
         self.closed_s = (self.closed_s + if closed { dt } else { -dt }).max(0.0);
         closed && self.closed_s >= self.config.pocket_unreachable_s - 1e-9
     }

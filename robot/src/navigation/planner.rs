@@ -7,7 +7,7 @@
 //! `f = 1 + u [cell unknown] + w (1 - (d - r_i) / c)^2 [d < r_i + c] + s [d_s < r_i] + p`
 //!
 //! with `d` the distance from the cell's centre to the nearest blocked cell's centre (the
-//! exact Euclidean distance transform of Felzenszwalb and Huttenlocher, by `imageproc`), `d_s`
+//! exact Euclidean distance transform of Felzenszwalb and Huttenlocher, [`super::distances`]), `d_s`
 //! the same to the nearest suspect cell (seen occupied only from afar, see
 //! [`super::grid`]) and `s` its factor `SUSPECT_FACTOR`, `r_i`
 //! the robot's radius plus `inflation_mm` (nearer is impassable), `c` the comfort band
@@ -19,9 +19,8 @@
 //! can leave. The goal is any passable cell whose centre lies within the goal's acceptance
 //! radius.
 
+use super::distances::{DistanceFields, Field};
 use super::grid::{CellState, GridGeometry, OccupancyGrid};
-use imageproc::distance_transform::euclidean_squared_distance_transform;
-use imageproc::image::GrayImage;
 use nalgebra::Point2;
 use pathfinding::prelude::astar;
 
@@ -67,8 +66,8 @@ pub struct CostMap {
     factor: Vec<Option<f32>>,
     /// Each cell's distance to the nearest blocked cell and to the nearest suspect cell, mm
     /// (`None`: there is none).
-    blocked_mm: Option<Vec<f32>>,
-    suspect_mm: Option<Vec<f32>>,
+    blocked_mm: Field,
+    suspect_mm: Field,
 }
 
 impl CostMap {
@@ -81,11 +80,25 @@ impl CostMap {
         robot: Point2<f64>,
         suspects: Suspects,
     ) -> Self {
+        let fields = DistanceFields::of(grid);
+        Self::priced(grid, &fields, settings, penalty, robot, suspects)
+    }
+
+    /// [`Self::new`] with the grid's distance fields already made (`fields`, up to date with
+    /// `grid`): a navigator keeps them between replans.
+    pub fn priced(
+        grid: &OccupancyGrid,
+        fields: &DistanceFields,
+        settings: &CostSettings,
+        penalty: &[f32],
+        robot: Point2<f64>,
+        suspects: Suspects,
+    ) -> Self {
         let g = *grid.geometry();
         let ri = settings.inflated_mm as f32;
-        let blocked = distances_mm(grid, CellState::Blocked);
-        let suspect = distances_mm(grid, CellState::Suspect);
-        let at = |v: &Option<Vec<f32>>, i: usize| v.as_ref().map_or(f32::INFINITY, |v| v[i]);
+        let blocked = fields.blocked_mm().clone();
+        let suspect = fields.suspect_mm().clone();
+        let at = |v: &Field, i: usize| v.as_ref().map_or(f32::INFINITY, |v| v[i]);
         let comfort = settings.comfort_mm.max(1e-6) as f32;
         let escape2 =
             ((settings.inflated_mm + g.cell_mm) * (settings.inflated_mm + g.cell_mm)) as f32;
@@ -128,7 +141,7 @@ impl CostMap {
     /// The distance from the cell holding `p` to the nearest blocked or suspect cell, mm
     /// (infinite outside the grid or where none is).
     pub fn room_at(&self, p: Point2<f64>) -> f64 {
-        let at = |v: &Option<Vec<f32>>, i: usize| v.as_ref().map_or(f32::INFINITY, |v| v[i]);
+        let at = |v: &Field, i: usize| v.as_ref().map_or(f32::INFINITY, |v| v[i]);
         self.geometry.cell_of(p).map_or(f64::INFINITY, |i| {
             f64::from(at(&self.blocked_mm, i).min(at(&self.suspect_mm, i)))
         })
@@ -281,28 +294,6 @@ impl CostMap {
         }
         out
     }
-}
-
-/// The distance from every cell's centre to the nearest centre of a cell in `state` (mm,
-/// row-major from the lower-left cell); `None` when no cell is in `state` (no transform then).
-fn distances_mm(grid: &OccupancyGrid, state: CellState) -> Option<Vec<f32>> {
-    let g = grid.geometry();
-    let mut marked = GrayImage::new(g.width as u32, g.height as u32);
-    let mut any = false;
-    for (px, cell) in marked.pixels_mut().zip(grid.states()) {
-        if cell == state {
-            px.0[0] = 255;
-            any = true;
-        }
-    }
-    let cell2 = (g.cell_mm * g.cell_mm) as f32;
-    any.then(|| {
-        euclidean_squared_distance_transform(&marked)
-            .as_raw()
-            .iter()
-            .map(|&d2| (d2 as f32 * cell2).sqrt())
-            .collect()
-    })
 }
 
 /// The 8 neighbours of a cell.
