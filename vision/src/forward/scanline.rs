@@ -195,15 +195,17 @@ impl ScanLine {
     fn shift_within(&self, a: &[f32], b: &[f32], lo: i64, hi: i64) -> f64 {
         let w = a.len() as i64;
         let (lo, hi) = (lo.max(self.rho - w), hi.min(self.rho));
-        let f = |t: i64| Self::difference(a, b, t);
+        // Each shift's difference computed once; the first of equal minima wins.
         let best = (lo..=hi)
-            .min_by(|&x, &y| f(x).total_cmp(&f(y)))
-            .unwrap_or(0);
+            .map(|t| (t, Self::difference(a, b, t)))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .map_or(0, |(t, _)| t);
         (-100..=100)
             .map(|k| best as f64 + k as f64 / 100.0)
             .filter(|&t| t >= lo as f64 && t <= hi as f64)
-            .min_by(|&x, &y| Self::difference_at(a, b, x).total_cmp(&Self::difference_at(a, b, y)))
-            .unwrap_or(best as f64)
+            .map(|t| (t, Self::difference_at(a, b, t)))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .map_or(best as f64, |(t, _)| t)
     }
 
     /// Eq. (5): the rotation between the frames of profiles `a` and `b`, rad, counter-clockwise
