@@ -267,9 +267,74 @@ impl Sensor {
     /// mirror.
     pub fn pixel_ray(&self, u: u32, v: u32) -> Option<crate::optics::Ray> {
         let (x, y) = self.image_coords(u, v);
-        let mut ray = self.scene_ray(x, y)?;
+        self.scene_ray(x, y).map(|ray| self.mounted(ray))
+    }
+
+    /// Every pixel's [`Self::pixel_ray`], row by row from the top: the same rays to the bit,
+    /// with what a pinhole camera's pixels share (its basis, two sines and cosines) worked out
+    /// once, not once a pixel (a camera on a pan unit is traced again at every frame).
+    pub fn pixel_rays(&self) -> impl Iterator<Item = Option<crate::optics::Ray>> + '_ {
+        let pinhole = match &self.optics {
+            Optics::Pinhole(c) => Some((c, c.basis())),
+            _ => None,
+        };
+        let (w, h) = (self.width_px, self.height_px);
+        (0..h).flat_map(move |v| {
+            (0..w).map(move |u| match &pinhole {
+                Some((c, basis)) => {
+                    let (x, y) = self.image_coords(u, v);
+                    Some(self.mounted(c.ray_in(basis, x, y)))
+                }
+                None => self.pixel_ray(u, v),
+            })
+        })
+    }
+
+    /// `ray` from the sensor's frame to the robot's: moved by the sensor's place on the robot.
+    fn mounted(&self, mut ray: crate::optics::Ray) -> crate::optics::Ray {
         ray.origin.x += self.mount_mm[0];
         ray.origin.y += self.mount_mm[1];
-        Some(ray)
+        ray
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every ray's numbers as bits, `None` for a pixel that sees no mirror.
+    fn bits(rays: impl Iterator<Item = Option<crate::optics::Ray>>) -> Vec<Option<[u64; 7]>> {
+        rays.map(|r| {
+            r.map(|r| {
+                let (o, d) = (r.origin, r.dir);
+                [o.x, o.y, o.z, d.x, d.y, d.z, r.path_mm].map(f64::to_bits)
+            })
+        })
+        .collect()
+    }
+
+    #[test]
+    fn all_pixel_rays_at_once_are_each_pixels_ray_to_the_bit() {
+        let mut mirror = SensorSpec::corner_paper("omni");
+        (mirror.width_px, mirror.height_px, mirror.mount_mm) = (40, 30, [12.5, -7.0]);
+        let mut panned = mirror.clone();
+        panned.optics = Optics::Pinhole(PinholeCamera {
+            focal_px: 51.6,
+            height_mm: 280.0,
+            pan_deg: -37.3,
+            tilt_deg: -11.0,
+            pan_rate_limit_deg_s: 60.0,
+        });
+        for spec in [mirror, panned] {
+            let s = spec.build();
+            let one_by_one = (0..s.height_px)
+                .flat_map(|v| (0..s.width_px).map(move |u| (u, v)))
+                .map(|(u, v)| s.pixel_ray(u, v));
+            let all = bits(s.pixel_rays());
+            assert_eq!(all.len(), 40 * 30);
+            // The mirror's corners see no mirror; the pinhole camera sees everywhere.
+            assert!(all.iter().any(Option::is_some), "{}", s.name);
+            assert_eq!(all, bits(one_by_one), "{:?}", s.optics.kind());
+        }
     }
 }

@@ -116,35 +116,32 @@ impl SensorRays {
     }
 
     fn traced(sensor: &Sensor, by_elevation: bool) -> Self {
-        let (w, h) = (sensor.width_px, sensor.height_px);
-        let mut rays = Vec::with_capacity((w * h) as usize);
+        let mut rays = Vec::with_capacity((sensor.width_px * sensor.height_px) as usize);
         // The farthest a ray starts from the axis: the optics' bound, or beyond it where a
         // mirror is mounted off its place.
         let mut max_offset = sensor.optics.max_origin_offset_mm();
-        for v in 0..h {
-            for u in 0..w {
-                rays.push(match sensor.pixel_ray(u, v) {
-                    Some(r) => {
-                        let axis_offset = (r.origin.x - sensor.mount_mm[0])
-                            .hypot(r.origin.y - sensor.mount_mm[1]);
-                        max_offset = max_offset.max(axis_offset);
-                        let d = [r.dir.x as f32, r.dir.y as f32, r.dir.z as f32];
-                        PixelRay {
-                            o: [r.origin.x as f32, r.origin.y as f32, r.origin.z as f32],
-                            d,
-                            // The body flag's bit clear until the body is known.
-                            azimuth: turns(d[1].atan2(d[0]) as f64) & !1,
-                            d_xy: (d[0] * d[0] + d[1] * d[1]).sqrt(),
-                        }
+        for ray in sensor.pixel_rays() {
+            rays.push(match ray {
+                Some(r) => {
+                    let axis_offset =
+                        (r.origin.x - sensor.mount_mm[0]).hypot(r.origin.y - sensor.mount_mm[1]);
+                    max_offset = max_offset.max(axis_offset);
+                    let d = [r.dir.x as f32, r.dir.y as f32, r.dir.z as f32];
+                    PixelRay {
+                        o: [r.origin.x as f32, r.origin.y as f32, r.origin.z as f32],
+                        d,
+                        // The body flag's bit clear until the body is known.
+                        azimuth: turns(d[1].atan2(d[0]) as f64) & !1,
+                        d_xy: (d[0] * d[0] + d[1] * d[1]).sqrt(),
                     }
-                    None => PixelRay {
-                        o: [0.0; 3],
-                        d: [0.0; 3],
-                        azimuth: 0,
-                        d_xy: -1.0,
-                    },
-                });
-            }
+                }
+                None => PixelRay {
+                    o: [0.0; 3],
+                    d: [0.0; 3],
+                    azimuth: 0,
+                    d_xy: -1.0,
+                },
+            });
         }
         Self {
             rays,
