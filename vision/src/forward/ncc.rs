@@ -72,16 +72,17 @@ pub fn match_ncc(
     if tt < 1e-6 {
         return None;
     }
-    // Eq. (7) at the template's centre (m, n) in `b`.
-    let score = |m: i64, n: i64| -> Option<f64> {
+    // Eq. (7) at the template's centre (m, n) in `b`; `patch` is reused from one to the next.
+    let mut patch = Vec::with_capacity(side * side);
+    let mut score = |m: i64, n: i64| -> Option<f64> {
         if m < r || n < r || m + r >= w || n + r >= h {
             return None;
         }
-        let mut patch = Vec::with_capacity(side * side);
-        for dy in -r..=r {
-            for dx in -r..=r {
-                patch.push(b.get_pixel((m + dx) as u32, (n + dy) as u32).0[0] as f64);
-            }
+        patch.clear();
+        let (raw, row_px) = (b.as_raw(), b.width() as usize);
+        for y in n - r..=n + r {
+            let start = y as usize * row_px + (m - r) as usize;
+            patch.extend(raw[start..start + side].iter().map(|&p| p as f64));
         }
         let mean = patch.iter().sum::<f64>() / patch.len() as f64;
         let (mut num, mut ii) = (0.0, 0.0);

@@ -163,7 +163,8 @@ impl ScanLine {
             if x < 0.0 || x > (w - 1) as f64 {
                 return None;
             }
-            let k = (x.floor() as usize).min(w - 2);
+            // `x >= 0` here, so truncating is flooring (without a call to `floor`).
+            let k = (x as usize).min(w - 2);
             let f = x - k as f64;
             Some(v[k] as f64 * (1.0 - f) + v[k + 1] as f64 * f)
         };
