@@ -394,7 +394,9 @@ impl OccupancyGrid {
                 let obstacle = (fs.free_mm[j] < fs.range_mm || !open)
                     && fs.free_mm[j] <= TRUST_MM
                     && !explained[j];
-                let lateral = d * (bearing - k * step).sin().abs();
+                // How far the cell's centre lies off the sector's centre line: worked out
+                // only for a cell that may be marked (most are cleared).
+                let lateral = || d * (bearing - k * step).sin().abs();
                 if open && d <= fs.clear_mm[j] {
                     // A cell confirmed blocked from near is cleared only from near: from
                     // afar a sector seen free may hold the edge of a cube beside it.
@@ -403,7 +405,7 @@ impl OccupancyGrid {
                     }
                     L_FREE
                 } else if obstacle
-                    && lateral <= strip
+                    && lateral() <= strip
                     && d <= front_of(j)
                     && d >= (front_of(j) - depth).min(fs.free_mm[j])
                 {
