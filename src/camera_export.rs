@@ -419,37 +419,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_hyperbolic_mirror_is_central_and_the_unified_model_exact_for_it() {
-        let spec = SensorSpec::corner_paper("omni");
-        let e = export_camera_model(&spec, CameraFormat::OpencvOmnidir).unwrap();
-        assert!(e.residual.count > 20_000, "{:?}", e.residual);
-        assert!(e.residual.worst_px < 0.05, "{:?}", e.residual);
-        assert!(e.viewpoint_spread_mm < 1e-6, "{}", e.viewpoint_spread_mm);
-        // The viewpoint is the upper focus, 205.08 mm above the floor on the axis.
-        let t = e.pose.translation_mm;
-        assert!(t.xy().norm() < 1e-9 && (t.z - 205.08).abs() < 1e-9, "{t}");
-        // xi = 2e / (1 + e^2) with e = c / b (Geyer and Daniilidis).
-        let m = omniloop_sim::optics::HyperbolicMirror::corner_paper();
-        let ecc = m.focal_half_distance_mm() / m.b_mm;
-        let FittedModel::Unified(m) = e.model else {
-            panic!("{:?}", e.model)
-        };
-        assert!((m.xi - 2.0 * ecc / (1.0 + ecc * ecc)).abs() < 1e-4, "{m:?}");
-        // The double sphere model holds the unified one: exact too.
-        let ds = export_camera_model(&spec, CameraFormat::KalibrDs).unwrap();
-        assert!(ds.residual.worst_px < 0.05, "{:?}", ds.residual);
-        assert!(ds.text.contains("camera_model: ds"), "{}", ds.text);
-        // Scaramuzza's polynomial approximates it (degree 4, its inverse to 0.01 px).
-        let ocam = export_camera_model(&spec, CameraFormat::Ocamcalib).unwrap();
-        assert!(ocam.residual.worst_px < 0.05, "{:?}", ocam.residual);
-        assert!(
-            ocam.text.starts_with("#polynomial coefficients"),
-            "{}",
-            ocam.text
-        );
-    }
-
-    #[test]
     fn a_pinhole_camera_is_not_exported() {
         let s =
             crate::load_scenario(std::path::Path::new("scenarios/render_pinhole.toml")).unwrap();

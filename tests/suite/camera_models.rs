@@ -1,7 +1,8 @@
 //! Standard camera models in and out, end to end: the corner paper's hyperbolic sensor
-//! exported to each central format and imported again as a `calibrated` sensor renders the
-//! analytic mirror's frames (CPU and GPU), drives E1 to its goal, and a bad calibration file
-//! stops a scenario with its file, line and field.
+//! exported to each central format (its viewpoint the mirror's focus, the unified model exact
+//! for it) and imported again as a `calibrated` sensor renders the analytic mirror's frames
+//! (CPU and GPU), drives E1 to its goal, and a bad calibration file stops a scenario with its
+//! file, line and field. The four fits are made once for the whole file (seconds each).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a test: a broken fixture stops it where it breaks
 
 use crate::common;
@@ -9,11 +10,12 @@ use crate::common;
 use common::{assert_alike, bin, cpu, gpu_or_skip, scenario, scenario_path, tmp};
 use nalgebra::{Isometry2, Matrix3, Vector2};
 use omniloop::Scenario;
-use omniloop::camera_export::{CameraExport, CameraFormat, export_camera_model};
+use omniloop::camera_export::{CameraExport, CameraFormat, FittedModel, export_camera_model};
 use omniloop::run::render_snapshot;
 use omniloop::run_scenario;
 use omniloop_sim::Renderer;
-use omniloop_sim::optics::{CalibratedCamera, Optics};
+use omniloop_sim::SensorSpec;
+use omniloop_sim::optics::{CalibratedCamera, HyperbolicMirror, Optics};
 use std::path::Path;
 use std::sync::OnceLock;
 
@@ -66,6 +68,39 @@ fn reimported(format: CameraFormat, dir: &Path) -> Scenario {
     .unwrap();
     s.robot.sensors[0].optics = Optics::Calibrated(cam);
     s
+}
+
+#[test]
+fn the_hyperbolic_mirror_is_central_and_the_unified_model_exact_for_it() {
+    // E1's sensor is the corner paper's.
+    let spec = &scenario("corner55_velocity_aware.toml").robot.sensors[0];
+    assert_eq!(spec, &SensorSpec::corner_paper("omni"));
+    let e = exported(CameraFormat::OpencvOmnidir);
+    assert!(e.residual.count > 20_000, "{:?}", e.residual);
+    assert!(e.residual.worst_px < 0.05, "{:?}", e.residual);
+    assert!(e.viewpoint_spread_mm < 1e-6, "{}", e.viewpoint_spread_mm);
+    // The viewpoint is the upper focus, 205.08 mm above the floor on the axis.
+    let t = e.pose.translation_mm;
+    assert!(t.xy().norm() < 1e-9 && (t.z - 205.08).abs() < 1e-9, "{t}");
+    // xi = 2e / (1 + e^2) with e = c / b (Geyer and Daniilidis).
+    let m = HyperbolicMirror::corner_paper();
+    let ecc = m.focal_half_distance_mm() / m.b_mm;
+    let FittedModel::Unified(m) = &e.model else {
+        panic!("{:?}", e.model)
+    };
+    assert!((m.xi - 2.0 * ecc / (1.0 + ecc * ecc)).abs() < 1e-4, "{m:?}");
+    // The double sphere model holds the unified one: exact too.
+    let ds = exported(CameraFormat::KalibrDs);
+    assert!(ds.residual.worst_px < 0.05, "{:?}", ds.residual);
+    assert!(ds.text.contains("camera_model: ds"), "{}", ds.text);
+    // Scaramuzza's polynomial approximates it (degree 4, its inverse to 0.01 px).
+    let ocam = exported(CameraFormat::Ocamcalib);
+    assert!(ocam.residual.worst_px < 0.05, "{:?}", ocam.residual);
+    assert!(
+        ocam.text.starts_with("#polynomial coefficients"),
+        "{}",
+        ocam.text
+    );
 }
 
 #[test]
@@ -160,11 +195,7 @@ fn a_bad_calibration_file_exits_2_naming_the_file_line_and_field() {
         "{text}"
     );
     // A polynomial whose rays turn back inside the image: world2cam has no real root there.
-    let e = export_camera_model(
-        &scenario("corner55_velocity_aware.toml").robot.sensors[0],
-        CameraFormat::Ocamcalib,
-    )
-    .unwrap();
+    let e = exported(CameraFormat::Ocamcalib);
     let pol_line = e.text.lines().position(|l| l.starts_with("5 ")).unwrap();
     let bent: String = e
         .text
