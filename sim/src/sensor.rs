@@ -270,24 +270,27 @@ impl Sensor {
         self.scene_ray(x, y).map(|ray| self.mounted(ray))
     }
 
-    /// Every pixel's [`Self::pixel_ray`], row by row from the top: the same rays to the bit,
-    /// with what a pinhole camera's pixels share (its basis, two sines and cosines) worked out
-    /// once, not once a pixel (a camera on a pan unit is traced again at every frame).
-    pub fn pixel_rays(&self) -> impl Iterator<Item = Option<crate::optics::Ray>> + '_ {
+    /// Calls `f` with every pixel's [`Self::pixel_ray`], row by row from the top: the same rays
+    /// to the bit, with what a pinhole camera's pixels share (its basis, two sines and cosines)
+    /// worked out once, not once a pixel (a camera on a pan unit is traced again at every
+    /// frame). Plain loops rather than an iterator of rows, so that the per-pixel work is
+    /// inlined into the caller's loop whatever the compiler's budget.
+    pub fn for_each_pixel_ray(&self, mut f: impl FnMut(Option<crate::optics::Ray>)) {
         let pinhole = match &self.optics {
             Optics::Pinhole(c) => Some((c, c.basis())),
             _ => None,
         };
-        let (w, h) = (self.width_px, self.height_px);
-        (0..h).flat_map(move |v| {
-            (0..w).map(move |u| match &pinhole {
-                Some((c, basis)) => {
-                    let (x, y) = self.image_coords(u, v);
-                    Some(self.mounted(c.ray_in(basis, x, y)))
-                }
-                None => self.pixel_ray(u, v),
-            })
-        })
+        for v in 0..self.height_px {
+            for u in 0..self.width_px {
+                f(match &pinhole {
+                    Some((c, basis)) => {
+                        let (x, y) = self.image_coords(u, v);
+                        Some(self.mounted(c.ray_in(basis, x, y)))
+                    }
+                    None => self.pixel_ray(u, v),
+                });
+            }
+        }
     }
 
     /// `ray` from the sensor's frame to the robot's: moved by the sensor's place on the robot.
@@ -330,7 +333,9 @@ mod tests {
             let one_by_one = (0..s.height_px)
                 .flat_map(|v| (0..s.width_px).map(move |u| (u, v)))
                 .map(|(u, v)| s.pixel_ray(u, v));
-            let all = bits(s.pixel_rays());
+            let mut each = Vec::new();
+            s.for_each_pixel_ray(|r| each.push(r));
+            let all = bits(each.into_iter());
             assert_eq!(all.len(), 40 * 30);
             // The mirror's corners see no mirror; the pinhole camera sees everywhere.
             assert!(all.iter().any(Option::is_some), "{}", s.name);

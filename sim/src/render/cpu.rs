@@ -120,7 +120,7 @@ impl SensorRays {
         // The farthest a ray starts from the axis: the optics' bound, or beyond it where a
         // mirror is mounted off its place.
         let mut max_offset = sensor.optics.max_origin_offset_mm();
-        for ray in sensor.pixel_rays() {
+        sensor.for_each_pixel_ray(|ray| {
             rays.push(match ray {
                 Some(r) => {
                     let axis_offset =
@@ -142,7 +142,7 @@ impl SensorRays {
                     d_xy: -1.0,
                 },
             });
-        }
+        });
         Self {
             rays,
             axis: [sensor.mount_mm[0] as f32, sensor.mount_mm[1] as f32],
